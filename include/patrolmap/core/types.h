@@ -1,0 +1,72 @@
+// Plain value types that stages exchange (DESIGN.md, "Stages talk through plain
+// value types"). Times are nanoseconds since an arbitrary epoch of the log;
+// image coordinates are pixels with the origin at the top-left pixel centre.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+namespace patrolmap {
+
+using TimestampNs = std::int64_t;
+
+inline double NsToSeconds(TimestampNs ns) { return static_cast<double>(ns) * 1e-9; }
+inline TimestampNs SecondsToNs(double seconds) {
+  return static_cast<TimestampNs>(seconds * 1e9 + (seconds >= 0 ? 0.5 : -0.5));
+}
+
+// One inertial measurement in the IMU frame: angular rate [rad/s], specific force [m/s^2].
+struct ImuSample {
+  TimestampNs timestamp_ns = 0;
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();
+};
+
+// Pinhole intrinsics at the log's native resolution [pixels].
+struct CameraIntrinsics {
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+  int width = 0, height = 0;
+  bool valid() const { return fx > 0.0 && fy > 0.0 && width > 0 && height > 0; }
+  // The same camera seen through an image resized by `scale`.
+  CameraIntrinsics Scaled(double scale) const;
+};
+
+// One camera frame with the sensor data that arrived since the previous frame
+// the source returned (so skipping frames never loses IMU samples).
+struct Frame {
+  TimestampNs timestamp_ns = 0;
+  std::int64_t index = 0;          // position in the log, counting unreadable frames too
+  cv::Mat image;                   // CV_8UC1; empty when the caller asked not to decode
+  std::vector<ImuSample> imu;      // samples with previous timestamp < t <= timestamp_ns
+  std::optional<double> speed_mps; // known platform speed, when the log carries it
+};
+
+// Kind of extremum of the smoothed scene-flow response (paper 002 §III-A).
+enum class ExtremumKind { kPeak, kValley };
+
+// One processed frame of the flow stage: the response signal before and after smoothing.
+struct FlowSample {
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  double raw_response = 0.0;       // NaN when no flow vector was accepted
+  double smoothed_response = 0.0;  // NaN until the smoothing window holds a valid sample
+  int tracked_vectors = 0;
+  int accepted_vectors = 0;
+};
+
+// A key location event: an extremum of the smoothed response (a node of the map).
+struct KeyLocation {
+  int node_index = 0;
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  double response = 0.0;  // smoothed response at the extremum
+  ExtremumKind kind = ExtremumKind::kPeak;
+};
+
+const char* ToString(ExtremumKind kind);
+
+}  // namespace patrolmap

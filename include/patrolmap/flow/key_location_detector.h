@@ -1,0 +1,85 @@
+// Key-location detection from optical flow, paper 002 §III-A: per processed
+// frame edges -> LK flow -> (de-rotation) -> polar transform -> hysteresis
+// voting -> scene-flow response (equation 3) -> window smoothing -> peaks and
+// valleys -> key locations.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "patrolmap/core/types.h"
+#include "patrolmap/flow/edge_flow.h"
+#include "patrolmap/flow/options.h"
+#include "patrolmap/flow/polar_voting.h"
+#include "patrolmap/flow/signal.h"
+
+namespace patrolmap::flow {
+
+// What the detector knows about the camera (from the log).
+struct CameraContext {
+  std::optional<CameraIntrinsics> camera;         // at the log's native resolution
+  std::optional<Eigen::Matrix3d> camera_from_imu; // needed for de-rotation
+};
+
+// What one call produced; the detector appends, the caller clears.
+struct DetectorOutput {
+  std::vector<FlowSample> samples;         // processed frames whose smoothing is final
+  std::vector<KeyLocation> key_locations;  // confirmed key locations
+};
+
+// Mean response of `accepted` vectors (equation 3) in image widths per
+// processed frame; NaN when none is accepted.
+double SceneFlowResponse(const std::vector<PolarVector>& vectors, const std::vector<std::uint8_t>& accepted,
+                         ResponseQuantity quantity, int image_width);
+
+class KeyLocationDetector {
+ public:
+  // `options` must be valid (KeyLocationOptions::IsValid); checked here.
+  KeyLocationDetector(const KeyLocationOptions& options, const CameraContext& context);
+
+  // Whether the next frame given to Process() will be processed, so a reader
+  // can skip decoding the others.
+  bool NeedsImage() const { return frames_until_next_ == 0; }
+
+  // Takes every frame of the log in order (skipped ones may come without an
+  // image: their IMU samples still count).
+  void Process(const Frame& frame, DetectorOutput* output);
+
+  // Flushes the smoothing window at the end of the log.
+  void Finish(DetectorOutput* output);
+
+  // True when flow is de-rotated (option on, IMU extrinsics and intrinsics known).
+  bool derotating() const { return derotate_; }
+  int processed_frames() const { return processed_frames_; }
+
+ private:
+  void ProcessSelected(const Frame& frame, DetectorOutput* output);
+  const cv::Mat& Downscale(const cv::Mat& image);
+  void Derotate(TimestampNs timestamp_ns, int image_width);
+  double NormaliseBySpeed(double response, const std::optional<double>& speed_mps) const;
+  void Emit(const FlowSample& sample, DetectorOutput* output);
+  void DetectExtrema(DetectorOutput* output);  // runs the released samples through the extremum detector
+
+  KeyLocationOptions options_;
+  CameraContext context_;
+  bool derotate_ = false;
+  EdgeFlowTracker tracker_;
+  std::optional<HysteresisVoter> voter_;
+  WindowSmoother smoother_;
+  ExtremumDetector extrema_;
+
+  int frames_until_next_ = 0;
+  int processed_frames_ = 0;
+  std::optional<TimestampNs> previous_processed_ns_;
+  std::vector<ImuSample> pending_imu_;
+  cv::Mat small_;
+  std::vector<FlowVector> vectors_;
+  std::vector<PolarVector> polar_;
+  std::vector<std::uint8_t> accepted_;
+  std::vector<FlowSample> released_;
+};
+
+}  // namespace patrolmap::flow

@@ -1,0 +1,60 @@
+// FrameSource: one interface for every kind of flight log (DESIGN.md, io).
+// Readers never decide algorithm parameters; they only deliver frames.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/core/types.h"
+
+namespace patrolmap::io {
+
+// What a reader knows about a log before reading frames.
+struct LogInfo {
+  std::string path;
+  std::string kind;                          // "euroc", "image-folder", "image-pattern", "video"
+  std::string flight_id;                     // from meta.yaml, else the folder name
+  std::optional<CameraIntrinsics> camera;    // from cam0/sensor.yaml when present
+  // Rotation taking IMU-frame vectors into the camera frame, when both
+  // extrinsics are known (EuRoC T_BS of cam0 and imu0).
+  std::optional<Eigen::Matrix3d> camera_from_imu;
+  std::int64_t frame_count = -1;             // -1 when unknown (live or some videos)
+  double frame_rate_hz = 0.0;                // nominal; 0 when unknown
+  bool has_imu = false;
+  bool has_speed = false;
+};
+
+// A frame that could not be read and was skipped.
+struct SkippedFrame {
+  std::int64_t index = 0;
+  std::string reason;  // names the file and the problem
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+
+  // Reads the next frame into `frame`. With `decode_image` false the image is
+  // left empty (for frames the caller skips; much cheaper). Returns
+  // Status::EndOfStream() after the last frame. An unreadable image in the
+  // middle of a log is counted in skipped(), logged, and passed over: the call
+  // returns the next readable frame instead.
+  virtual Status Next(bool decode_image, Frame* frame) = 0;
+
+  virtual const LogInfo& info() const = 0;
+
+  const std::vector<SkippedFrame>& skipped() const { return skipped_; }
+
+ protected:
+  void RecordSkipped(std::int64_t index, std::string reason);
+
+ private:
+  std::vector<SkippedFrame> skipped_;
+};
+
+}  // namespace patrolmap::io

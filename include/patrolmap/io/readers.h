@@ -1,0 +1,44 @@
+// The flight-log readers and the function that picks one for a path.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "patrolmap/io/frame_source.h"
+
+namespace patrolmap::io {
+
+struct ImageFolderOptions {
+  // Frame rate assumed for logs without timestamps (image folders, printf
+  // patterns, videos that report none) [Hz].
+  double frame_rate_hz = 30.0;
+};
+
+// Image folder: every .png/.jpg/.jpeg/.bmp/.pgm/.ppm/.tif/.tiff file of a
+// folder, in natural order. Timestamps are index / frame_rate_hz.
+Status OpenImageFolder(const std::string& folder, const ImageFolderOptions& options,
+                       std::unique_ptr<FrameSource>* source);
+
+// printf pattern such as "flight/frame_%05d.png": indices from the first that
+// exists (0 or 1) up to the first gap.
+Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& options,
+                        std::unique_ptr<FrameSource>* source);
+
+// Video file through OpenCV VideoCapture; frames converted to grey.
+Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
+                 std::unique_ptr<FrameSource>* source);
+
+// EuRoC/ASL layout (DESIGN.md): <log>/cam0/data.csv and cam0/data/, optional
+// cam0/sensor.yaml, imu0/data.csv (+ imu0/sensor.yaml), meta.yaml and
+// state_groundtruth_estimate0/data.csv (platform speed). A top folder holding
+// mav0/ (as EuRoC archives do) is accepted too. The tables are checked when
+// the log is opened: malformed lines and non-monotonic timestamps fail here.
+Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source);
+
+// Picks the reader for `path`: EuRoC when it holds cam0/data.csv (or
+// mav0/cam0/data.csv), a printf pattern when it contains '%', an image folder
+// for other folders, and a video for other files.
+Status OpenLog(const std::string& path, const ImageFolderOptions& options,
+               std::unique_ptr<FrameSource>* source);
+
+}  // namespace patrolmap::io

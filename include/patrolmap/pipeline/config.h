@@ -1,0 +1,63 @@
+// The run configuration: every stage's options struct, loaded from YAML.
+// config/default.yaml mirrors these structs one to one; keys are the dotted
+// paths listed by VisitConfig (e.g. flow.voting.accept).
+#pragma once
+
+#include <string>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/flow/options.h"
+#include "patrolmap/io/readers.h"
+
+namespace patrolmap::pipeline {
+
+struct Config {
+  io::ImageFolderOptions input;
+  flow::KeyLocationOptions flow;
+
+  bool IsValid(std::string* error) const;
+};
+
+// Calls visitor.Field(path, &field) for every configurable field, in file order.
+template <typename Visitor>
+void VisitConfig(Config* config, Visitor* visitor) {
+  visitor->Field("input.frame_rate_hz", &config->input.frame_rate_hz);
+  flow::KeyLocationOptions& flow = config->flow;
+  visitor->Field("flow.frames.step", &flow.frames.step);
+  visitor->Field("flow.frames.scale", &flow.frames.scale);
+  visitor->Field("flow.edges.canny_low", &flow.edges.canny_low);
+  visitor->Field("flow.edges.canny_high", &flow.edges.canny_high);
+  visitor->Field("flow.edges.max_points", &flow.edges.max_points);
+  visitor->Field("flow.edges.grid_columns", &flow.edges.grid_columns);
+  visitor->Field("flow.edges.grid_rows", &flow.edges.grid_rows);
+  visitor->Field("flow.edges.border", &flow.edges.border);
+  visitor->Field("flow.tracker.window_size", &flow.tracker.window_size);
+  visitor->Field("flow.tracker.pyramid_levels", &flow.tracker.pyramid_levels);
+  visitor->Field("flow.tracker.max_iterations", &flow.tracker.max_iterations);
+  visitor->Field("flow.tracker.epsilon", &flow.tracker.epsilon);
+  visitor->Field("flow.tracker.min_eigen_threshold", &flow.tracker.min_eigen_threshold);
+  visitor->Field("flow.voting.theta_bins", &flow.voting.theta_bins);
+  visitor->Field("flow.voting.r_bin_fraction", &flow.voting.r_bin_fraction);
+  visitor->Field("flow.voting.accept", &flow.voting.accept);
+  visitor->Field("flow.voting.reject", &flow.voting.reject);
+  visitor->Field("flow.voting.max_votes", &flow.voting.max_votes);
+  visitor->Field("flow.response.quantity", &flow.response.quantity);
+  visitor->Field("flow.response.derotate_with_imu", &flow.response.derotate_with_imu);
+  visitor->Field("flow.response.normalise_by_speed", &flow.response.normalise_by_speed);
+  visitor->Field("flow.response.reference_speed_mps", &flow.response.reference_speed_mps);
+  visitor->Field("flow.response.min_speed_mps", &flow.response.min_speed_mps);
+  visitor->Field("flow.smoothing.window", &flow.smoothing.window);
+  visitor->Field("flow.smoothing.mode", &flow.smoothing.mode);
+  visitor->Field("flow.extrema.min_change", &flow.extrema.min_change);
+  visitor->Field("flow.extrema.min_time_s", &flow.extrema.min_time_s);
+}
+
+// Loads `path` over the defaults in `config`: keys absent from the file keep
+// their value; an unknown key, a value of the wrong type or an invalid
+// combination fails with a message naming the file, the key and the line.
+Status LoadConfig(const std::string& path, Config* config);
+
+// The configuration as YAML (every key, nested sections).
+std::string ConfigToYaml(const Config& config);
+
+}  // namespace patrolmap::pipeline

@@ -1,0 +1,46 @@
+// Key-location detection over a whole flight log, and its outputs.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/core/types.h"
+#include "patrolmap/flow/options.h"
+#include "patrolmap/io/frame_source.h"
+
+namespace patrolmap::pipeline {
+
+struct DetectionResult {
+  std::vector<FlowSample> samples;         // one per processed frame
+  std::vector<KeyLocation> key_locations;
+  std::int64_t frames_read = 0;            // frames delivered by the source
+  std::vector<io::SkippedFrame> skipped;   // unreadable frames that were passed over
+  bool derotated = false;                  // flow was de-rotated with the gyro
+  double seconds = 0.0;                    // wall time of the run
+};
+
+// Called now and then with (frames read, frames in the log or -1).
+using FrameProgress = std::function<void(std::int64_t, std::int64_t)>;
+
+// Runs the flow stage over every frame of `source`. `options` must be valid.
+Status RunDetection(io::FrameSource* source, const flow::KeyLocationOptions& options, DetectionResult* result,
+                    const FrameProgress& progress = {});
+
+// Optional ground truth to draw on the plot: times of true key locations [s].
+struct PlotTruth {
+  std::vector<double> times_s;
+};
+
+// Writes DIR/key_locations.csv, DIR/response.csv and DIR/response.svg (a plot
+// like paper 002 Fig. 3: raw and smoothed response, key locations marked).
+// Each file is written atomically.
+Status WriteDetectionOutputs(const DetectionResult& result, const std::string& folder,
+                             const PlotTruth& truth = {});
+
+std::string KeyLocationsCsv(const std::vector<KeyLocation>& key_locations);
+std::string ResponseCsv(const std::vector<FlowSample>& samples);
+std::string ResponsePlotSvg(const DetectionResult& result, const PlotTruth& truth);
+
+}  // namespace patrolmap::pipeline

@@ -1,0 +1,87 @@
+// Simulated flights: a trajectory through a Scene, rendered into an EuRoC/ASL
+// flight log (DESIGN.md "Flight logs") with ground truth beside it.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/core/types.h"
+#include "patrolmap/sim/renderer.h"
+#include "patrolmap/sim/scene.h"
+
+namespace patrolmap::sim {
+
+// State of the platform (the body frame: x forward, y left, z up) at one instant.
+struct PlatformState {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();      // world [m]
+  double heading = 0.0;                                    // yaw of body x from world x [rad]
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();      // world [m/s]
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  // world, without gravity [m/s^2]
+  double yaw_rate = 0.0;                                   // [rad/s]
+};
+
+struct SimulatedFlight {
+  std::string flight_id = "sim";
+  Scene scene;
+  CameraIntrinsics camera{458.0, 458.0, 375.5, 239.5, 752, 480};
+  double frame_rate_hz = 30.0;
+  double imu_rate_hz = 200.0;
+  double mount_angle = 1.5707963267948966;  // optical axis from body x towards body y (left) [rad]
+  double duration_s = 0.0;
+  std::function<PlatformState(double)> trajectory;  // state at time t in [0, duration_s]
+};
+
+// Camera pose of the platform state for the flight's mount angle.
+CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& state);
+
+// Ground-truth key location: a vertical building edge crossing the optical axis.
+struct TruthKeyLocation {
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  bool opening = false;        // the view axis goes from a near surface to a far one
+  Eigen::Vector2d edge;        // the edge's ground position [m]
+  double depth_before = 0.0;   // view-axis depth just before and after the crossing [m]
+  double depth_after = 0.0;
+};
+
+// The frames at which a wall end visible on the optical axis crosses it.
+std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight);
+
+int FrameCount(const SimulatedFlight& flight);
+TimestampNs FrameTimestamp(const SimulatedFlight& flight, int frame);
+
+// Called after each written frame with (frames done, frames in all).
+using ProgressCallback = std::function<void(int, int)>;
+
+// Renders every frame and writes the log into `folder`: meta.yaml,
+// cam0/{data.csv,data/,sensor.yaml}, imu0/{data.csv,sensor.yaml},
+// state_groundtruth_estimate0/data.csv and groundtruth/key_locations.csv.
+Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder,
+                     const ProgressCallback& progress = {});
+
+// A straight street: `walls` near facades of `wall_length_m` separated by gaps of
+// `gap_length_m`, all `near_depth_m` from the path, with one long far facade at
+// `far_depth_m` seen through the gaps. The camera looks left (90 degree mount)
+// and flies at constant speed and height from the middle of the first facade
+// to the middle of the last.
+struct StreetOptions {
+  int walls = 3;
+  double wall_length_m = 16.0;
+  double gap_length_m = 12.0;
+  double near_depth_m = 5.0;
+  double far_depth_m = 25.0;
+  double wall_height_m = 7.0;
+  double speed_mps = 2.5;
+  double altitude_m = 3.0;
+  bool static_camera = false;  // hover at the start instead of flying
+  std::uint32_t seed = 1;
+};
+
+// Returns the flight; `gaps` receives each gap's [start, end] position along the street [m].
+SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen::Vector2d>* gaps = nullptr);
+
+}  // namespace patrolmap::sim

@@ -1,0 +1,193 @@
+// EuRoC/ASL flight-log reader (DESIGN.md "Flight logs").
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+#include <Eigen/Geometry>
+
+#include "image_list_source.h"
+#include "patrolmap/io/csv.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/io/yaml_file.h"
+
+namespace fs = std::filesystem;
+
+namespace patrolmap::io {
+namespace {
+
+Status CheckColumns(const CsvReader& csv, const std::vector<std::string_view>& fields,
+                    std::size_t minimum) {
+  if (fields.size() >= minimum) return Status::Ok();
+  return csv.Error("expected at least " + std::to_string(minimum) + " columns, found " +
+                   std::to_string(fields.size()));
+}
+
+Status CheckIncreasing(const CsvReader& csv, TimestampNs previous, TimestampNs current) {
+  if (current > previous) return Status::Ok();
+  return csv.Error("timestamp " + std::to_string(current) +
+                   " is not after the previous one (" + std::to_string(previous) + ")");
+}
+
+Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(log + "/cam0/data.csv"));
+  std::vector<std::string_view> fields;
+  Status status;
+  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
+  while ((status = csv.NextRow(&fields)).ok()) {
+    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 2));
+    ImageEntry entry;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &entry.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, entry.timestamp_ns));
+    if (fields[1].empty()) return csv.Error("empty file name");
+    entry.path = log + "/cam0/data/" + std::string(fields[1]);
+    previous = entry.timestamp_ns;
+    entries->push_back(std::move(entry));
+  }
+  if (!status.end_of_stream()) return status;
+  if (entries->empty()) return Status::DataLoss(csv.path() + ": no frames listed");
+  return Status::Ok();
+}
+
+Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields,
+                   std::size_t first, const char* column, Eigen::Vector3d* vector) {
+  for (int axis = 0; axis < 3; ++axis) {
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + axis], column, &(*vector)[axis]));
+  }
+  return Status::Ok();
+}
+
+Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples) {
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
+  std::vector<std::string_view> fields;
+  Status status;
+  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
+  while ((status = csv.NextRow(&fields)).ok()) {
+    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 7));
+    ImuSample sample;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &sample.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, sample.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample.gyro));
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample.accel));
+    previous = sample.timestamp_ns;
+    samples->push_back(sample);
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+// EuRoC ground-truth state: timestamp, position (3), quaternion (4), velocity (3), ...
+Status ReadSpeedTable(const std::string& path, std::vector<SpeedSample>* samples) {
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
+  std::vector<std::string_view> fields;
+  Status status;
+  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
+  while ((status = csv.NextRow(&fields)).ok()) {
+    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 11));
+    SpeedSample sample;
+    Eigen::Vector3d velocity;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &sample.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, sample.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 8, "v_RS_R [m s^-1]", &velocity));
+    sample.speed_mps = velocity.norm();
+    previous = sample.timestamp_ns;
+    samples->push_back(sample);
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* key,
+                   std::size_t count, std::vector<double>* values) {
+  try {
+    *values = node.as<std::vector<double>>();
+  } catch (const YAML::Exception&) {
+    return Status::DataLoss(path + ": '" + key + "' must be a list of numbers");
+  }
+  if (values->size() != count) {
+    return Status::DataLoss(path + ": '" + key + "' must have " + std::to_string(count) +
+                            " numbers, has " + std::to_string(values->size()));
+  }
+  return Status::Ok();
+}
+
+// Reads T_BS (body from sensor) of a sensor.yaml; identity when absent.
+Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen::Matrix3d* rotation) {
+  rotation->setIdentity();
+  if (!root["T_BS"]) return Status::Ok();
+  std::vector<double> data;
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["T_BS"]["data"], "T_BS.data", 16, &data));
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) (*rotation)(row, col) = data[row * 4 + col];
+  }
+  return Status::Ok();
+}
+
+Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d* body_from_camera) {
+  YAML::Node root;
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(path, &root));
+  std::vector<double> intrinsics, resolution;
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
+  CameraIntrinsics camera{intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3],
+                          static_cast<int>(resolution[0]), static_cast<int>(resolution[1])};
+  if (!camera.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
+  info->camera = camera;
+  if (root["rate_hz"]) info->frame_rate_hz = root["rate_hz"].as<double>(0.0);
+  return ReadBodyFromSensor(path, root, body_from_camera);
+}
+
+Status ReadMeta(const std::string& path, LogInfo* info) {
+  YAML::Node root;
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(path, &root));
+  if (root["flight_id"]) info->flight_id = root["flight_id"].as<std::string>("");
+  if (root["frame_rate_hz"]) info->frame_rate_hz = root["frame_rate_hz"].as<double>(0.0);
+  return Status::Ok();
+}
+
+Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<ImuSample>* imu,
+                           std::vector<SpeedSample>* speeds) {
+  Eigen::Matrix3d body_from_camera = Eigen::Matrix3d::Identity();
+  const bool has_camera_yaml = fs::exists(log + "/cam0/sensor.yaml");
+  if (has_camera_yaml) {
+    PATROLMAP_RETURN_IF_ERROR(ReadCameraSensor(log + "/cam0/sensor.yaml", info, &body_from_camera));
+  }
+  if (fs::exists(log + "/meta.yaml")) PATROLMAP_RETURN_IF_ERROR(ReadMeta(log + "/meta.yaml", info));
+  if (fs::exists(log + "/imu0/data.csv")) {
+    PATROLMAP_RETURN_IF_ERROR(ReadImuTable(log + "/imu0/data.csv", imu));
+    Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();
+    if (fs::exists(log + "/imu0/sensor.yaml")) {
+      YAML::Node root;
+      PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(log + "/imu0/sensor.yaml", &root));
+      PATROLMAP_RETURN_IF_ERROR(ReadBodyFromSensor(log + "/imu0/sensor.yaml", root, &body_from_imu));
+    }
+    if (has_camera_yaml) info->camera_from_imu = body_from_camera.transpose() * body_from_imu;
+  }
+  const std::string state = log + "/state_groundtruth_estimate0/data.csv";
+  if (fs::exists(state)) PATROLMAP_RETURN_IF_ERROR(ReadSpeedTable(state, speeds));
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source) {
+  std::string log = folder;
+  if (!fs::exists(log + "/cam0/data.csv") && fs::exists(log + "/mav0/cam0/data.csv")) log += "/mav0";
+  LogInfo info;
+  info.path = folder;
+  info.kind = "euroc";
+  info.flight_id = fs::path(folder).lexically_normal().filename().string();
+  if (info.flight_id.empty()) info.flight_id = fs::path(folder).parent_path().filename().string();
+  std::vector<ImageEntry> entries;
+  std::vector<ImuSample> imu;
+  std::vector<SpeedSample> speeds;
+  PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, &entries));
+  PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &speeds));
+  if (!imu.empty() && !info.camera_from_imu) {
+    spdlog::warn("{}: imu0 present but cam0/sensor.yaml missing: camera-IMU rotation unknown", log);
+  }
+  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu),
+                                              std::move(speeds));
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::io

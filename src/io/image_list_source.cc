@@ -1,0 +1,70 @@
+#include "image_list_source.h"
+
+#include <algorithm>
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace patrolmap::io {
+
+ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries,
+                                 std::vector<ImuSample> imu, std::vector<SpeedSample> speeds)
+    : info_(std::move(info)), entries_(std::move(entries)), imu_(std::move(imu)),
+      speeds_(std::move(speeds)) {
+  info_.frame_count = static_cast<std::int64_t>(entries_.size());
+  info_.has_imu = !imu_.empty();
+  info_.has_speed = !speeds_.empty();
+}
+
+Status ImageListSource::Next(bool decode_image, Frame* frame) {
+  frame->imu.clear();
+  while (next_entry_ < entries_.size()) {
+    const std::int64_t index = static_cast<std::int64_t>(next_entry_);
+    const ImageEntry& entry = entries_[next_entry_++];
+    AppendImuUpTo(entry.timestamp_ns, &frame->imu);
+    frame->image.release();
+    if (decode_image && !Decode(index, entry.path, &frame->image)) continue;
+    frame->timestamp_ns = entry.timestamp_ns;
+    frame->index = index;
+    frame->speed_mps = SpeedAt(entry.timestamp_ns);
+    return Status::Ok();
+  }
+  return Status::EndOfStream();
+}
+
+bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Mat* image) {
+  *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image->empty()) {
+    RecordSkipped(index, path + ": missing or unreadable image");
+    return false;
+  }
+  if (first_size_.empty()) first_size_ = image->size();
+  if (image->size() != first_size_) {
+    RecordSkipped(index, path + ": image is " + std::to_string(image->cols) + "x" +
+                             std::to_string(image->rows) + ", the log's first image is " +
+                             std::to_string(first_size_.width) + "x" +
+                             std::to_string(first_size_.height));
+    return false;
+  }
+  return true;
+}
+
+void ImageListSource::AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples) {
+  while (next_imu_ < imu_.size() && imu_[next_imu_].timestamp_ns <= timestamp_ns) {
+    samples->push_back(imu_[next_imu_++]);
+  }
+}
+
+std::optional<double> ImageListSource::SpeedAt(TimestampNs timestamp_ns) const {
+  if (speeds_.empty()) return std::nullopt;
+  const auto after = std::lower_bound(
+      speeds_.begin(), speeds_.end(), timestamp_ns,
+      [](const SpeedSample& sample, TimestampNs t) { return sample.timestamp_ns < t; });
+  if (after == speeds_.begin()) return after->speed_mps;
+  if (after == speeds_.end()) return speeds_.back().speed_mps;
+  const SpeedSample& before = *(after - 1);
+  const double span = static_cast<double>(after->timestamp_ns - before.timestamp_ns);
+  const double weight = static_cast<double>(timestamp_ns - before.timestamp_ns) / span;
+  return before.speed_mps + weight * (after->speed_mps - before.speed_mps);
+}
+
+}  // namespace patrolmap::io

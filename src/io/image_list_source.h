@@ -1,0 +1,45 @@
+// Internal: a FrameSource over a list of timestamped image files, shared by
+// the image-folder, printf-pattern and EuRoC readers.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "patrolmap/io/frame_source.h"
+
+namespace patrolmap::io {
+
+struct ImageEntry {
+  TimestampNs timestamp_ns = 0;
+  std::string path;
+};
+
+struct SpeedSample {
+  TimestampNs timestamp_ns = 0;
+  double speed_mps = 0.0;
+};
+
+class ImageListSource : public FrameSource {
+ public:
+  // `imu` and `speeds` must be sorted by time (the EuRoC reader checks this).
+  ImageListSource(LogInfo info, std::vector<ImageEntry> entries, std::vector<ImuSample> imu = {},
+                  std::vector<SpeedSample> speeds = {});
+
+  Status Next(bool decode_image, Frame* frame) override;
+  const LogInfo& info() const override { return info_; }
+
+ private:
+  void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);
+  std::optional<double> SpeedAt(TimestampNs timestamp_ns) const;
+  bool Decode(std::int64_t index, const std::string& path, cv::Mat* image);
+
+  LogInfo info_;
+  std::vector<ImageEntry> entries_;
+  std::vector<ImuSample> imu_;
+  std::vector<SpeedSample> speeds_;
+  std::size_t next_entry_ = 0;
+  std::size_t next_imu_ = 0;
+  cv::Size first_size_;
+};
+
+}  // namespace patrolmap::io

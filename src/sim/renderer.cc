@@ -1,0 +1,149 @@
+#include "patrolmap/sim/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "patrolmap/core/status.h"
+
+namespace patrolmap::sim {
+namespace {
+
+constexpr double kNearestDepth = 0.05;  // surfaces closer than this are ignored [m]
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+std::uint8_t Bilinear(const cv::Mat& image, double u, double v, bool wrap) {
+  const double x = u - 0.5, y = v - 0.5;
+  int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const double fx = x - x0, fy = y - y0;
+  int x1 = x0 + 1, y1 = y0 + 1;
+  const auto fix = [wrap](int value, int size) {
+    if (wrap) return ((value % size) + size) % size;
+    return std::clamp(value, 0, size - 1);
+  };
+  x0 = fix(x0, image.cols), x1 = fix(x1, image.cols), y0 = fix(y0, image.rows), y1 = fix(y1, image.rows);
+  const unsigned char* row0 = image.ptr<unsigned char>(y0);
+  const unsigned char* row1 = image.ptr<unsigned char>(y1);
+  const double top = row0[x0] + fx * (row0[x1] - row0[x0]);
+  const double bottom = row1[x0] + fx * (row1[x1] - row1[x0]);
+  return static_cast<std::uint8_t>(top + fy * (bottom - top) + 0.5);
+}
+
+}  // namespace
+
+Eigen::Matrix3d WorldFromCameraRotation(double yaw) {
+  const Eigen::Vector3d forward(std::cos(yaw), std::sin(yaw), 0.0);
+  const Eigen::Vector3d right(std::sin(yaw), -std::cos(yaw), 0.0);
+  const Eigen::Vector3d down(0.0, 0.0, -1.0);
+  Eigen::Matrix3d rotation;
+  rotation << right, down, forward;
+  return rotation;
+}
+
+bool Project(const CameraIntrinsics& camera, const CameraPose& pose, const Eigen::Vector3d& point,
+             Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d in_camera = WorldFromCameraRotation(pose.yaw).transpose() * (point - pose.position);
+  if (in_camera.z() <= kNearestDepth) return false;
+  *pixel = {camera.fx * in_camera.x() / in_camera.z() + camera.cx,
+            camera.fy * in_camera.y() / in_camera.z() + camera.cy};
+  return true;
+}
+
+std::uint8_t SampleTexture(const Texture& texture, double u, double v, double footprint, bool wrap) {
+  int level = footprint > 1.0 ? static_cast<int>(std::log2(footprint)) : 0;
+  level = std::min(level, static_cast<int>(texture.levels.size()) - 1);
+  const double scale = 1.0 / static_cast<double>(1 << level);
+  return Bilinear(texture.levels[level], u * scale, v * scale, wrap);
+}
+
+Renderer::Renderer(const Scene* scene, const CameraIntrinsics& camera) : scene_(scene), camera_(camera) {
+  PATROLMAP_CHECK(scene != nullptr && camera.valid());
+  for (const Wall& wall : scene->walls) {
+    PATROLMAP_CHECK(wall.texture >= 0 && wall.texture < static_cast<int>(scene->textures.size()));
+  }
+}
+
+void Renderer::IntersectColumn(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction) {
+  hits_.clear();
+  for (std::size_t i = 0; i < scene_->walls.size(); ++i) {
+    const Wall& wall = scene_->walls[i];
+    const Eigen::Vector2d along = wall.end - wall.start;
+    const double denominator = Cross(direction, along);
+    if (std::abs(denominator) < 1e-12) continue;
+    const Eigen::Vector2d offset = wall.start - origin;
+    const double depth = Cross(offset, along) / denominator;
+    const double fraction = Cross(offset, direction) / denominator;
+    if (depth < kNearestDepth || fraction < 0.0 || fraction > 1.0) continue;
+    hits_.push_back({depth, fraction * along.norm(), static_cast<int>(i)});
+  }
+  std::sort(hits_.begin(), hits_.end(), [](const Hit& a, const Hit& b) { return a.depth < b.depth; });
+}
+
+std::uint8_t Renderer::ShadeGround(const Eigen::Vector2d& point, double depth) const {
+  if (scene_->ground_texture < 0) return scene_->ground_grey;
+  const Texture& texture = scene_->textures[scene_->ground_texture];
+  const double footprint = depth * texture.texels_per_metre / camera_.fx;
+  return SampleTexture(texture, point.x() * texture.texels_per_metre, point.y() * texture.texels_per_metre,
+                       footprint, true);
+}
+
+std::uint8_t Renderer::ShadeWall(const Hit& hit, double z) const {
+  const Wall& wall = scene_->walls[hit.wall];
+  const Texture& texture = scene_->textures[wall.texture];
+  const double footprint = hit.depth * texture.texels_per_metre / camera_.fx;
+  return SampleTexture(texture, hit.s * texture.texels_per_metre, (wall.height - z) * texture.texels_per_metre,
+                       footprint, false);
+}
+
+void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction,
+                           cv::Mat* image) const {
+  const double height = pose.position.z();
+  for (int row = 0; row < image->rows; ++row) {
+    const double slope = (row - camera_.cy) / camera_.fy;  // metres down per metre of depth
+    std::uint8_t grey = slope > 0.0 ? 0 : scene_->sky_grey;
+    bool shaded = false;
+    for (const Hit& hit : hits_) {
+      const double z = height - slope * hit.depth;
+      if (z > scene_->walls[hit.wall].height) continue;  // the ray passes over this wall
+      if (z >= 0.0) grey = ShadeWall(hit, z);
+      shaded = z >= 0.0;
+      break;
+    }
+    if (!shaded && slope > 0.0) {
+      const double depth = height / slope;
+      grey = ShadeGround(pose.position.head<2>() + depth * direction, depth);
+    }
+    image->at<std::uint8_t>(row, column) = grey;
+  }
+}
+
+void Renderer::Render(const CameraPose& pose, cv::Mat* image) {
+  image->create(camera_.height, camera_.width, CV_8UC1);
+  const Eigen::Matrix3d rotation = WorldFromCameraRotation(pose.yaw);
+  const Eigen::Vector2d forward = rotation.col(2).head<2>();
+  const Eigen::Vector2d right = rotation.col(0).head<2>();
+  for (int column = 0; column < camera_.width; ++column) {
+    const Eigen::Vector2d direction = forward + ((column - camera_.cx) / camera_.fx) * right;
+    IntersectColumn(pose.position.head<2>(), direction);
+    ShadeColumn(column, pose, direction, image);
+  }
+}
+
+void Renderer::ColumnDepths(const CameraPose& pose, std::vector<double>* depths) {
+  depths->assign(camera_.width, std::numeric_limits<double>::infinity());
+  const Eigen::Matrix3d rotation = WorldFromCameraRotation(pose.yaw);
+  for (int column = 0; column < camera_.width; ++column) {
+    const Eigen::Vector2d direction =
+        rotation.col(2).head<2>() + ((column - camera_.cx) / camera_.fx) * rotation.col(0).head<2>();
+    IntersectColumn(pose.position.head<2>(), direction);
+    for (const Hit& hit : hits_) {
+      if (scene_->walls[hit.wall].height >= pose.position.z()) {
+        (*depths)[column] = hit.depth;
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace patrolmap::sim

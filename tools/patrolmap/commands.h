@@ -1,0 +1,17 @@
+// Subcommands of the patrolmap command line. Each registers its options on
+// the app and returns the exit code when run: 0 success, 1 bad input or a
+// failed run (the message names the file and the problem), 2 bad usage.
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace patrolmap::tools {
+
+using Command = std::function<int()>;
+
+Command AddDetectCommand(CLI::App* app);
+Command AddSimulateCommand(CLI::App* app);
+
+}  // namespace patrolmap::tools

@@ -1,0 +1,104 @@
+// patrolmap detect LOG [--config FILE] [--out DIR]
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+#include "patrolmap/io/ground_truth.h"
+#include "patrolmap/pipeline/config.h"
+#include "patrolmap/pipeline/detect.h"
+#include "progress.h"
+
+namespace patrolmap::tools {
+namespace {
+
+struct DetectArguments {
+  std::string log;
+  std::string config;
+  std::string out = "patrolmap_out";
+  std::string quantity;
+  std::string smoothing;
+};
+
+int Fail(const Status& status) {
+  spdlog::error("{}", status.message());
+  return 1;
+}
+
+Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config) {
+  if (!arguments.quantity.empty() &&
+      !flow::ParseResponseQuantity(arguments.quantity, &config->flow.response.quantity)) {
+    return Status::InvalidArgument("--response must be length or line_parameter");
+  }
+  if (!arguments.smoothing.empty() && !flow::ParseSmoothingMode(arguments.smoothing, &config->flow.smoothing.mode)) {
+    return Status::InvalidArgument("--smoothing must be centered or causal");
+  }
+  return Status::Ok();
+}
+
+pipeline::PlotTruth LoadPlotTruth(const std::string& log) {
+  pipeline::PlotTruth truth;
+  std::vector<io::TruthKeyLocationRecord> records;
+  if (!io::ReadTruthKeyLocations(log, &records).ok()) return truth;
+  for (const auto& record : records) truth.times_s.push_back(NsToSeconds(record.timestamp_ns));
+  return truth;
+}
+
+void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionResult& result) {
+  int peaks = 0;
+  for (const KeyLocation& node : result.key_locations) peaks += node.kind == ExtremumKind::kPeak;
+  std::printf("%s: %lld frames, %zu processed, %zu key locations (%d peaks, %zu valleys), %zu unreadable frames "
+              "skipped, %.1f s (%.0f frames/s); outputs in %s\n",
+              arguments.log.c_str(), static_cast<long long>(result.frames_read), result.samples.size(),
+              result.key_locations.size(), peaks, result.key_locations.size() - peaks, result.skipped.size(),
+              result.seconds, result.frames_read / std::max(result.seconds, 1e-9), arguments.out.c_str());
+}
+
+int RunDetect(const DetectArguments& arguments) {
+  pipeline::Config config;
+  if (!arguments.config.empty()) {
+    const Status status = pipeline::LoadConfig(arguments.config, &config);
+    if (!status.ok()) return Fail(status);
+  }
+  Status status = ApplyOverrides(arguments, &config);
+  std::string error;
+  if (status.ok() && !config.IsValid(&error)) status = Status::InvalidArgument(error);
+  if (!status.ok()) return Fail(status);
+  std::unique_ptr<io::FrameSource> source;
+  status = io::OpenLog(arguments.log, config.input, &source);
+  if (!status.ok()) return Fail(status);
+  pipeline::DetectionResult result;
+  {
+    Progress progress("detect");
+    status = pipeline::RunDetection(source.get(), config.flow, &result,
+                                    [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); });
+  }
+  if (!status.ok()) return Fail(status);
+  if (config.flow.response.derotate_with_imu && !result.derotated && source->info().has_imu) {
+    spdlog::warn("{}: IMU present but camera extrinsics unknown: flow not de-rotated", arguments.log);
+  }
+  status = pipeline::WriteDetectionOutputs(result, arguments.out, LoadPlotTruth(arguments.log));
+  if (!status.ok()) return Fail(status);
+  PrintSummary(arguments, result);
+  return 0;
+}
+
+}  // namespace
+
+Command AddDetectCommand(CLI::App* app) {
+  auto arguments = std::make_shared<DetectArguments>();
+  app->add_option("log", arguments->log,
+                  "flight log: EuRoC folder, image folder, printf pattern (frame_%04d.png) or video file")
+      ->required();
+  app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
+  app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
+  app->add_option("--response", arguments->quantity,
+                  "override flow.response.quantity: length or line_parameter");
+  app->add_option("--smoothing", arguments->smoothing, "override flow.smoothing.mode: centered or causal");
+  app->footer("Writes OUT/key_locations.csv, OUT/response.csv and OUT/response.svg.");
+  return [arguments] { return RunDetect(*arguments); };
+}
+
+}  // namespace patrolmap::tools

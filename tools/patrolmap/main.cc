@@ -1,0 +1,33 @@
+// patrolmap: topological appearance mapping for UAV patrols (offline front end).
+#include <map>
+
+#include <spdlog/spdlog.h>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"patrolmap: key locations from optical flow, topological maps and change detection for UAV patrols"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "patrolmap 0.1.0");
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "only print errors");
+  std::map<CLI::App*, patrolmap::tools::Command> commands;
+  const auto add = [&](const char* name, const char* help, auto adder) {
+    CLI::App* sub = app.add_subcommand(name, help);
+    commands[sub] = adder(sub);
+  };
+  add("detect", "detect key locations in a flight log (paper 002 III-A)", patrolmap::tools::AddDetectCommand);
+  add("simulate", "render a simulated flight log with ground truth", patrolmap::tools::AddSimulateCommand);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : 2;
+  }
+  spdlog::set_pattern("%l: %v");
+  spdlog::set_level(quiet ? spdlog::level::err : spdlog::level::info);
+  for (const auto& [sub, command] : commands) {
+    if (sub->parsed()) return command();
+  }
+  return 2;
+}

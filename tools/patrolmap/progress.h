@@ -1,0 +1,41 @@
+// Progress lines on stderr, only when stderr is a terminal.
+#pragma once
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+
+namespace patrolmap::tools {
+
+class Progress {
+ public:
+  explicit Progress(const char* what) : what_(what), enabled_(::isatty(STDERR_FILENO) != 0) {}
+  ~Progress() {
+    if (enabled_ && shown_) std::fprintf(stderr, "\n");
+  }
+
+  // Shows "what: done/total (rate/s)"; total < 0 when unknown.
+  void Update(std::int64_t done, std::int64_t total) {
+    if (!enabled_) return;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double rate = seconds > 0.0 ? done / seconds : 0.0;
+    if (total > 0) {
+      std::fprintf(stderr, "\r%s: %lld/%lld frames (%.0f/s)   ", what_, static_cast<long long>(done),
+                   static_cast<long long>(total), rate);
+    } else {
+      std::fprintf(stderr, "\r%s: %lld frames (%.0f/s)   ", what_, static_cast<long long>(done), rate);
+    }
+    shown_ = true;
+  }
+
+ private:
+  const char* what_;
+  bool enabled_;
+  bool shown_ = false;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace patrolmap::tools
