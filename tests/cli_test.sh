@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Command-line behaviour: exit codes, messages that name the file, outputs.
+# Usage: cli_test.sh PATROLMAP_BINARY SOURCE_DIR
+set -u
+bin=$1
+source_dir=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+failures=0
+passes=0
+
+expect() {  # expect NAME WANTED_CODE PATTERN -- COMMAND...
+  local name=$1 wanted=$2 pattern=$3
+  shift 4
+  local output code
+  output=$("$@" 2>&1)
+  code=$?
+  if [[ $code -ne $wanted ]] || ! grep -qE -- "$pattern" <<<"$output"; then
+    echo "FAIL $name: exit $code (wanted $wanted), output:"
+    echo "$output" | head -5
+    failures=$((failures + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+
+expect "no subcommand" 2 "subcommand" -- "$bin"
+expect "missing log" 1 "$work/nothing: no such file or folder" -- "$bin" detect "$work/nothing" --out "$work/o"
+mkdir -p "$work/empty"
+expect "empty folder" 1 "folder holds no images" -- "$bin" detect "$work/empty" --out "$work/o"
+expect "missing config" 1 "nope.yaml: no such file" -- "$bin" detect "$work/empty" --config "$work/nope.yaml"
+printf 'flow:\n  smoothing:\n    windw: 3\n' >"$work/bad.yaml"
+expect "unknown config key" 1 "bad.yaml:3: flow.smoothing.windw: unknown key" -- \
+  "$bin" detect "$work/empty" --config "$work/bad.yaml"
+expect "bad override" 1 "--response must be" -- "$bin" detect "$work/empty" --response speed
+
+expect "simulate" 0 "frames at 30 Hz" -- "$bin" simulate --route street --walls 2 --speed 6 --out "$work/log"
+expect "detect" 0 "key locations" -- "$bin" detect "$work/log" --config "$source_dir/config/default.yaml" --out "$work/out"
+for file in key_locations.csv response.csv response.svg; do
+  [[ -s "$work/out/$file" ]] || { echo "FAIL detect output $file missing"; failures=$((failures + 1)); }
+done
+
+# An unreadable image in the middle of the log (frame 20, one the detector decodes) is reported and
+# skipped; the run goes on.
+middle=$(sed -n '22p' "$work/log/cam0/data.csv" | cut -d, -f2)
+echo "garbage" >"$work/log/cam0/data/$middle"
+expect "corrupt image" 0 "1 unreadable frames skipped" -- "$bin" detect "$work/log" --out "$work/out2"
+
+# A malformed line in the camera table stops the run with the file and line.
+sed -i '7s/^[0-9]*/12x4/' "$work/log/cam0/data.csv"
+expect "malformed csv" 1 "cam0/data.csv:7: column 'timestamp \[ns\]': not an integer" -- \
+  "$bin" detect "$work/log" --out "$work/out3"
+
+echo "cli: $passes passed, $failures failed"
+[[ $failures -eq 0 ]]

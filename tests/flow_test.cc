@@ -1,0 +1,325 @@
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/flow/edge_flow.h"
+#include "patrolmap/flow/key_location_detector.h"
+#include "patrolmap/flow/polar_voting.h"
+#include "patrolmap/flow/signal.h"
+
+namespace patrolmap::flow {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+TEST(Polar, FollowsEquationsOneAndTwo) {
+  const PolarVector a = ToPolar({{10.0f, 20.0f}, {3.0f, 4.0f}});
+  EXPECT_NEAR(a.theta, std::atan2(4.0, 3.0), 1e-6);
+  EXPECT_NEAR(a.r, 10.0 * 0.6 + 20.0 * 0.8, 1e-4);
+  EXPECT_NEAR(a.length, 5.0, 1e-6);
+  const PolarVector left = ToPolar({{50.0f, 7.0f}, {-2.0f, 0.0f}});
+  EXPECT_NEAR(std::abs(left.theta), kPi, 1e-6);
+  EXPECT_NEAR(left.r, -50.0, 1e-4);
+  EXPECT_NEAR(left.length, 2.0, 1e-6);
+}
+
+// Runs the voter over frames that each hold the given vectors; returns per frame whether vector 0 passed.
+std::vector<int> VoteSequence(HysteresisVoter* voter, const std::vector<std::vector<PolarVector>>& frames) {
+  std::vector<int> passed;
+  std::vector<std::uint8_t> accepted;
+  for (const auto& vectors : frames) {
+    voter->Vote(vectors, &accepted);
+    passed.push_back(vectors.empty() ? -1 : accepted[0]);
+  }
+  return passed;
+}
+
+TEST(HysteresisVoter, AcceptsAfterThreeVotesAndDropsUnderTwo) {
+  const VotingOptions options;  // accept 3, reject 2 (Table I)
+  const PolarVector v = ToPolar({{100.0f, 50.0f}, {-8.0f, 0.0f}});
+  HysteresisVoter voter(options, 376, 240);
+  // present x3, absent x2 (vote 3 -> 1: dropped), present (vote 2 < accept: not yet back).
+  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {}, {}, {v}, {v}}), (std::vector<int>{0, 0, 1, -1, -1, 0, 1}));
+  voter.Reset();
+  // present x3, absent once (vote 2: still accepted), present.
+  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {}, {v}}), (std::vector<int>{0, 0, 1, -1, 1}));
+}
+
+TEST(HysteresisVoter, RandomDirectionsAreNeverAccepted) {
+  HysteresisVoter voter(VotingOptions{}, 376, 240);
+  cv::RNG rng(7);
+  std::vector<std::uint8_t> accepted;
+  int total = 0;
+  for (int frame = 0; frame < 50; ++frame) {
+    std::vector<PolarVector> vectors;
+    for (int i = 0; i < 5; ++i) {
+      vectors.push_back(ToPolar({{rng.uniform(0.f, 376.f), rng.uniform(0.f, 240.f)},
+                                 {rng.uniform(-5.f, 5.f), rng.uniform(-5.f, 5.f)}}));
+    }
+    total += voter.Vote(vectors, &accepted);
+  }
+  EXPECT_LE(total, 3);  // 250 scattered vectors over ~2,700 cells: chance repeats only
+}
+
+TEST(SceneFlowResponse, AveragesAcceptedQuantityInImageWidths) {
+  std::vector<PolarVector> vectors(3);
+  vectors[0].length = 10, vectors[1].length = 20, vectors[2].length = 30;
+  vectors[0].r = 5, vectors[1].r = -7, vectors[2].r = 9;
+  const std::vector<std::uint8_t> accepted = {1, 0, 1};
+  EXPECT_DOUBLE_EQ(SceneFlowResponse(vectors, accepted, ResponseQuantity::kLength, 100), 0.2);
+  EXPECT_DOUBLE_EQ(SceneFlowResponse(vectors, accepted, ResponseQuantity::kLineParameter, 100), 0.07);
+  EXPECT_TRUE(std::isnan(SceneFlowResponse(vectors, {0, 0, 0}, ResponseQuantity::kLength, 100)));
+}
+
+std::vector<FlowSample> Samples(const std::vector<double>& values, double rate_hz = 1.0) {
+  std::vector<FlowSample> samples(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    samples[i].timestamp_ns = SecondsToNs(i / rate_hz);
+    samples[i].frame_index = static_cast<std::int64_t>(i);
+    samples[i].raw_response = values[i];
+    samples[i].smoothed_response = values[i];
+  }
+  return samples;
+}
+
+std::vector<double> Smooth(const std::vector<double>& values, SmoothingOptions options,
+                           std::vector<int>* released_after = nullptr) {
+  WindowSmoother smoother(options);
+  std::vector<FlowSample> released;
+  for (const FlowSample& sample : Samples(values)) {
+    smoother.Add(sample, &released);
+    if (released_after) released_after->push_back(static_cast<int>(released.size()));
+  }
+  smoother.Finish(&released);
+  std::vector<double> smoothed;
+  for (const FlowSample& sample : released) smoothed.push_back(sample.smoothed_response);
+  return smoothed;
+}
+
+TEST(WindowSmoother, CenteredWindowTruncatesAtTheEnds) {
+  std::vector<int> released_after;
+  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, {3, SmoothingMode::kCentered}, &released_after);
+  EXPECT_EQ(smoothed, (std::vector<double>{1.5, 2, 3, 4, 4.5}));
+  EXPECT_EQ(released_after, (std::vector<int>{0, 1, 2, 3, 4}));  // one sample late
+}
+
+TEST(WindowSmoother, CausalWindowLagsAndReleasesAtOnce) {
+  std::vector<int> released_after;
+  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, {3, SmoothingMode::kCausal}, &released_after);
+  EXPECT_EQ(smoothed, (std::vector<double>{1, 1.5, 2, 3, 4}));
+  EXPECT_EQ(released_after, (std::vector<int>{1, 2, 3, 4, 5}));
+}
+
+TEST(WindowSmoother, NaNSamplesAreLeftOut) {
+  const double nan = std::nan("");
+  const std::vector<double> smoothed = Smooth({1, nan, 3}, {3, SmoothingMode::kCentered});
+  EXPECT_DOUBLE_EQ(smoothed[1], 2.0);
+  EXPECT_TRUE(std::isnan(Smooth({nan, nan}, {1, SmoothingMode::kCentered})[0]));
+}
+
+TEST(WindowSmoother, PaperWindowCentresAStepOnItsMidpoint) {
+  std::vector<double> step(100, 0.0);
+  std::fill(step.begin() + 50, step.end(), 1.0);
+  const std::vector<double> smoothed = Smooth(step, {30, SmoothingMode::kCentered});
+  EXPECT_DOUBLE_EQ(smoothed[35], 1.0 / 30.0);  // window [21, 50] holds one 1
+  EXPECT_DOUBLE_EQ(smoothed[49], 15.0 / 30.0);
+  EXPECT_DOUBLE_EQ(smoothed[64], 1.0);
+  const std::vector<double> causal = Smooth(step, {30, SmoothingMode::kCausal});
+  EXPECT_DOUBLE_EQ(causal[64], 15.0 / 30.0);  // lag of (30 - 1) / 2 samples
+}
+
+std::vector<KeyLocation> Extrema(const std::vector<double>& values, double rate_hz, ExtremumOptions options) {
+  ExtremumDetector detector(options);
+  std::vector<KeyLocation> events;
+  for (const FlowSample& sample : Samples(values, rate_hz)) detector.Add(sample, &events);
+  return events;
+}
+
+TEST(ExtremumDetector, FindsEveryPeakAndValleyOfASineWithWiggles) {
+  std::vector<double> values;
+  for (int i = 0; i <= 300; ++i) {
+    const double t = i / 10.0;
+    values.push_back(0.05 + 0.03 * std::sin(2 * kPi * t / 10.0) + 0.004 * std::sin(2 * kPi * t / 0.7));
+  }
+  const std::vector<KeyLocation> events = Extrema(values, 10.0, {0.02, 2.0});
+  ASSERT_EQ(events.size(), 6u);
+  const double expected[] = {2.5, 7.5, 12.5, 17.5, 22.5, 27.5};
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    EXPECT_NEAR(NsToSeconds(events[i].timestamp_ns), expected[i], 0.4) << i;  // the wiggle moves them
+    EXPECT_EQ(events[i].kind, i % 2 == 0 ? ExtremumKind::kPeak : ExtremumKind::kValley);
+    EXPECT_EQ(events[i].node_index, static_cast<int>(i));
+  }
+}
+
+TEST(ExtremumDetector, ChangesSmallerThanTheThresholdAreNotNodes) {
+  std::vector<double> values;
+  // Starts in a valley; peaks at 5, 15, 25 s, valleys at 10, 20 s (the one at 30 s is never confirmed).
+  for (int i = 0; i <= 300; ++i) values.push_back(0.05 - 0.009 * std::cos(2 * kPi * i / 100.0));
+  EXPECT_TRUE(Extrema(values, 10.0, {0.02, 2.0}).empty());  // swing 0.018 < 0.02
+  const std::vector<KeyLocation> events = Extrema(values, 10.0, {0.015, 2.0});
+  ASSERT_EQ(events.size(), 5u);
+  EXPECT_EQ(events[0].frame_index, 50);
+  EXPECT_EQ(events[1].frame_index, 100);
+}
+
+TEST(ExtremumDetector, NodesCloserThanTheMinimumTimeAreDropped) {
+  // Peak at 1 s, valley at 2 s, peak at 6 s, valley at 7 s (1 Hz samples).
+  const std::vector<double> values = {0.0, 0.1, 0.0, 0.05, 0.08, 0.09, 0.1, 0.0, 0.1};
+  const std::vector<KeyLocation> all = Extrema(values, 1.0, {0.05, 0.0});
+  ASSERT_EQ(all.size(), 4u);
+  const std::vector<KeyLocation> spaced = Extrema(values, 1.0, {0.05, 2.0});
+  ASSERT_EQ(spaced.size(), 2u);
+  EXPECT_EQ(spaced[0].frame_index, 1);
+  EXPECT_EQ(spaced[1].frame_index, 6);
+}
+
+TEST(EdgeSelection, CapIsSharedByTheGridCells) {
+  cv::Mat edges(200, 200, CV_8UC1, cv::Scalar(255));
+  EdgeOptions options;
+  options.max_points = 100;
+  options.grid_columns = 2;
+  options.grid_rows = 2;
+  options.border = 0;
+  std::vector<cv::Point2f> points;
+  SelectEdgePoints(edges, options, &points);
+  ASSERT_EQ(points.size(), 100u);
+  int top_left = 0;
+  for (const cv::Point2f& p : points) top_left += p.x < 100 && p.y < 100;
+  EXPECT_EQ(top_left, 25);
+  // Edges only in one quadrant: that cell's share, spread down its rows.
+  edges.setTo(0);
+  edges(cv::Rect(0, 0, 100, 100)).setTo(255);
+  SelectEdgePoints(edges, options, &points);
+  ASSERT_EQ(points.size(), 25u);
+  EXPECT_GT(points.back().y, 90.0f);
+}
+
+cv::Mat Texture(int seed) {
+  cv::Mat image(240, 376, CV_8UC1);
+  cv::RNG rng(seed);
+  rng.fill(image, cv::RNG::UNIFORM, 0, 255);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  cv::normalize(image, image, 0, 255, cv::NORM_MINMAX);
+  return image;
+}
+
+TEST(EdgeFlowTracker, RecoversAKnownShift) {
+  const cv::Mat first = Texture(3);
+  cv::Mat second;
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 3.0, 0, 1, -2.0);
+  cv::warpAffine(first, second, shift, first.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  EdgeFlowTracker tracker(EdgeOptions{}, TrackerOptions{});
+  std::vector<FlowVector> vectors;
+  tracker.Track(first, &vectors);
+  EXPECT_TRUE(vectors.empty());
+  tracker.Track(second, &vectors);
+  ASSERT_GT(vectors.size(), 300u);
+  std::vector<float> dx, dy;
+  for (const FlowVector& v : vectors) dx.push_back(v.delta.x), dy.push_back(v.delta.y);
+  std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+  std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
+  EXPECT_NEAR(dx[dx.size() / 2], 3.0, 0.05);
+  EXPECT_NEAR(dy[dy.size() / 2], -2.0, 0.05);
+}
+
+TEST(Gyro, IntegratesAConstantRate) {
+  std::vector<ImuSample> samples;
+  for (int i = 1; i <= 40; ++i) {
+    ImuSample sample;
+    sample.timestamp_ns = SecondsToNs(i * 0.005);
+    sample.gyro = Eigen::Vector3d(0.0, 0.0, 0.5);
+    samples.push_back(sample);
+  }
+  const Eigen::Matrix3d rotation =
+      IntegrateGyro(samples, 0, SecondsToNs(0.2), Eigen::Matrix3d::Identity());
+  const Eigen::AngleAxisd angle_axis(rotation);
+  EXPECT_NEAR(angle_axis.angle(), 0.1, 1e-9);
+  EXPECT_NEAR(angle_axis.axis().z(), 1.0, 1e-9);
+  // Only (start, end] counts.
+  EXPECT_NEAR(Eigen::AngleAxisd(IntegrateGyro(samples, SecondsToNs(0.1), SecondsToNs(0.2),
+                                               Eigen::Matrix3d::Identity())).angle(), 0.05, 1e-9);
+}
+
+TEST(Derotation, RemovesFlowOfAPureRotation) {
+  const CameraIntrinsics camera{229.0, 229.0, 187.5, 119.5, 376, 240};
+  const Eigen::Matrix3d earlier_from_later =
+      Eigen::AngleAxisd(0.03, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()).toRotationMatrix();
+  Eigen::Matrix3d k;
+  k << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1;
+  std::vector<FlowVector> vectors;
+  for (float x = 20; x < 360; x += 40) {
+    for (float y = 20; y < 230; y += 40) {
+      const Eigen::Vector3d moved = k * earlier_from_later.transpose() * k.inverse() * Eigen::Vector3d(x, y, 1);
+      vectors.push_back({{x, y}, {float(moved.x() / moved.z() - x), float(moved.y() / moved.z() - y)}});
+    }
+  }
+  EXPECT_GT(std::abs(vectors[0].delta.x), 5.0f);
+  DerotateFlow(camera, earlier_from_later, &vectors);
+  for (const FlowVector& v : vectors) {
+    EXPECT_NEAR(v.delta.x, 0.0, 1e-3);
+    EXPECT_NEAR(v.delta.y, 0.0, 1e-3);
+  }
+}
+
+TEST(KeyLocationOptions, DefaultsAreTableOneAndChecksNameTheField) {
+  KeyLocationOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error));
+  EXPECT_EQ(options.voting.accept, 3);
+  EXPECT_EQ(options.voting.reject, 2);
+  EXPECT_EQ(options.smoothing.window, 30);
+  EXPECT_DOUBLE_EQ(options.extrema.min_change, 0.02);
+  EXPECT_DOUBLE_EQ(options.extrema.min_time_s, 2.0);
+  options.voting.reject = 4;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("reject"), std::string::npos);
+}
+
+TEST(KeyLocationDetectorDeathTest, InvalidOptionsAbort) {
+  KeyLocationOptions options;
+  options.smoothing.window = 0;
+  EXPECT_DEATH(KeyLocationDetector(options, CameraContext{}), "smoothing.window");
+}
+
+TEST(KeyLocationDetector, StaticSceneGivesNoKeyLocation) {
+  KeyLocationOptions options;
+  options.frames.step = 1;
+  options.frames.scale = 1.0;
+  KeyLocationDetector detector(options, CameraContext{});
+  DetectorOutput output;
+  Frame frame;
+  const cv::Mat image = Texture(5);
+  for (int i = 0; i < 120; ++i) {
+    frame.index = i;
+    frame.timestamp_ns = SecondsToNs(i / 6.0);
+    frame.image = image;
+    detector.Process(frame, &output);
+  }
+  detector.Finish(&output);
+  EXPECT_EQ(output.samples.size(), 120u);
+  EXPECT_TRUE(output.key_locations.empty());
+  EXPECT_LT(output.samples[60].smoothed_response, 1e-3);
+}
+
+TEST(KeyLocationDetector, ProcessesEveryStepthFrameOnly) {
+  KeyLocationOptions options;  // step 5
+  KeyLocationDetector detector(options, CameraContext{});
+  DetectorOutput output;
+  Frame frame;
+  const cv::Mat image = Texture(5);
+  int decoded = 0;
+  for (int i = 0; i < 23; ++i) {
+    frame.index = i;
+    frame.image = detector.NeedsImage() ? image : cv::Mat();
+    decoded += !frame.image.empty();
+    detector.Process(frame, &output);
+  }
+  EXPECT_EQ(decoded, 5);  // frames 0, 5, 10, 15, 20
+  EXPECT_EQ(detector.processed_frames(), 5);
+}
+
+}  // namespace
+}  // namespace patrolmap::flow

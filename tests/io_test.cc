@@ -1,0 +1,279 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "patrolmap/io/csv.h"
+#include "patrolmap/io/natural_sort.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/io/yaml_file.h"
+#include "test_util.h"
+
+namespace patrolmap::io {
+namespace {
+
+using testing::TempDir;
+using testing::WriteText;
+
+cv::Mat TestImage(int value) {
+  cv::Mat image(24, 32, CV_8UC1, cv::Scalar(value));
+  return image;
+}
+
+std::vector<Frame> ReadAll(FrameSource* source, Status* end) {
+  std::vector<Frame> frames;
+  Frame frame;
+  while ((*end = source->Next(true, &frame)).ok()) frames.push_back(frame);
+  return frames;
+}
+
+// A EuRoC log of `count` frames 50 ms apart, images valued 10, 20, 30, ...
+void MakeEurocLog(const std::string& log, int count) {
+  std::filesystem::create_directories(log + "/cam0/data");
+  std::string table = "#timestamp [ns],filename\n";
+  for (int i = 0; i < count; ++i) {
+    const std::string name = std::to_string(1000000000LL + i * 50000000LL) + ".png";
+    cv::imwrite(log + "/cam0/data/" + name, TestImage(10 * (i + 1)));
+    table += std::to_string(1000000000LL + i * 50000000LL) + "," + name + "\n";
+  }
+  WriteText(log + "/cam0/data.csv", table);
+}
+
+TEST(NaturalSort, OrdersDigitRunsByValue) {
+  std::vector<std::string> names = {"10.png", "2.png", "1.png", "img10.png", "img9.png", "a.png", "002.png"};
+  NaturalSort(&names);
+  const std::vector<std::string> expected = {"1.png", "002.png", "2.png", "10.png", "a.png", "img9.png", "img10.png"};
+  EXPECT_EQ(names, expected);
+}
+
+TEST(Csv, SplitsAndTrims) {
+  std::vector<std::string_view> fields;
+  SplitCsvLine(" 12 ,abc.png\r", &fields);
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_EQ(fields[0], "12");
+  EXPECT_EQ(fields[1], "abc.png");
+}
+
+TEST(ImageFolder, ReadsInNaturalOrderWithTimestampsFromRate) {
+  TempDir dir;
+  for (int i : {10, 2, 1}) cv::imwrite(dir / (std::to_string(i) + ".png"), TestImage(i));
+  WriteText(dir / "notes.txt", "not an image");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  EXPECT_TRUE(end.end_of_stream());
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].image.at<uchar>(0, 0), 1);
+  EXPECT_EQ(frames[1].image.at<uchar>(0, 0), 2);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 10);
+  EXPECT_EQ(frames[2].timestamp_ns, 200000000);
+}
+
+TEST(ImageFolder, EmptyAndMissingFoldersFailWithTheirName) {
+  TempDir dir;
+  std::unique_ptr<FrameSource> source;
+  Status status = OpenImageFolder(dir.path(), {}, &source);
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find(dir.path()), std::string::npos);
+  status = OpenLog(dir / "missing", {}, &source);
+  EXPECT_EQ(status.code(), StatusCode::kNotFound);
+  EXPECT_NE(status.message().find("missing"), std::string::npos);
+}
+
+TEST(ImagePattern, StartsAtZeroOrOneAndStopsAtTheFirstGap) {
+  TempDir dir;
+  for (int i : {1, 2, 3, 5}) cv::imwrite(dir / cv::format("f_%03d.png", i), TestImage(i));
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(dir / "f_%03d.png", {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 3);
+  EXPECT_EQ(OpenLog(dir / "g_%03d.png", {}, &source).code(), StatusCode::kNotFound);
+}
+
+TEST(Video, ReadsGreyFramesAndCountsThem) {
+  TempDir dir;
+  const std::string path = dir / "clip.avi";
+  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(64, 48), true);
+  if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV build cannot write MJPG video";
+  for (int i = 0; i < 6; ++i) writer.write(cv::Mat(48, 64, CV_8UC3, cv::Scalar(40 * i, 40 * i, 40 * i)));
+  writer.release();
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(path, {}, &source).ok());
+  EXPECT_EQ(source->info().kind, "video");
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 6u);
+  EXPECT_EQ(frames[3].image.type(), CV_8UC1);
+  EXPECT_NEAR(frames[3].image.at<uchar>(10, 10), 120, 6);
+  EXPECT_EQ(frames[5].timestamp_ns, 200000000);  // 5 / 25 Hz
+}
+
+TEST(Video, GarbageFileFails) {
+  TempDir dir;
+  WriteText(dir / "junk.mp4", "this is not a video");
+  std::unique_ptr<FrameSource> source;
+  const Status status = OpenLog(dir / "junk.mp4", {}, &source);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("junk.mp4"), std::string::npos);
+}
+
+TEST(Euroc, ReadsFramesImuAndSensorYaml) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 4);
+  // EuRoC's own sensor.yaml starts with an OpenCV directive that is not YAML.
+  WriteText(log + "/cam0/sensor.yaml",
+            "%YAML:1.0\nT_BS:\n  cols: 4\n  rows: 4\n  data: [0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+            "rate_hz: 20\nresolution: [32, 24]\nintrinsics: [30.0, 31.0, 15.5, 11.5]\n");
+  WriteText(log + "/imu0/data.csv",
+            "#timestamp,wx,wy,wz,ax,ay,az\n"
+            "1000000000,0,0,0.1,0,0,9.8\n1020000000,0,0,0.2,0,0,9.8\n1050000000,0,0,0.3,0,0,9.8\n"
+            "1070000000,0,0,0.4,0,0,9.8\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  const LogInfo& info = source->info();
+  EXPECT_EQ(info.kind, "euroc");
+  EXPECT_EQ(info.frame_count, 4);
+  ASSERT_TRUE(info.camera.has_value());
+  EXPECT_DOUBLE_EQ(info.camera->fy, 31.0);
+  ASSERT_TRUE(info.camera_from_imu.has_value());
+  EXPECT_NEAR((*info.camera_from_imu)(0, 1), 1.0, 1e-12);  // transpose of T_BS's rotation
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(frames[0].imu.size(), 1u);  // t <= 1.00 s
+  EXPECT_EQ(frames[1].imu.size(), 2u);  // 1.00 s < t <= 1.05 s
+  EXPECT_EQ(frames[2].imu.size(), 1u);
+  EXPECT_EQ(frames[3].imu.size(), 0u);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 30);
+}
+
+TEST(Euroc, AcceptsTheMav0Folder) {
+  TempDir dir;
+  MakeEurocLog(dir / "flight/mav0", 2);
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(dir / "flight", {}, &source).ok());
+  EXPECT_EQ(source->info().frame_count, 2);
+}
+
+TEST(Euroc, MalformedLineNamesFileAndLine) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/cam0/data.csv", "#timestamp [ns],filename\n1000,a.png\n2000x,b.png\n");
+  std::unique_ptr<FrameSource> source;
+  const Status status = OpenLog(log, {}, &source);
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find("cam0/data.csv:3:"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("2000x"), std::string::npos);
+}
+
+TEST(Euroc, MissingColumnIsAnError) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  WriteText(log + "/cam0/data.csv", "1000\n");
+  std::unique_ptr<FrameSource> source;
+  const Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("data.csv:1: expected at least 2 columns"), std::string::npos) << status.message();
+}
+
+TEST(Euroc, NonMonotonicTimestampsAreRejected) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  WriteText(log + "/cam0/data.csv", "1000,a.png\n3000,b.png\n2000,c.png\n");
+  std::unique_ptr<FrameSource> source;
+  const Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (3000)"),
+            std::string::npos)
+      << status.message();
+}
+
+TEST(Euroc, MalformedImuLineIsAnError) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 2);
+  WriteText(log + "/imu0/data.csv", "1000,0,0,0,0,0,9.8\n2000,0,0,zero,0,0,9.8\n");
+  std::unique_ptr<FrameSource> source;
+  const Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("imu0/data.csv:2:"), std::string::npos) << status.message();
+}
+
+TEST(Euroc, UnreadableImageInTheMiddleIsCountedAndSkipped) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 5);
+  WriteText(log + "/cam0/data/1100000000.png", "truncated png");           // frame 2 corrupt
+  std::filesystem::remove(log + "/cam0/data/1150000000.png");              // frame 3 missing
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  EXPECT_TRUE(end.end_of_stream());
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[2].index, 4);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 50);
+  ASSERT_EQ(source->skipped().size(), 2u);
+  EXPECT_EQ(source->skipped()[0].index, 2);
+  EXPECT_NE(source->skipped()[0].reason.find("1100000000.png"), std::string::npos);
+}
+
+TEST(Euroc, SkippingDecodeReturnsEmptyImagesButKeepsOrder) {
+  TempDir dir;
+  MakeEurocLog(dir / "flight", 3);
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(dir / "flight", {}, &source).ok());
+  Frame frame;
+  ASSERT_TRUE(source->Next(false, &frame).ok());
+  EXPECT_TRUE(frame.image.empty());
+  ASSERT_TRUE(source->Next(true, &frame).ok());
+  EXPECT_EQ(frame.index, 1);
+  EXPECT_EQ(frame.image.at<uchar>(0, 0), 20);
+}
+
+TEST(Euroc, BadSensorYamlNamesTheFile) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3]\nresolution: [32, 24]\n");
+  std::unique_ptr<FrameSource> source;
+  Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("sensor.yaml: 'intrinsics' must have 4 numbers"), std::string::npos)
+      << status.message();
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3\n");
+  status = OpenLog(log, {}, &source);
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find("sensor.yaml:"), std::string::npos) << status.message();
+}
+
+TEST(Euroc, SpeedIsInterpolatedFromTheStateTable) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/state_groundtruth_estimate0/data.csv",
+            "1000000000,0,0,0,1,0,0,0,3,4,0\n1100000000,0,0,0,1,0,0,0,0,1,0\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_TRUE(frames[1].speed_mps.has_value());
+  EXPECT_DOUBLE_EQ(*frames[0].speed_mps, 5.0);
+  EXPECT_DOUBLE_EQ(*frames[1].speed_mps, 3.0);  // halfway between 5 and 1
+  EXPECT_DOUBLE_EQ(*frames[2].speed_mps, 1.0);
+}
+
+TEST(Euroc, RealSensorYamlFromSharedData) {
+  const std::string path = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/sensorLeft.yaml";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data not present";
+  YAML::Node root;
+  ASSERT_TRUE(LoadYamlFile(path, &root).ok());
+  EXPECT_DOUBLE_EQ(root["intrinsics"][0].as<double>(), 458.654);
+}
+
+}  // namespace
+}  // namespace patrolmap::io

@@ -1,0 +1,159 @@
+#include <cmath>
+#include <functional>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "patrolmap/flow/key_location_detector.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/pipeline/config.h"
+#include "patrolmap/pipeline/detect.h"
+#include "patrolmap/sim/flight.h"
+#include "test_util.h"
+
+namespace patrolmap::pipeline {
+namespace {
+
+const std::string kDefaultConfig = std::string(PATROLMAP_SOURCE_DIR) + "/config/default.yaml";
+
+void FlattenKeys(const YAML::Node& node, const std::string& prefix, std::set<std::string>* keys) {
+  for (const auto& item : node) {
+    const std::string path = prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
+    if (item.second.IsMap()) FlattenKeys(item.second, path, keys);
+    else keys->insert(path);
+  }
+}
+
+TEST(Config, DefaultFileMirrorsTheOptionsStructsOneToOne) {
+  Config loaded;
+  loaded.flow.voting.accept = 99;  // must be overwritten by the file
+  loaded.flow.voting.max_votes = 99;
+  ASSERT_TRUE(LoadConfig(kDefaultConfig, &loaded).ok());
+  EXPECT_EQ(ConfigToYaml(loaded), ConfigToYaml(Config{}));
+  std::set<std::string> file_keys, struct_keys;
+  FlattenKeys(YAML::LoadFile(kDefaultConfig), "", &file_keys);
+  FlattenKeys(YAML::Load(ConfigToYaml(Config{})), "", &struct_keys);
+  EXPECT_EQ(file_keys, struct_keys);
+}
+
+TEST(Config, UnknownKeyNamesFileLineAndKey) {
+  testing::TempDir dir;
+  testing::WriteText(dir / "c.yaml", "flow:\n  voting:\n    accept: 4\n    acept: 4\n");
+  Config config;
+  const Status status = LoadConfig(dir / "c.yaml", &config);
+  EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(status.message().find("c.yaml:4: flow.voting.acept: unknown key"), std::string::npos) << status.message();
+}
+
+TEST(Config, WrongTypesAndBadValuesAreReported) {
+  testing::TempDir dir;
+  Config config;
+  testing::WriteText(dir / "a.yaml", "flow:\n  smoothing:\n    window: wide\n");
+  Status status = LoadConfig(dir / "a.yaml", &config);
+  EXPECT_NE(status.message().find("a.yaml:3: flow.smoothing.window: expected an integer, got 'wide'"),
+            std::string::npos)
+      << status.message();
+  testing::WriteText(dir / "b.yaml", "flow:\n  response:\n    quantity: speed\n");
+  status = LoadConfig(dir / "b.yaml", &config);
+  EXPECT_NE(status.message().find("expected length or line_parameter"), std::string::npos) << status.message();
+  testing::WriteText(dir / "c.yaml", "flow:\n  voting:\n    accept: 1\n");  // under reject 2
+  status = LoadConfig(dir / "c.yaml", &config);
+  EXPECT_NE(status.message().find("c.yaml: flow.voting"), std::string::npos) << status.message();
+  EXPECT_EQ(LoadConfig(dir / "missing.yaml", &config).code(), StatusCode::kNotFound);
+}
+
+TEST(Config, PartialFileKeepsOtherDefaults) {
+  testing::TempDir dir;
+  testing::WriteText(dir / "p.yaml", "flow:\n  smoothing:\n    mode: causal\n  extrema:\n    min_time_s: 3.5\n");
+  Config config;
+  ASSERT_TRUE(LoadConfig(dir / "p.yaml", &config).ok());
+  EXPECT_EQ(config.flow.smoothing.mode, flow::SmoothingMode::kCausal);
+  EXPECT_DOUBLE_EQ(config.flow.extrema.min_time_s, 3.5);
+  EXPECT_EQ(config.flow.smoothing.window, 30);
+}
+
+// Runs the detector over a simulated flight rendered in memory (only the frames it processes).
+std::vector<KeyLocation> DetectOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
+  flow::KeyLocationDetector detector(options, {flight.camera, std::nullopt});
+  sim::Renderer renderer(&flight.scene, flight.camera);
+  flow::DetectorOutput output;
+  Frame frame;
+  for (int i = 0; i < sim::FrameCount(flight); ++i) {
+    frame.index = i;
+    frame.timestamp_ns = sim::FrameTimestamp(flight, i);
+    frame.image.release();
+    if (detector.NeedsImage()) {
+      renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(i / flight.frame_rate_hz)), &frame.image);
+    }
+    detector.Process(frame, &output);
+  }
+  detector.Finish(&output);
+  return output.key_locations;
+}
+
+// The street has openings (gaps) at [16, 28] and [44, 56] m; the camera flies from 8 m at 2.5 m/s, so the
+// gaps are in front of the axis during [3.2, 8.0] s and [14.4, 19.2] s. The paper's detector puts a valley
+// inside each opening and a peak on the facade between them; nothing else.
+TEST(DetectEndToEnd, StreetWithTwoOpeningsGivesValleyPeakValley) {
+  const sim::SimulatedFlight flight = sim::MakeStreetFlight(sim::StreetOptions{});
+  const std::vector<KeyLocation> nodes = DetectOnFlight(flight, flow::KeyLocationOptions{});
+  ASSERT_EQ(nodes.size(), 3u);
+  const double expected_s[] = {5.6, 11.2, 16.8};  // opening, facade and opening centres
+  const ExtremumKind kinds[] = {ExtremumKind::kValley, ExtremumKind::kPeak, ExtremumKind::kValley};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(NsToSeconds(nodes[i].timestamp_ns), expected_s[i], 1.0) << i;  // tolerance: 1 s = 2.5 m
+    EXPECT_EQ(nodes[i].kind, kinds[i]) << i;
+  }
+  EXPECT_GT(nodes[1].response - nodes[0].response, 0.02);
+}
+
+// The causal smoother lags (window - 1) / 2 processed frames, so near the end of a log the last extremum may
+// not be confirmed; a street with three openings leaves room for the first three nodes.
+TEST(DetectEndToEnd, CausalSmoothingFindsTheSameNodesLater) {
+  sim::StreetOptions street;
+  street.walls = 4;
+  const sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
+  flow::KeyLocationOptions options;
+  options.smoothing.mode = flow::SmoothingMode::kCausal;
+  const std::vector<KeyLocation> nodes = DetectOnFlight(flight, options);
+  ASSERT_GE(nodes.size(), 3u);
+  const double lag_s = 14.5 * 5 / 30.0;  // 14.5 processed frames of 5 camera frames at 30 Hz
+  const double expected_s[] = {5.6, 11.2, 16.8};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(NsToSeconds(nodes[i].timestamp_ns), expected_s[i] + lag_s, 1.0) << i;
+    EXPECT_EQ(nodes[i].kind, i == 1 ? ExtremumKind::kPeak : ExtremumKind::kValley) << i;
+  }
+}
+
+TEST(DetectEndToEnd, HoveringCameraGivesNoKeyLocation) {
+  sim::StreetOptions options;
+  options.static_camera = true;
+  EXPECT_TRUE(DetectOnFlight(sim::MakeStreetFlight(options), flow::KeyLocationOptions{}).empty());
+}
+
+TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
+  testing::TempDir dir;
+  sim::StreetOptions street;
+  street.speed_mps = 5.0;
+  ASSERT_TRUE(sim::WriteEurocLog(sim::MakeStreetFlight(street), dir / "log").ok());
+  std::unique_ptr<io::FrameSource> source;
+  ASSERT_TRUE(io::OpenLog(dir / "log", {}, &source).ok());
+  DetectionResult result;
+  ASSERT_TRUE(RunDetection(source.get(), flow::KeyLocationOptions{}, &result).ok());
+  EXPECT_TRUE(result.derotated);
+  EXPECT_EQ(result.frames_read, source->info().frame_count);
+  EXPECT_EQ(static_cast<std::int64_t>(result.samples.size()), (result.frames_read + 4) / 5);
+  ASSERT_TRUE(WriteDetectionOutputs(result, dir / "out", {{1.0, 2.0}}).ok());
+  const std::string nodes = testing::ReadText(dir / "out/key_locations.csv");
+  EXPECT_EQ(nodes.substr(0, nodes.find('\n')), "node,timestamp_ns,frame_index,response,kind");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(nodes.begin(), nodes.end(), '\n')), result.key_locations.size() + 1);
+  const std::string response = testing::ReadText(dir / "out/response.csv");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(response.begin(), response.end(), '\n')), result.samples.size() + 1);
+  const std::string svg = testing::ReadText(dir / "out/response.svg");
+  EXPECT_NE(svg.find("<polyline"), std::string::npos);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace patrolmap::pipeline
