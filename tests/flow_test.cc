@@ -225,6 +225,45 @@ TEST(EdgeFlowTracker, RecoversAKnownShift) {
   EXPECT_NEAR(dy[dy.size() / 2], -2.0, 0.05);
 }
 
+// A periodic checkerboard (period 8 px): no structure survives at coarse pyramid levels, so a
+// 14 px motion is ambiguous for LK unless the search starts near the answer.
+cv::Mat Checkerboard(int offset) {
+  cv::Mat image(240, 376, CV_8UC1);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) image.at<uchar>(y, x) = ((x + offset) / 4 + y / 4) % 2 ? 200 : 60;
+  }
+  cv::GaussianBlur(image, image, cv::Size(3, 3), 0.8);
+  return image;
+}
+
+float MedianDx(const std::vector<FlowVector>& vectors) {
+  std::vector<float> dx;
+  for (const FlowVector& v : vectors) dx.push_back(v.delta.x);
+  std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+  return dx[dx.size() / 2];
+}
+
+// Motion ramps up 2, 4, ..., 14 px per frame (a platform taking off): with prediction each search
+// starts from the previous flow and stays on the true period; without it, 14 px locks onto an alias.
+float FinalMedianShift(bool predict) {
+  TrackerOptions tracker;
+  tracker.predict_from_previous = predict;
+  EdgeFlowTracker flow(EdgeOptions{}, tracker);
+  std::vector<FlowVector> vectors;
+  int offset = 0;
+  flow.Track(Checkerboard(offset), &vectors);
+  for (int shift = 2; shift <= 14; shift += 2) {
+    offset += shift;
+    flow.Track(Checkerboard(offset), &vectors);
+  }
+  return MedianDx(vectors);
+}
+
+TEST(EdgeFlowTracker, PredictionFollowsLargeMotionOnRepetitiveTexture) {
+  EXPECT_NEAR(FinalMedianShift(true), -14.0f, 0.5f);
+  EXPECT_GT(std::abs(FinalMedianShift(false) + 14.0f), 2.0f);  // the problem prediction solves
+}
+
 TEST(Gyro, IntegratesAConstantRate) {
   std::vector<ImuSample> samples;
   for (int i = 1; i <= 40; ++i) {
@@ -302,6 +341,29 @@ TEST(KeyLocationDetector, StaticSceneGivesNoKeyLocation) {
   EXPECT_EQ(output.samples.size(), 120u);
   EXPECT_TRUE(output.key_locations.empty());
   EXPECT_LT(output.samples[60].smoothed_response, 1e-3);
+}
+
+TEST(KeyLocationDetector, LengthResponseIsImageWidthsPerSecond) {
+  KeyLocationOptions options;
+  options.frames.step = 1;
+  options.frames.scale = 1.0;
+  options.smoothing.window = 1;
+  KeyLocationDetector detector(options, CameraContext{});
+  DetectorOutput output;
+  const cv::Mat texture = Texture(9);
+  Frame frame;
+  for (int i = 0; i < 8; ++i) {
+    const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, -4.0 * i, 0, 1, 0);  // 4 px left per frame
+    cv::warpAffine(texture, frame.image, shift, texture.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+    frame.index = i;
+    frame.timestamp_ns = SecondsToNs(0.2 * i);
+    detector.Process(frame, &output);
+  }
+  detector.Finish(&output);
+  ASSERT_EQ(output.samples.size(), 8u);
+  EXPECT_TRUE(std::isnan(output.samples[0].raw_response));
+  EXPECT_NEAR(output.samples[7].raw_response, 4.0 / 376.0 / 0.2, 0.002);  // 0.0532 widths/s
+  EXPECT_GT(output.samples[7].accepted_vectors, 300);
 }
 
 TEST(KeyLocationDetector, ProcessesEveryStepthFrameOnly) {

@@ -4,7 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "patrolmap/io/csv.h"
+#include "patrolmap/core/csv.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/io/yaml_file.h"

@@ -9,6 +9,11 @@
 namespace patrolmap::flow {
 namespace {
 
+float Median(std::vector<float>* values) {
+  std::nth_element(values->begin(), values->begin() + values->size() / 2, values->end());
+  return (*values)[values->size() / 2];
+}
+
 void SelectInCell(const cv::Mat& edges, const cv::Rect& cell, int quota,
                   std::vector<cv::Point2f>* points) {
   const int count = cv::countNonZero(edges(cell));
@@ -47,11 +52,51 @@ void SelectEdgePoints(const cv::Mat& edges, const EdgeOptions& options, std::vec
 }
 
 EdgeFlowTracker::EdgeFlowTracker(const EdgeOptions& edges, const TrackerOptions& tracker)
-    : edge_options_(edges), tracker_options_(tracker) {}
+    : edge_options_(edges), tracker_options_(tracker) {
+  const int cells = edges.grid_columns * edges.grid_rows + 1;  // the last one is the whole image
+  cell_flow_.assign(cells, cv::Point2f(0.0f, 0.0f));
+  cell_dx_.resize(cells);
+  cell_dy_.resize(cells);
+}
 
 void EdgeFlowTracker::Reset() {
   previous_pyramid_.clear();
   previous_points_.clear();
+  has_prediction_ = false;
+}
+
+int EdgeFlowTracker::CellOf(const cv::Point2f& point, const cv::Size& size) const {
+  const int column = std::clamp(static_cast<int>(point.x * edge_options_.grid_columns / size.width), 0,
+                                edge_options_.grid_columns - 1);
+  const int row = std::clamp(static_cast<int>(point.y * edge_options_.grid_rows / size.height), 0,
+                             edge_options_.grid_rows - 1);
+  return row * edge_options_.grid_columns + column;
+}
+
+// Median flow per cell of the vectors that end in it (where the next frame's points start).
+void EdgeFlowTracker::UpdatePrediction(const std::vector<FlowVector>& vectors, const cv::Size& size) {
+  const int all = static_cast<int>(cell_flow_.size()) - 1;
+  for (std::size_t cell = 0; cell < cell_flow_.size(); ++cell) cell_dx_[cell].clear(), cell_dy_[cell].clear();
+  for (const FlowVector& vector : vectors) {
+    const int cell = CellOf(vector.start + vector.delta, size);
+    for (int target : {cell, all}) {
+      cell_dx_[target].push_back(vector.delta.x);
+      cell_dy_[target].push_back(vector.delta.y);
+    }
+  }
+  has_prediction_ = !cell_dx_[all].empty();
+  if (!has_prediction_) return;
+  const cv::Point2f global(Median(&cell_dx_[all]), Median(&cell_dy_[all]));
+  for (int cell = 0; cell < all; ++cell) {
+    cell_flow_[cell] = cell_dx_[cell].empty() ? global : cv::Point2f(Median(&cell_dx_[cell]), Median(&cell_dy_[cell]));
+  }
+}
+
+void EdgeFlowTracker::PredictPositions(const cv::Size& size) {
+  tracked_points_.resize(previous_points_.size());
+  for (std::size_t i = 0; i < previous_points_.size(); ++i) {
+    tracked_points_[i] = previous_points_[i] + cell_flow_[CellOf(previous_points_[i], size)];
+  }
 }
 
 void EdgeFlowTracker::Track(const cv::Mat& image, std::vector<FlowVector>* vectors) {
@@ -62,12 +107,15 @@ void EdgeFlowTracker::Track(const cv::Mat& image, std::vector<FlowVector>* vecto
   if (!previous_points_.empty()) {
     const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
                                     tracker_options_.max_iterations, tracker_options_.epsilon);
+    const bool predict = tracker_options_.predict_from_previous && has_prediction_;
+    if (predict) PredictPositions(image.size());
     cv::calcOpticalFlowPyrLK(previous_pyramid_, current_pyramid_, previous_points_, tracked_points_,
-                             track_status_, track_errors_, window, tracker_options_.pyramid_levels,
-                             criteria, 0, tracker_options_.min_eigen_threshold);
+                             track_status_, track_errors_, window, tracker_options_.pyramid_levels, criteria,
+                             predict ? cv::OPTFLOW_USE_INITIAL_FLOW : 0, tracker_options_.min_eigen_threshold);
     for (std::size_t i = 0; i < previous_points_.size(); ++i) {
       if (track_status_[i]) vectors->push_back({previous_points_[i], tracked_points_[i] - previous_points_[i]});
     }
+    UpdatePrediction(*vectors, image.size());
   }
   cv::Canny(image, edges_, edge_options_.canny_low, edge_options_.canny_high);
   SelectEdgePoints(edges_, edge_options_, &previous_points_);

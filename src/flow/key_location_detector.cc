@@ -71,8 +71,7 @@ void KeyLocationDetector::ProcessSelected(const Frame& frame, DetectorOutput* ou
   sample.frame_index = frame.index;
   sample.tracked_vectors = static_cast<int>(vectors_.size());
   sample.accepted_vectors = voter_->Vote(polar_, &accepted_);
-  const double response = SceneFlowResponse(polar_, accepted_, options_.response.quantity, image.cols);
-  sample.raw_response = NormaliseBySpeed(response, frame.speed_mps);
+  sample.raw_response = ResponseOf(frame, image.cols);
   previous_processed_ns_ = frame.timestamp_ns;
   pending_imu_.clear();
   ++processed_frames_;
@@ -86,9 +85,16 @@ void KeyLocationDetector::Derotate(TimestampNs timestamp_ns, int image_width) {
   DerotateFlow(context_.camera->Scaled(scale), rotation, &vectors_);
 }
 
-double KeyLocationDetector::NormaliseBySpeed(double response, const std::optional<double>& speed_mps) const {
-  if (!options_.response.normalise_by_speed || !speed_mps) return response;
-  const double speed = std::max(*speed_mps, options_.response.min_speed_mps);
+// Equation 3 in the documented unit: lengths become a rate over the time since
+// the previous processed frame; optionally scaled to the reference speed.
+double KeyLocationDetector::ResponseOf(const Frame& frame, int image_width) const {
+  double response = SceneFlowResponse(polar_, accepted_, options_.response.quantity, image_width);
+  if (options_.response.quantity == ResponseQuantity::kLength) {
+    const double interval_s = previous_processed_ns_ ? NsToSeconds(frame.timestamp_ns - *previous_processed_ns_) : 0.0;
+    response = interval_s > 0.0 ? response / interval_s : std::numeric_limits<double>::quiet_NaN();
+  }
+  if (!options_.response.normalise_by_speed || !frame.speed_mps) return response;
+  const double speed = std::max(*frame.speed_mps, options_.response.min_speed_mps);
   return response * options_.response.reference_speed_mps / speed;
 }
 

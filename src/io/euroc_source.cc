@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 
 #include "image_list_source.h"
-#include "patrolmap/io/csv.h"
+#include "patrolmap/core/csv.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/io/yaml_file.h"
 

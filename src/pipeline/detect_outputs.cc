@@ -75,7 +75,7 @@ void Axes(const PlotFrame& frame, std::ostringstream* svg) {
        << "' font-size='12' text-anchor='middle'>time [s]</text>\n"
        << "<text x='18' y='" << (frame.top + frame.bottom) / 2 << "' font-size='12' text-anchor='middle' "
        << "transform='rotate(-90 18 " << (frame.top + frame.bottom) / 2
-       << ")'>response [image widths / frame]</text>\n";
+       << ")'>response [image widths / s]</text>\n";
 }
 
 void Markers(const DetectionResult& result, const PlotTruth& truth, const PlotFrame& frame, std::ostringstream* svg) {

@@ -1,6 +1,8 @@
 // The straight-street scene: facades with gaps in front of a far facade.
 #include <cmath>
 
+#include <opencv2/core.hpp>
+
 #include "patrolmap/sim/flight.h"
 
 namespace patrolmap::sim {
@@ -22,20 +24,43 @@ void AddBuilding(double x0, double x1, double y, double height, std::uint32_t se
   scene->walls.push_back({d, a, height, side});
 }
 
+struct Facade {
+  double x0 = 0.0, x1 = 0.0, depth = 0.0, height = 0.0;
+};
+
+std::vector<Facade> LayFacades(const StreetOptions& options) {
+  cv::RNG rng(options.seed * 7919u + 17u);
+  const auto draw = [&](double value, double low, double high) {
+    return options.irregular ? value * rng.uniform(low, high) : value;
+  };
+  std::vector<Facade> facades;
+  double x = 0.0;
+  for (int i = 0; i < options.walls; ++i) {
+    Facade facade;
+    facade.x0 = x;
+    facade.x1 = x + draw(options.wall_length_m, 0.6, 1.5);
+    facade.depth = draw(options.near_depth_m, 0.8, 1.6);
+    facade.height = draw(options.wall_height_m, 0.7, 1.3);
+    facades.push_back(facade);
+    x = facade.x1 + draw(options.gap_length_m, 0.5, 1.3);
+  }
+  return facades;
+}
+
 }  // namespace
 
 SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen::Vector2d>* gaps) {
   SimulatedFlight flight;
   flight.flight_id = "street";
+  flight.mount_angle = options.mount_angle_deg * M_PI / 180.0;
   Scene& scene = flight.scene;
-  const double period = options.wall_length_m + options.gap_length_m;
-  for (int i = 0; i < options.walls; ++i) {
-    const double x0 = i * period;
-    AddBuilding(x0, x0 + options.wall_length_m, options.near_depth_m, options.wall_height_m,
-                options.seed * 1000u + 10u * i, &scene);
-    if (gaps != nullptr && i + 1 < options.walls) gaps->emplace_back(x0 + options.wall_length_m, (i + 1) * period);
+  const std::vector<Facade> facades = LayFacades(options);
+  for (std::size_t i = 0; i < facades.size(); ++i) {
+    const Facade& facade = facades[i];
+    AddBuilding(facade.x0, facade.x1, facade.depth, facade.height, options.seed * 1000u + 10u * i, &scene);
+    if (gaps != nullptr && i + 1 < facades.size()) gaps->emplace_back(facade.x1, facades[i + 1].x0);
   }
-  const double street_end = (options.walls - 1) * period + options.wall_length_m;
+  const double street_end = facades.back().x1;
   const double margin = 4.0 * options.far_depth_m;
   scene.textures.push_back(MakeFacadeTexture(street_end + 2 * margin, 2.0 * options.wall_height_m,
                                              options.seed * 1000u + 999u));
@@ -45,8 +70,8 @@ SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen
   scene.textures.push_back(MakeGroundTexture(scene.ground_tile_metres, options.seed * 1000u + 998u));
   scene.ground_texture = static_cast<int>(scene.textures.size()) - 1;
 
-  const double start = 0.5 * options.wall_length_m;
-  const double length = street_end - options.wall_length_m;
+  const double start = 0.5 * (facades.front().x0 + facades.front().x1);
+  const double length = 0.5 * (facades.back().x0 + facades.back().x1) - start;
   const double speed = options.static_camera ? 0.0 : options.speed_mps;
   flight.duration_s = options.static_camera ? 10.0 : length / options.speed_mps;
   const double altitude = options.altitude_m;

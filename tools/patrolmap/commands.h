@@ -13,5 +13,6 @@ using Command = std::function<int()>;
 
 Command AddDetectCommand(CLI::App* app);
 Command AddSimulateCommand(CLI::App* app);
+Command AddEvalCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

@@ -6,7 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
-#include "patrolmap/io/ground_truth.h"
+#include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/pipeline/detect.h"
 #include "progress.h"
@@ -40,9 +40,9 @@ Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config
 
 pipeline::PlotTruth LoadPlotTruth(const std::string& log) {
   pipeline::PlotTruth truth;
-  std::vector<io::TruthKeyLocationRecord> records;
-  if (!io::ReadTruthKeyLocations(log, &records).ok()) return truth;
-  for (const auto& record : records) truth.times_s.push_back(NsToSeconds(record.timestamp_ns));
+  std::vector<eval::TruthEdge> edges;
+  if (!eval::ReadTruthEdges(log, &edges).ok()) return truth;
+  for (const eval::TruthEdge& edge : edges) truth.times_s.push_back(NsToSeconds(edge.timestamp_ns));
   return truth;
 }
 

@@ -19,6 +19,8 @@ struct SimulateArguments {
   bool static_camera = false;
   double speed_mps = 2.5;
   int walls = 3;
+  double mount_deg = 90.0;
+  bool irregular = false;
 };
 
 int RunSimulate(const SimulateArguments& arguments) {
@@ -27,6 +29,8 @@ int RunSimulate(const SimulateArguments& arguments) {
   street.static_camera = arguments.static_camera;
   street.speed_mps = arguments.speed_mps;
   street.walls = arguments.walls;
+  street.mount_angle_deg = arguments.mount_deg;
+  street.irregular = arguments.irregular;
   sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
   flight.flight_id = arguments.route + "-" + std::to_string(arguments.seed);
   Status status;
@@ -55,6 +59,11 @@ Command AddSimulateCommand(CLI::App* app) {
   app->add_option("-o,--out", arguments->out, "folder of the EuRoC-layout log to write")->required();
   app->add_option("--speed", arguments->speed_mps, "flight speed [m/s]")->check(CLI::PositiveNumber)->capture_default_str();
   app->add_option("--walls", arguments->walls, "facades along the street")->check(CLI::Range(1, 100))->capture_default_str();
+  app->add_option("--mount", arguments->mount_deg, "camera mount: angle of the optical axis from the flight "
+                  "direction, towards the left [deg]")
+      ->check(CLI::Range(20.0, 90.0))
+      ->capture_default_str();
+  app->add_flag("--irregular", arguments->irregular, "draw facade lengths, gaps, depths and heights from the seed");
   app->add_flag("--static", arguments->static_camera, "hover in place for 10 s (no ego-motion)");
   return [arguments] { return RunSimulate(*arguments); };
 }

@@ -32,6 +32,10 @@ class EdgeFlowTracker {
   int last_point_count() const { return last_point_count_; }
 
  private:
+  int CellOf(const cv::Point2f& point, const cv::Size& size) const;
+  void UpdatePrediction(const std::vector<FlowVector>& vectors, const cv::Size& size);
+  void PredictPositions(const cv::Size& size);
+
   EdgeOptions edge_options_;
   TrackerOptions tracker_options_;
   std::vector<cv::Mat> previous_pyramid_;
@@ -42,6 +46,9 @@ class EdgeFlowTracker {
   std::vector<float> track_errors_;
   cv::Mat edges_;
   int last_point_count_ = 0;
+  std::vector<cv::Point2f> cell_flow_;             // predicted flow per edge-grid cell
+  std::vector<std::vector<float>> cell_dx_, cell_dy_;  // scratch for the medians
+  bool has_prediction_ = false;
 };
 
 // Rotation of the camera between two instants from gyro samples in the IMU

@@ -30,8 +30,8 @@ struct DetectorOutput {
   std::vector<KeyLocation> key_locations;  // confirmed key locations
 };
 
-// Mean response of `accepted` vectors (equation 3) in image widths per
-// processed frame; NaN when none is accepted.
+// Mean quantity of `accepted` vectors (equation 3) in image widths (per
+// processed frame for kLength); NaN when none is accepted.
 double SceneFlowResponse(const std::vector<PolarVector>& vectors, const std::vector<std::uint8_t>& accepted,
                          ResponseQuantity quantity, int image_width);
 
@@ -59,7 +59,7 @@ class KeyLocationDetector {
   void ProcessSelected(const Frame& frame, DetectorOutput* output);
   const cv::Mat& Downscale(const cv::Mat& image);
   void Derotate(TimestampNs timestamp_ns, int image_width);
-  double NormaliseBySpeed(double response, const std::optional<double>& speed_mps) const;
+  double ResponseOf(const Frame& frame, int image_width) const;
   void Emit(const FlowSample& sample, DetectorOutput* output);
   void DetectExtrema(DetectorOutput* output);  // runs the released samples through the extremum detector
 

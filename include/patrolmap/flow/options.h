@@ -26,11 +26,15 @@ struct EdgeOptions {
 
 // Pyramidal Lucas-Kanade tracking of the edge pixels into the next processed frame.
 struct TrackerOptions {
-  int window_size = 15;            // LK window side [pixels, at processing scale]
+  int window_size = 11;            // LK window side [pixels, at processing scale]
   int pyramid_levels = 3;          // extra pyramid levels above the base image
-  int max_iterations = 20;         // LK iteration cap per level
+  int max_iterations = 10;         // LK iteration cap per level
   double epsilon = 0.03;           // LK convergence threshold [pixels]
   double min_eigen_threshold = 1e-3;  // reject points with weaker gradient structure
+  // Start each point's search from the median flow of its edge-grid cell in the
+  // previous processed frame (else from zero). Keeps LK from locking onto a
+  // period of repetitive texture (brick, windows) when motion is large.
+  bool predict_from_previous = true;
 };
 
 // Hysteresis voting in the polar (theta, r) domain (equations 1-2, Table I).
@@ -47,8 +51,9 @@ enum class ResponseQuantity {
   kLineParameter,  // mean r of equation 2, r = x1 cos(theta) + y1 sin(theta): the paper's formula
 };
 
-// Scene-flow response, equation 3: the mean over accepted vectors. Unit: image
-// widths per processed frame (resolution independent).
+// Scene-flow response, equation 3: the mean over accepted vectors. Units:
+// kLength in image widths per second (independent of resolution and of the
+// frame step), kLineParameter in image widths (r is a position, not a rate).
 struct ResponseOptions {
   ResponseQuantity quantity = ResponseQuantity::kLength;
   bool derotate_with_imu = true;    // subtract gyro-predicted rotational flow when imu0 exists

@@ -65,9 +65,9 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder,
 
 // A straight street: `walls` near facades of `wall_length_m` separated by gaps of
 // `gap_length_m`, all `near_depth_m` from the path, with one long far facade at
-// `far_depth_m` seen through the gaps. The camera looks left (90 degree mount)
-// and flies at constant speed and height from the middle of the first facade
-// to the middle of the last.
+// `far_depth_m` seen through the gaps. The camera looks left (90 degree mount by
+// default) and flies at constant speed and height from the middle of the first
+// facade to the middle of the last.
 struct StreetOptions {
   int walls = 3;
   double wall_length_m = 16.0;
@@ -78,6 +78,10 @@ struct StreetOptions {
   double speed_mps = 2.5;
   double altitude_m = 3.0;
   bool static_camera = false;  // hover at the start instead of flying
+  double mount_angle_deg = 90.0;  // optical axis from the flight direction towards the left [deg]
+  // Draw each facade's length (0.6-1.5x), each gap (0.5-1.3x), each near depth
+  // (0.8-1.6x) and height (0.7-1.3x) from the seed instead of using them as given.
+  bool irregular = false;
   std::uint32_t seed = 1;
 };
 

@@ -11,7 +11,7 @@
 
 #include "patrolmap/core/status.h"
 
-namespace patrolmap::io {
+namespace patrolmap {
 
 class CsvReader {
  public:
@@ -42,4 +42,4 @@ class CsvReader {
 // Splits `line` at commas, trimming spaces, tabs and a trailing '\r'.
 void SplitCsvLine(std::string_view line, std::vector<std::string_view>* fields);
 
-}  // namespace patrolmap::io
+}  // namespace patrolmap

@@ -1,11 +1,11 @@
-#include "patrolmap/io/csv.h"
+#include "patrolmap/core/csv.h"
 
 #include <cerrno>
 #include <charconv>
 #include <cstdlib>
 #include <filesystem>
 
-namespace patrolmap::io {
+namespace patrolmap {
 namespace {
 
 std::string_view Trim(std::string_view text) {
@@ -73,4 +73,4 @@ Status CsvReader::ParseDouble(std::string_view field, const char* column, double
   return Status::Ok();
 }
 
-}  // namespace patrolmap::io
+}  // namespace patrolmap

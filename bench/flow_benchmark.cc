@@ -1,0 +1,93 @@
+// Per-frame cost of the key-location (flow) stage: edges, LK tracking, polar
+// voting, response, smoothing and extremum detection on rendered street
+// frames. Run with OpenCV on one thread, as on one core of the onboard target.
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/flow/key_location_detector.h"
+#include "patrolmap/sim/flight.h"
+
+namespace {
+
+using namespace patrolmap;
+
+// Every 5th frame of the street flight (the frames the detector processes), at `width` x `height`.
+const std::vector<cv::Mat>& StreetFrames(int width, int height) {
+  static std::vector<cv::Mat> frames[2];
+  std::vector<cv::Mat>& cached = frames[width > 400 ? 1 : 0];
+  if (!cached.empty()) return cached;
+  sim::SimulatedFlight flight = sim::MakeStreetFlight(sim::StreetOptions{});
+  const double scale = width / 752.0;
+  flight.camera = flight.camera.Scaled(scale);
+  sim::Renderer renderer(&flight.scene, flight.camera);
+  for (int i = 0; i < sim::FrameCount(flight); i += 5) {
+    cv::Mat image;
+    renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(i / flight.frame_rate_hz)), &image);
+    cached.push_back(image);
+  }
+  (void)height;
+  return cached;
+}
+
+void BM_FlowStagePerProcessedFrame(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const std::vector<cv::Mat>& frames = StreetFrames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  flow::KeyLocationOptions options;
+  options.frames.step = 1;     // the frames given are already the processed ones
+  options.frames.scale = 1.0;  // and already at processing size
+  flow::KeyLocationDetector detector(options, {});
+  flow::DetectorOutput output;
+  Frame frame;
+  std::size_t next = 0;
+  for (auto _ : state) {
+    frame.image = frames[next % frames.size()];
+    frame.index = static_cast<std::int64_t>(next);
+    frame.timestamp_ns = SecondsToNs(next / 6.0);
+    ++next;
+    output.samples.clear();
+    output.key_locations.clear();
+    detector.Process(frame, &output);
+    benchmark::DoNotOptimize(output.samples.data());
+  }
+  state.SetLabel(std::to_string(state.range(0)) + "x" + std::to_string(state.range(1)));
+}
+BENCHMARK(BM_FlowStagePerProcessedFrame)
+    ->Args({376, 240})
+    ->Args({752, 480})
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
+// Downscaling a native 752x480 frame to 376x240 (done once per processed frame when scale is 0.5).
+void BM_DownscaleHalf(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat& image = StreetFrames(752, 480)[10];
+  cv::Mat small;
+  for (auto _ : state) {
+    cv::resize(image, small, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    benchmark::DoNotOptimize(small.data);
+  }
+}
+BENCHMARK(BM_DownscaleHalf)->Unit(benchmark::kMicrosecond);
+
+// Simulator rendering speed (frames per second = 1 / time).
+void BM_RenderStreetFrame(benchmark::State& state) {
+  sim::SimulatedFlight flight = sim::MakeStreetFlight(sim::StreetOptions{});
+  flight.camera = flight.camera.Scaled(state.range(0) / 752.0);
+  sim::Renderer renderer(&flight.scene, flight.camera);
+  cv::Mat image;
+  int i = 0;
+  for (auto _ : state) {
+    renderer.Render(sim::CameraPoseAt(flight, flight.trajectory((i++ % 600) / 30.0)), &image);
+    benchmark::DoNotOptimize(image.data);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RenderStreetFrame)->Arg(376)->Arg(752)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

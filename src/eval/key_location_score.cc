@@ -1,0 +1,115 @@
+#include "patrolmap/eval/key_location_score.h"
+
+#include <cmath>
+#include <limits>
+
+#include "patrolmap/core/csv.h"
+
+namespace patrolmap::eval {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+ExtremumKind KindAfter(const TruthEdge& edge) {
+  return edge.opening ? ExtremumKind::kValley : ExtremumKind::kPeak;
+}
+
+double Centre(const ExpectedSpan& span) {
+  if (std::isinf(span.start_s)) return span.end_s;
+  if (std::isinf(span.end_s)) return span.start_s;
+  return 0.5 * (span.start_s + span.end_s);
+}
+
+// The unmatched span of the detection's kind that contains it, nearest centre first; -1 when none.
+int FindSpan(const KeyLocation& node, const KeyLocationScore& score, double tolerance_s) {
+  const double t = NsToSeconds(node.timestamp_ns);
+  int best = -1;
+  for (std::size_t i = 0; i < score.spans.size(); ++i) {
+    const ExpectedSpan& span = score.spans[i];
+    if (span.kind != node.kind || score.span_match[i] >= 0) continue;
+    if (t < span.start_s - tolerance_s || t > span.end_s + tolerance_s) continue;
+    if (best < 0 || std::abs(t - Centre(span)) < std::abs(t - Centre(score.spans[best]))) best = static_cast<int>(i);
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& edges) {
+  std::vector<ExpectedSpan> spans;
+  if (edges.empty()) return spans;
+  const ExtremumKind before_first = edges.front().opening ? ExtremumKind::kPeak : ExtremumKind::kValley;
+  spans.push_back({-kInfinity, NsToSeconds(edges.front().timestamp_ns), before_first, false});
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
+    const bool alternating = edges[i].opening != edges[i + 1].opening;
+    spans.push_back({NsToSeconds(edges[i].timestamp_ns), NsToSeconds(edges[i + 1].timestamp_ns), KindAfter(edges[i]),
+                     alternating});
+  }
+  spans.push_back({NsToSeconds(edges.back().timestamp_ns), kInfinity, KindAfter(edges.back()), false});
+  return spans;
+}
+
+KeyLocationScore ScoreKeyLocations(const std::vector<KeyLocation>& detected, const std::vector<TruthEdge>& edges,
+                                   const KeyLocationScoreOptions& options) {
+  KeyLocationScore score;
+  score.spans = ExpectedSpans(edges);
+  score.span_match.assign(score.spans.size(), -1);
+  score.detected = static_cast<int>(detected.size());
+  for (std::size_t d = 0; d < detected.size(); ++d) {
+    const int span = FindSpan(detected[d], score, options.tolerance_s);
+    if (span >= 0) score.span_match[span] = static_cast<int>(d);
+    score.verdicts.push_back(span >= 0 ? Verdict::kTruePositive : Verdict::kFalsePositive);
+    ++(span >= 0 ? score.true_positives : score.false_positives);
+  }
+  for (std::size_t i = 0; i < score.spans.size(); ++i) {
+    if (!score.spans[i].required) continue;
+    ++score.expected;
+    score.missed += score.span_match[i] < 0;
+  }
+  return score;
+}
+
+Status ReadTruthEdges(const std::string& log, std::vector<TruthEdge>* edges) {
+  edges->clear();
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(log + "/groundtruth/key_locations.csv"));
+  std::vector<std::string_view> fields;
+  Status status;
+  while ((status = csv.NextRow(&fields)).ok()) {
+    if (fields.size() < 3) return csv.Error("expected at least 3 columns");
+    TruthEdge edge;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &edge.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "frame_index", &edge.frame_index));
+    if (fields[2] != "opening" && fields[2] != "closing") return csv.Error("kind must be opening or closing");
+    if (!edges->empty() && edge.timestamp_ns < edges->back().timestamp_ns) return csv.Error("timestamps go back");
+    edge.opening = fields[2] == "opening";
+    edges->push_back(edge);
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+Status ReadKeyLocationsCsv(const std::string& path, std::vector<KeyLocation>* key_locations) {
+  key_locations->clear();
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
+  std::vector<std::string_view> fields;
+  Status status = csv.NextRow(&fields);  // header
+  if (!status.ok()) return status.end_of_stream() ? csv.Error("empty file: no header") : status;
+  if (fields.empty() || fields[0] != "node") return csv.Error("header must start with 'node'");
+  while ((status = csv.NextRow(&fields)).ok()) {
+    if (fields.size() < 5) return csv.Error("expected 5 columns");
+    KeyLocation node;
+    std::int64_t index = 0;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "node", &index));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "timestamp_ns", &node.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[2], "frame_index", &node.frame_index));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3], "response", &node.response));
+    if (fields[4] != "peak" && fields[4] != "valley") return csv.Error("kind must be peak or valley");
+    node.node_index = static_cast<int>(index);
+    node.kind = fields[4] == "peak" ? ExtremumKind::kPeak : ExtremumKind::kValley;
+    key_locations->push_back(node);
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+}  // namespace patrolmap::eval

@@ -1,0 +1,95 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "patrolmap/eval/key_location_score.h"
+#include "test_util.h"
+
+namespace patrolmap::eval {
+namespace {
+
+KeyLocation Node(double t, ExtremumKind kind) {
+  KeyLocation node;
+  node.timestamp_ns = SecondsToNs(t);
+  node.kind = kind;
+  return node;
+}
+
+TruthEdge Edge(double t, bool opening) { return {SecondsToNs(t), 0, opening}; }
+
+const auto kPeak = ExtremumKind::kPeak;
+const auto kValley = ExtremumKind::kValley;
+
+TEST(ExpectedSpans, AlternatingEdgesAreRequiredOthersOptional) {
+  // opening 10, closing 20, closing 25 (depth step), opening 30.
+  const std::vector<ExpectedSpan> spans =
+      ExpectedSpans({Edge(10, true), Edge(20, false), Edge(25, false), Edge(30, true)});
+  ASSERT_EQ(spans.size(), 5u);
+  EXPECT_TRUE(std::isinf(spans[0].start_s));
+  EXPECT_EQ(spans[0].kind, kPeak);  // facing a facade before the first opening
+  EXPECT_FALSE(spans[0].required);
+  EXPECT_EQ(spans[1].kind, kValley);
+  EXPECT_TRUE(spans[1].required);
+  EXPECT_FALSE(spans[2].required);   // closing then closing
+  EXPECT_EQ(spans[3].kind, kPeak);
+  EXPECT_TRUE(spans[3].required);
+  EXPECT_FALSE(spans[4].required);
+}
+
+TEST(ScoreKeyLocations, CountsTrueFalseAndMissed) {
+  const std::vector<TruthEdge> edges = {Edge(10, true), Edge(20, false), Edge(30, true), Edge(40, false)};
+  // Required: valley [10,20], peak [20,30], valley [30,40].
+  const std::vector<KeyLocation> detected = {
+      Node(15, kValley),   // true
+      Node(16, kValley),   // second in the same span: false
+      Node(25, kValley),   // wrong kind for a facade: false
+      Node(40.8, kValley), // inside the tolerance of [30, 40]: true
+      Node(50, kPeak),     // optional span after the last edge: true, never missed
+  };
+  const KeyLocationScore score = ScoreKeyLocations(detected, edges, {1.0});
+  EXPECT_EQ(score.detected, 5);
+  EXPECT_EQ(score.expected, 3);
+  EXPECT_EQ(score.true_positives, 3);
+  EXPECT_EQ(score.false_positives, 2);
+  EXPECT_EQ(score.missed, 1);  // the peak on [20, 30]
+  EXPECT_DOUBLE_EQ(score.precision(), 0.6);
+  EXPECT_NEAR(score.recall(), 2.0 / 3.0, 1e-12);
+  EXPECT_EQ(score.verdicts[1], Verdict::kFalsePositive);
+  EXPECT_EQ(score.verdicts[2], Verdict::kFalsePositive);
+}
+
+TEST(ScoreKeyLocations, ToleranceDecidesAtTheSpanBorder) {
+  const std::vector<TruthEdge> edges = {Edge(10, true), Edge(20, false)};
+  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {1.0}).true_positives, 0);
+  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {2.0}).true_positives, 1);
+}
+
+TEST(ScoreKeyLocations, NothingDetectedOnNoTruthIsPerfect) {
+  const KeyLocationScore score = ScoreKeyLocations({}, {}, {});
+  EXPECT_EQ(score.expected, 0);
+  EXPECT_DOUBLE_EQ(score.precision(), 1.0);
+  EXPECT_DOUBLE_EQ(score.recall(), 1.0);
+}
+
+TEST(ReadFiles, RunAndTruthTablesRoundTripAndBadLinesAreNamed) {
+  testing::TempDir dir;
+  testing::WriteText(dir / "run/key_locations.csv",
+                     "node,timestamp_ns,frame_index,response,kind\n0,1500000000,45,0.031,valley\n");
+  std::vector<KeyLocation> nodes;
+  ASSERT_TRUE(ReadKeyLocationsCsv(dir / "run/key_locations.csv", &nodes).ok());
+  ASSERT_EQ(nodes.size(), 1u);
+  EXPECT_EQ(nodes[0].frame_index, 45);
+  EXPECT_EQ(nodes[0].kind, kValley);
+  testing::WriteText(dir / "run/key_locations.csv", "node,timestamp_ns,frame_index,response,kind\n0,15,45,0.1,top\n");
+  const Status status = ReadKeyLocationsCsv(dir / "run/key_locations.csv", &nodes);
+  EXPECT_NE(status.message().find("key_locations.csv:2: kind must be peak or valley"), std::string::npos);
+  testing::WriteText(dir / "log/groundtruth/key_locations.csv", "#t,frame,kind\n100,3,opening\n200,6,closing\n");
+  std::vector<TruthEdge> edges;
+  ASSERT_TRUE(ReadTruthEdges(dir / "log", &edges).ok());
+  ASSERT_EQ(edges.size(), 2u);
+  EXPECT_TRUE(edges[0].opening);
+  EXPECT_EQ(ReadTruthEdges(dir / "nolog", &edges).code(), StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace patrolmap::eval
