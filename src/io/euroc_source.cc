@@ -27,25 +27,25 @@ Status CheckIncreasing(const CsvReader& csv, TimestampNs previous, TimestampNs c
                    " is not after the previous one (" + std::to_string(previous) + ")");
 }
 
-Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
+// Reads a table whose first column is a strictly increasing timestamp [ns];
+// `parse_row(csv, fields, &row)` fills the other columns of each row.
+template <typename Row, typename ParseRow>
+Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow parse_row, std::vector<Row>* rows) {
   CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(log + "/cam0/data.csv"));
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
   std::vector<std::string_view> fields;
   Status status;
   TimestampNs previous = std::numeric_limits<TimestampNs>::min();
   while ((status = csv.NextRow(&fields)).ok()) {
-    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 2));
-    ImageEntry entry;
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &entry.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, entry.timestamp_ns));
-    if (fields[1].empty()) return csv.Error("empty file name");
-    entry.path = log + "/cam0/data/" + std::string(fields[1]);
-    previous = entry.timestamp_ns;
-    entries->push_back(std::move(entry));
+    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, columns));
+    Row row;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &row.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, row.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(parse_row(csv, fields, &row));
+    previous = row.timestamp_ns;
+    rows->push_back(std::move(row));
   }
-  if (!status.end_of_stream()) return status;
-  if (entries->empty()) return Status::DataLoss(csv.path() + ": no frames listed");
-  return Status::Ok();
+  return status.end_of_stream() ? Status::Ok() : status;
 }
 
 Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields,
@@ -56,44 +56,35 @@ Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fi
   return Status::Ok();
 }
 
+Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
+  const std::string path = log + "/cam0/data.csv";
+  const auto parse = [&log](const CsvReader& csv, const std::vector<std::string_view>& fields, ImageEntry* entry) {
+    if (fields[1].empty()) return csv.Error("empty file name");
+    entry->path = log + "/cam0/data/" + std::string(fields[1]);
+    return Status::Ok();
+  };
+  PATROLMAP_RETURN_IF_ERROR(ReadTimedTable(path, 2, parse, entries));
+  if (entries->empty()) return Status::DataLoss(path + ": no frames listed");
+  return Status::Ok();
+}
+
 Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples) {
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
-  std::vector<std::string_view> fields;
-  Status status;
-  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
-  while ((status = csv.NextRow(&fields)).ok()) {
-    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 7));
-    ImuSample sample;
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &sample.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, sample.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample.gyro));
-    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample.accel));
-    previous = sample.timestamp_ns;
-    samples->push_back(sample);
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, ImuSample* sample) {
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample->gyro));
+    return ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample->accel);
+  };
+  return ReadTimedTable(path, 7, parse, samples);
 }
 
 // EuRoC ground-truth state: timestamp, position (3), quaternion (4), velocity (3), ...
 Status ReadSpeedTable(const std::string& path, std::vector<SpeedSample>* samples) {
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
-  std::vector<std::string_view> fields;
-  Status status;
-  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
-  while ((status = csv.NextRow(&fields)).ok()) {
-    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, 11));
-    SpeedSample sample;
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, SpeedSample* sample) {
     Eigen::Vector3d velocity;
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &sample.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, sample.timestamp_ns));
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 8, "v_RS_R [m s^-1]", &velocity));
-    sample.speed_mps = velocity.norm();
-    previous = sample.timestamp_ns;
-    samples->push_back(sample);
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
+    sample->speed_mps = velocity.norm();
+    return Status::Ok();
+  };
+  return ReadTimedTable(path, 11, parse, samples);
 }
 
 Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* key,
