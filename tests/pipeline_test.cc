@@ -73,15 +73,22 @@ TEST(Config, PartialFileKeepsOtherDefaults) {
   EXPECT_EQ(config.flow.smoothing.window, 30);
 }
 
-// Runs the detector over a simulated flight rendered in memory (only the frames it processes).
-std::vector<KeyLocation> DetectOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
-  flow::KeyLocationDetector detector(options, {flight.camera, std::nullopt});
+// Runs the detector over a simulated flight rendered in memory (only the frames it processes), with the
+// flight's IMU samples and camera-IMU rotation as a log would carry them.
+flow::DetectorOutput RunOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
+  const Eigen::Matrix3d camera_from_imu = sim::BodyFromCamera(flight.mount_angle).transpose();
+  flow::KeyLocationDetector detector(options, {flight.camera, camera_from_imu});
   sim::Renderer renderer(&flight.scene, flight.camera);
+  const std::vector<ImuSample> imu = sim::ImuSamples(flight);
+  std::size_t next_imu = 0;
   flow::DetectorOutput output;
   Frame frame;
   for (int i = 0; i < sim::FrameCount(flight); ++i) {
     frame.index = i;
     frame.timestamp_ns = sim::FrameTimestamp(flight, i);
+    frame.imu.clear();
+    while (next_imu < imu.size() && imu[next_imu].timestamp_ns <= frame.timestamp_ns) frame.imu.push_back(imu[next_imu++]);
+    frame.speed_mps = flight.trajectory(i / flight.frame_rate_hz).velocity.norm();
     frame.image.release();
     if (detector.NeedsImage()) {
       renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(i / flight.frame_rate_hz)), &frame.image);
@@ -89,7 +96,20 @@ std::vector<KeyLocation> DetectOnFlight(const sim::SimulatedFlight& flight, cons
     detector.Process(frame, &output);
   }
   detector.Finish(&output);
-  return output.key_locations;
+  return output;
+}
+
+std::vector<KeyLocation> DetectOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
+  return RunOnFlight(flight, options).key_locations;
+}
+
+double MeanRawResponse(const flow::DetectorOutput& output) {
+  double sum = 0.0;
+  int count = 0;
+  for (const FlowSample& sample : output.samples) {
+    if (!std::isnan(sample.raw_response)) sum += sample.raw_response, ++count;
+  }
+  return sum / count;
 }
 
 // The street has openings (gaps) at [16, 28] and [44, 56] m; the camera flies from 8 m at 2.5 m/s, so the
@@ -124,6 +144,55 @@ TEST(DetectEndToEnd, CausalSmoothingFindsTheSameNodesLater) {
     EXPECT_NEAR(NsToSeconds(nodes[i].timestamp_ns), expected_s[i] + lag_s, 1.0) << i;
     EXPECT_EQ(nodes[i].kind, i == 1 ? ExtremumKind::kPeak : ExtremumKind::kValley) << i;
   }
+}
+
+TEST(DetectEndToEnd, GyroDerotationRemovesTheFlowOfAYawingHover) {
+  sim::StreetOptions street;
+  street.static_camera = true;
+  street.yaw_wobble_deg = 15.0;
+  street.yaw_period_s = 4.0;
+  const sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
+  flow::KeyLocationOptions options;
+  const double derotated = MeanRawResponse(RunOnFlight(flight, options));
+  options.response.derotate_with_imu = false;
+  const double raw = MeanRawResponse(RunOnFlight(flight, options));
+  EXPECT_GT(raw, 0.1);              // rotation alone: ~0.22 image widths per second
+  EXPECT_LT(derotated, 0.05 * raw);  // measured: 3 % of it remains
+}
+
+// A slow heading swing (+-15 degrees, 12 s period) passes the smoother and shifts the response; the
+// gyro-derotated flow keeps all three nodes, the raw flow loses one.
+TEST(DetectEndToEnd, GyroDerotationRestoresNodesUnderYawWobble) {
+  sim::StreetOptions street;
+  street.yaw_wobble_deg = 15.0;
+  const sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
+  flow::KeyLocationOptions options;
+  const std::vector<KeyLocation> derotated = DetectOnFlight(flight, options);
+  ASSERT_EQ(derotated.size(), 3u);
+  const double expected_s[] = {5.6, 11.2, 16.8};
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(NsToSeconds(derotated[i].timestamp_ns), expected_s[i], 1.0) << i;
+  options.response.derotate_with_imu = false;
+  const std::vector<KeyLocation> raw = DetectOnFlight(flight, options);
+  EXPECT_NE(raw.size(), 3u);
+}
+
+// Speed swinging by +-50 % over 12 s moves the response as much as the buildings do; normalising by the
+// known speed gives back exactly the three nodes of the street.
+TEST(DetectEndToEnd, SpeedNormalisationRemovesNodesCausedBySpeedChanges) {
+  sim::StreetOptions street;
+  street.walls = 4;
+  street.speed_variation = 0.5;
+  const sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
+  flow::KeyLocationOptions options;
+  options.response.normalise_by_speed = true;
+  options.response.reference_speed_mps = 2.5;
+  const std::vector<KeyLocation> normalised = DetectOnFlight(flight, options);
+  ASSERT_EQ(normalised.size(), 5u);  // valley, peak, valley, peak, valley
+  for (std::size_t i = 0; i < normalised.size(); ++i) {
+    EXPECT_EQ(normalised[i].kind, i % 2 == 0 ? ExtremumKind::kValley : ExtremumKind::kPeak) << i;
+  }
+  options.response.normalise_by_speed = false;
+  EXPECT_NE(DetectOnFlight(flight, options).size(), 5u);
 }
 
 TEST(DetectEndToEnd, HoveringCameraGivesNoKeyLocation) {

@@ -19,15 +19,6 @@ Eigen::Matrix3d WorldFromBody(double heading) {
   return Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-// Rotation taking camera-frame vectors into the body frame, for a mount angle.
-Eigen::Matrix3d BodyFromCamera(double mount_angle) {
-  Eigen::Matrix3d rotation;
-  rotation.col(0) = Eigen::Vector3d(std::sin(mount_angle), -std::cos(mount_angle), 0.0);
-  rotation.col(1) = Eigen::Vector3d(0.0, 0.0, -1.0);
-  rotation.col(2) = Eigen::Vector3d(std::cos(mount_angle), std::sin(mount_angle), 0.0);
-  return rotation;
-}
-
 std::string MatrixYaml(const Eigen::Matrix3d& rotation) {
   std::ostringstream out;
   out.precision(12);
@@ -67,14 +58,9 @@ std::string ImuTable(const SimulatedFlight& flight) {
   out.precision(9);
   out << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
          "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
-  const int samples = static_cast<int>(flight.duration_s * flight.imu_rate_hz) + 1;
-  for (int i = 0; i < samples; ++i) {
-    const double t = i / flight.imu_rate_hz;
-    const PlatformState state = flight.trajectory(t);
-    const Eigen::Vector3d accel =
-        WorldFromBody(state.heading).transpose() * (state.acceleration + Eigen::Vector3d(0, 0, kGravity));
-    out << SecondsToNs(t) << ",0,0," << state.yaw_rate << "," << accel.x() << "," << accel.y() << ","
-        << accel.z() << "\n";
+  for (const ImuSample& sample : ImuSamples(flight)) {
+    out << sample.timestamp_ns << "," << sample.gyro.x() << "," << sample.gyro.y() << "," << sample.gyro.z() << ","
+        << sample.accel.x() << "," << sample.accel.y() << "," << sample.accel.z() << "\n";
   }
   return out.str();
 }
@@ -132,6 +118,28 @@ double AxisDepth(Renderer* renderer, const CameraPose& pose, int centre_column, 
 }
 
 }  // namespace
+
+Eigen::Matrix3d BodyFromCamera(double mount_angle) {
+  Eigen::Matrix3d rotation;
+  rotation.col(0) = Eigen::Vector3d(std::sin(mount_angle), -std::cos(mount_angle), 0.0);
+  rotation.col(1) = Eigen::Vector3d(0.0, 0.0, -1.0);
+  rotation.col(2) = Eigen::Vector3d(std::cos(mount_angle), std::sin(mount_angle), 0.0);
+  return rotation;
+}
+
+std::vector<ImuSample> ImuSamples(const SimulatedFlight& flight) {
+  const int count = static_cast<int>(flight.duration_s * flight.imu_rate_hz) + 1;
+  std::vector<ImuSample> samples(count);
+  for (int i = 0; i < count; ++i) {
+    const double t = i / flight.imu_rate_hz;
+    const PlatformState state = flight.trajectory(t);
+    samples[i].timestamp_ns = SecondsToNs(t);
+    samples[i].gyro = Eigen::Vector3d(0.0, 0.0, state.yaw_rate);  // level flight: yaw only
+    samples[i].accel =
+        WorldFromBody(state.heading).transpose() * (state.acceleration + Eigen::Vector3d(0, 0, kGravity));
+  }
+  return samples;
+}
 
 CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& state) {
   return {state.position, state.heading + flight.mount_angle};

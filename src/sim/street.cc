@@ -47,6 +47,26 @@ std::vector<Facade> LayFacades(const StreetOptions& options) {
   return facades;
 }
 
+// Straight flight along +x at `speed` on average, with the optional yaw and speed swings.
+std::function<PlatformState(double)> StreetTrajectory(double start, double speed, const StreetOptions& options) {
+  const double yaw_period = options.yaw_period_s, speed_period = options.speed_period_s;
+  const double yaw_amplitude = options.yaw_wobble_deg * M_PI / 180.0;
+  const double variation = options.speed_variation;
+  const double altitude = options.altitude_m;
+  return [=](double t) {
+    const double yaw_phase = 2.0 * M_PI * t / yaw_period, speed_phase = 2.0 * M_PI * t / speed_period;
+    PlatformState state;
+    // x(t) integrates speed * (1 + variation * sin(speed_phase)).
+    const double x = speed * (t + variation * speed_period / (2.0 * M_PI) * (1.0 - std::cos(speed_phase)));
+    state.position = Eigen::Vector3d(start + x, 0.0, altitude);
+    state.velocity = Eigen::Vector3d(speed * (1.0 + variation * std::sin(speed_phase)), 0.0, 0.0);
+    state.acceleration = Eigen::Vector3d(speed * variation * 2.0 * M_PI / speed_period * std::cos(speed_phase), 0.0, 0.0);
+    state.heading = yaw_amplitude * std::sin(yaw_phase);
+    state.yaw_rate = yaw_amplitude * 2.0 * M_PI / yaw_period * std::cos(yaw_phase);
+    return state;
+  };
+}
+
 }  // namespace
 
 SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen::Vector2d>* gaps) {
@@ -74,13 +94,7 @@ SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen
   const double length = 0.5 * (facades.back().x0 + facades.back().x1) - start;
   const double speed = options.static_camera ? 0.0 : options.speed_mps;
   flight.duration_s = options.static_camera ? 10.0 : length / options.speed_mps;
-  const double altitude = options.altitude_m;
-  flight.trajectory = [start, speed, altitude](double t) {
-    PlatformState state;
-    state.position = Eigen::Vector3d(start + speed * t, 0.0, altitude);
-    state.velocity = Eigen::Vector3d(speed, 0.0, 0.0);
-    return state;
-  };
+  flight.trajectory = StreetTrajectory(start, speed, options);
   return flight;
 }
 

@@ -21,6 +21,10 @@ struct SimulateArguments {
   int walls = 3;
   double mount_deg = 90.0;
   bool irregular = false;
+  double yaw_wobble_deg = 0.0;
+  double speed_variation = 0.0;
+  double yaw_period_s = 12.0;
+  double speed_period_s = 12.0;
 };
 
 int RunSimulate(const SimulateArguments& arguments) {
@@ -31,6 +35,10 @@ int RunSimulate(const SimulateArguments& arguments) {
   street.walls = arguments.walls;
   street.mount_angle_deg = arguments.mount_deg;
   street.irregular = arguments.irregular;
+  street.yaw_wobble_deg = arguments.yaw_wobble_deg;
+  street.speed_variation = arguments.speed_variation;
+  street.yaw_period_s = arguments.yaw_period_s;
+  street.speed_period_s = arguments.speed_period_s;
   sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
   flight.flight_id = arguments.route + "-" + std::to_string(arguments.seed);
   Status status;
@@ -64,6 +72,19 @@ Command AddSimulateCommand(CLI::App* app) {
       ->check(CLI::Range(20.0, 90.0))
       ->capture_default_str();
   app->add_flag("--irregular", arguments->irregular, "draw facade lengths, gaps, depths and heights from the seed");
+  app->add_option("--yaw-wobble", arguments->yaw_wobble_deg, "heading swing amplitude [deg]")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
+  app->add_option("--speed-variation", arguments->speed_variation,
+                  "speed swing as a fraction of --speed")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  app->add_option("--yaw-period", arguments->yaw_period_s, "period of the heading swing [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  app->add_option("--speed-period", arguments->speed_period_s, "period of the speed swing [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
   app->add_flag("--static", arguments->static_camera, "hover in place for 10 s (no ego-motion)");
   return [arguments] { return RunSimulate(*arguments); };
 }

@@ -51,6 +51,12 @@ struct TruthKeyLocation {
 // The frames at which a wall end visible on the optical axis crosses it.
 std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight);
 
+// Gyro and accelerometer samples at imu_rate_hz over the whole flight, in the body frame.
+std::vector<ImuSample> ImuSamples(const SimulatedFlight& flight);
+
+// Rotation taking camera-frame vectors into the body frame for a mount angle [rad].
+Eigen::Matrix3d BodyFromCamera(double mount_angle);
+
 int FrameCount(const SimulatedFlight& flight);
 TimestampNs FrameTimestamp(const SimulatedFlight& flight, int frame);
 
@@ -82,6 +88,11 @@ struct StreetOptions {
   // Draw each facade's length (0.6-1.5x), each gap (0.5-1.3x), each near depth
   // (0.8-1.6x) and height (0.7-1.3x) from the seed instead of using them as given.
   bool irregular = false;
+  // Disturbances a hand-flown UAV shows (paper 002 §III-A names both compensations):
+  double yaw_wobble_deg = 0.0;     // heading swings by this amplitude ... [deg]
+  double yaw_period_s = 12.0;      // ... with this period [s]
+  double speed_variation = 0.0;    // speed swings by this fraction of speed_mps ...
+  double speed_period_s = 12.0;    // ... with this period [s]
   std::uint32_t seed = 1;
 };
 
