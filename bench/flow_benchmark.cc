@@ -38,6 +38,7 @@ void BM_FlowStagePerProcessedFrame(benchmark::State& state) {
   flow::KeyLocationOptions options;
   options.frames.step = 1;     // the frames given are already the processed ones
   options.frames.scale = 1.0;  // and already at processing size
+  options.tracker.max_forward_backward_px = static_cast<double>(state.range(2));
   flow::KeyLocationDetector detector(options, {});
   flow::DetectorOutput output;
   Frame frame;
@@ -52,11 +53,14 @@ void BM_FlowStagePerProcessedFrame(benchmark::State& state) {
     detector.Process(frame, &output);
     benchmark::DoNotOptimize(output.samples.data());
   }
-  state.SetLabel(std::to_string(state.range(0)) + "x" + std::to_string(state.range(1)));
+  state.SetLabel(std::to_string(state.range(0)) + "x" + std::to_string(state.range(1)) +
+                 (state.range(2) > 0 ? " forward-backward check" : ""));
 }
 BENCHMARK(BM_FlowStagePerProcessedFrame)
-    ->Args({376, 240})
-    ->Args({752, 480})
+    ->Args({376, 240, 0})
+    ->Args({752, 480, 0})
+    ->Args({376, 240, 1})
+    ->Args({752, 480, 1})
     ->Unit(benchmark::kMillisecond)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);

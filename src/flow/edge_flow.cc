@@ -112,6 +112,7 @@ void EdgeFlowTracker::Track(const cv::Mat& image, std::vector<FlowVector>* vecto
     cv::calcOpticalFlowPyrLK(previous_pyramid_, current_pyramid_, previous_points_, tracked_points_,
                              track_status_, track_errors_, window, tracker_options_.pyramid_levels, criteria,
                              predict ? cv::OPTFLOW_USE_INITIAL_FLOW : 0, tracker_options_.min_eigen_threshold);
+    if (tracker_options_.max_forward_backward_px > 0.0) CheckForwardBackward(criteria);
     for (std::size_t i = 0; i < previous_points_.size(); ++i) {
       if (track_status_[i]) vectors->push_back({previous_points_[i], tracked_points_[i] - previous_points_[i]});
     }
@@ -120,6 +121,21 @@ void EdgeFlowTracker::Track(const cv::Mat& image, std::vector<FlowVector>* vecto
   cv::Canny(image, edges_, edge_options_.canny_low, edge_options_.canny_high);
   SelectEdgePoints(edges_, edge_options_, &previous_points_);
   std::swap(previous_pyramid_, current_pyramid_);
+}
+
+// Tracks the found points back into the previous image and clears the status
+// of those that do not return close to where they started.
+void EdgeFlowTracker::CheckForwardBackward(const cv::TermCriteria& criteria) {
+  const cv::Size window(tracker_options_.window_size, tracker_options_.window_size);
+  back_points_ = previous_points_;  // the start is the natural first guess
+  cv::calcOpticalFlowPyrLK(current_pyramid_, previous_pyramid_, tracked_points_, back_points_, back_status_,
+                           track_errors_, window, tracker_options_.pyramid_levels, criteria,
+                           cv::OPTFLOW_USE_INITIAL_FLOW, tracker_options_.min_eigen_threshold);
+  const double limit = tracker_options_.max_forward_backward_px;
+  for (std::size_t i = 0; i < previous_points_.size(); ++i) {
+    const cv::Point2f miss = back_points_[i] - previous_points_[i];
+    if (!back_status_[i] || miss.dot(miss) > limit * limit) track_status_[i] = 0;
+  }
 }
 
 Eigen::Matrix3d IntegrateGyro(const std::vector<ImuSample>& samples, TimestampNs start_ns,

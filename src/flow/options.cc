@@ -30,6 +30,9 @@ bool CheckTracker(const TrackerOptions& tracker, std::string* error) {
   if (tracker.max_iterations < 1) return Fail(error, "flow.tracker.max_iterations must be at least 1");
   if (!(tracker.epsilon > 0.0)) return Fail(error, "flow.tracker.epsilon must be positive");
   if (!(tracker.min_eigen_threshold >= 0.0)) return Fail(error, "flow.tracker.min_eigen_threshold must not be negative");
+  if (!(tracker.max_forward_backward_px >= 0.0)) {
+    return Fail(error, "flow.tracker.max_forward_backward_px must not be negative");
+  }
   return true;
 }
 

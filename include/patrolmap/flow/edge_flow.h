@@ -35,6 +35,7 @@ class EdgeFlowTracker {
   int CellOf(const cv::Point2f& point, const cv::Size& size) const;
   void UpdatePrediction(const std::vector<FlowVector>& vectors, const cv::Size& size);
   void PredictPositions(const cv::Size& size);
+  void CheckForwardBackward(const cv::TermCriteria& criteria);
 
   EdgeOptions edge_options_;
   TrackerOptions tracker_options_;
@@ -43,6 +44,8 @@ class EdgeFlowTracker {
   std::vector<cv::Point2f> previous_points_;
   std::vector<cv::Point2f> tracked_points_;
   std::vector<unsigned char> track_status_;
+  std::vector<cv::Point2f> back_points_;
+  std::vector<unsigned char> back_status_;
   std::vector<float> track_errors_;
   cv::Mat edges_;
   int last_point_count_ = 0;

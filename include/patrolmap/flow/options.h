@@ -35,6 +35,10 @@ struct TrackerOptions {
   // previous processed frame (else from zero). Keeps LK from locking onto a
   // period of repetitive texture (brick, windows) when motion is large.
   bool predict_from_previous = true;
+  // Track each point back from where it was found and drop it when it lands
+  // farther than this from its start [pixels]; 0 turns the check off (it costs
+  // a second LK pass).
+  double max_forward_backward_px = 0.0;
 };
 
 // Hysteresis voting in the polar (theta, r) domain (equations 1-2, Table I).

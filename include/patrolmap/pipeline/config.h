@@ -37,6 +37,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("flow.tracker.epsilon", &flow.tracker.epsilon);
   visitor->Field("flow.tracker.min_eigen_threshold", &flow.tracker.min_eigen_threshold);
   visitor->Field("flow.tracker.predict_from_previous", &flow.tracker.predict_from_previous);
+  visitor->Field("flow.tracker.max_forward_backward_px", &flow.tracker.max_forward_backward_px);
   visitor->Field("flow.voting.theta_bins", &flow.voting.theta_bins);
   visitor->Field("flow.voting.r_bin_fraction", &flow.voting.r_bin_fraction);
   visitor->Field("flow.voting.accept", &flow.voting.accept);
