@@ -20,20 +20,37 @@ TruthEdge Edge(double t, bool opening) { return {SecondsToNs(t), 0, opening}; }
 const auto kPeak = ExtremumKind::kPeak;
 const auto kValley = ExtremumKind::kValley;
 
-TEST(ExpectedSpans, AlternatingEdgesAreRequiredOthersOptional) {
-  // opening 10, closing 20, closing 25 (depth step), opening 30.
-  const std::vector<ExpectedSpan> spans =
-      ExpectedSpans({Edge(10, true), Edge(20, false), Edge(25, false), Edge(30, true)});
-  ASSERT_EQ(spans.size(), 5u);
+TEST(ExpectedSpans, InnerSpansAreRequiredOpenEndsOptional) {
+  const std::vector<ExpectedSpan> spans = ExpectedSpans({Edge(10, true), Edge(20, false), Edge(30, true)}, 2.0);
+  ASSERT_EQ(spans.size(), 4u);
   EXPECT_TRUE(std::isinf(spans[0].start_s));
   EXPECT_EQ(spans[0].kind, kPeak);  // facing a facade before the first opening
   EXPECT_FALSE(spans[0].required);
   EXPECT_EQ(spans[1].kind, kValley);
   EXPECT_TRUE(spans[1].required);
-  EXPECT_FALSE(spans[2].required);   // closing then closing
-  EXPECT_EQ(spans[3].kind, kPeak);
-  EXPECT_TRUE(spans[3].required);
-  EXPECT_FALSE(spans[4].required);
+  EXPECT_EQ(spans[2].kind, kPeak);
+  EXPECT_TRUE(spans[2].required);
+  EXPECT_FALSE(spans[3].required);
+}
+
+TEST(ExpectedSpans, RunsOfOneKindCountOnce) {
+  // opening 10, closing 20, closing 25 (a second step nearer), opening 30.
+  const std::vector<ExpectedSpan> spans =
+      ExpectedSpans({Edge(10, true), Edge(20, false), Edge(25, false), Edge(30, true)}, 2.0);
+  ASSERT_EQ(spans.size(), 4u);
+  EXPECT_DOUBLE_EQ(spans[2].start_s, 20.0);
+  EXPECT_DOUBLE_EQ(spans[2].end_s, 30.0);
+  EXPECT_EQ(spans[2].kind, kPeak);
+}
+
+TEST(ExpectedSpans, ASlitShorterThanTheMinimumJoinsItsNeighbours) {
+  // Facade, a 1 s slit at 20-21 s, facade, a passage 30-40 s.
+  const std::vector<TruthEdge> edges = {Edge(5, false), Edge(20, true), Edge(21, false), Edge(30, true), Edge(40, false)};
+  const std::vector<ExpectedSpan> spans = ExpectedSpans(edges, 2.0);
+  ASSERT_EQ(spans.size(), 4u);
+  EXPECT_DOUBLE_EQ(spans[1].start_s, 5.0);  // one facade from 5 to 30 s
+  EXPECT_DOUBLE_EQ(spans[1].end_s, 30.0);
+  EXPECT_EQ(ExpectedSpans(edges, 0.5).size(), 6u);  // with a lower minimum the slit stays
 }
 
 TEST(ScoreKeyLocations, CountsTrueFalseAndMissed) {
@@ -46,7 +63,7 @@ TEST(ScoreKeyLocations, CountsTrueFalseAndMissed) {
       Node(40.8, kValley), // inside the tolerance of [30, 40]: true
       Node(50, kPeak),     // optional span after the last edge: true, never missed
   };
-  const KeyLocationScore score = ScoreKeyLocations(detected, edges, {1.0});
+  const KeyLocationScore score = ScoreKeyLocations(detected, edges, {1.0, 2.0});
   EXPECT_EQ(score.detected, 5);
   EXPECT_EQ(score.expected, 3);
   EXPECT_EQ(score.true_positives, 3);
@@ -60,8 +77,8 @@ TEST(ScoreKeyLocations, CountsTrueFalseAndMissed) {
 
 TEST(ScoreKeyLocations, ToleranceDecidesAtTheSpanBorder) {
   const std::vector<TruthEdge> edges = {Edge(10, true), Edge(20, false)};
-  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {1.0}).true_positives, 0);
-  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {2.0}).true_positives, 1);
+  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {1.0, 2.0}).true_positives, 0);
+  EXPECT_EQ(ScoreKeyLocations({Node(21.5, kValley)}, edges, {2.0, 2.0}).true_positives, 1);
 }
 
 TEST(ScoreKeyLocations, NothingDetectedOnNoTruthIsPerfect) {

@@ -33,17 +33,41 @@ int FindSpan(const KeyLocation& node, const KeyLocationScore& score, double tole
   return best;
 }
 
+// Keeps the first edge of each run of one kind.
+std::vector<TruthEdge> CollapseRuns(const std::vector<TruthEdge>& edges) {
+  std::vector<TruthEdge> kept;
+  for (const TruthEdge& edge : edges) {
+    if (kept.empty() || kept.back().opening != edge.opening) kept.push_back(edge);
+  }
+  return kept;
+}
+
+// Removes the two edges around the shortest inner span under min_span_s, until none is left.
+std::vector<TruthEdge> MergeShortSpans(std::vector<TruthEdge> edges, double min_span_s) {
+  while (edges.size() >= 2) {
+    std::size_t shortest = 0;
+    for (std::size_t i = 1; i + 1 < edges.size(); ++i) {
+      if (edges[i + 1].timestamp_ns - edges[i].timestamp_ns < edges[shortest + 1].timestamp_ns - edges[shortest].timestamp_ns) {
+        shortest = i;
+      }
+    }
+    if (NsToSeconds(edges[shortest + 1].timestamp_ns - edges[shortest].timestamp_ns) >= min_span_s) break;
+    edges.erase(edges.begin() + shortest, edges.begin() + shortest + 2);
+  }
+  return edges;
+}
+
 }  // namespace
 
-std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& edges) {
+std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& raw_edges, double min_span_s) {
   std::vector<ExpectedSpan> spans;
+  const std::vector<TruthEdge> edges = MergeShortSpans(CollapseRuns(raw_edges), min_span_s);
   if (edges.empty()) return spans;
   const ExtremumKind before_first = edges.front().opening ? ExtremumKind::kPeak : ExtremumKind::kValley;
   spans.push_back({-kInfinity, NsToSeconds(edges.front().timestamp_ns), before_first, false});
   for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
-    const bool alternating = edges[i].opening != edges[i + 1].opening;
     spans.push_back({NsToSeconds(edges[i].timestamp_ns), NsToSeconds(edges[i + 1].timestamp_ns), KindAfter(edges[i]),
-                     alternating});
+                     true});
   }
   spans.push_back({NsToSeconds(edges.back().timestamp_ns), kInfinity, KindAfter(edges.back()), false});
   return spans;
@@ -52,7 +76,7 @@ std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& edges) {
 KeyLocationScore ScoreKeyLocations(const std::vector<KeyLocation>& detected, const std::vector<TruthEdge>& edges,
                                    const KeyLocationScoreOptions& options) {
   KeyLocationScore score;
-  score.spans = ExpectedSpans(edges);
+  score.spans = ExpectedSpans(edges, options.min_span_s);
   score.span_match.assign(score.spans.size(), -1);
   score.detected = static_cast<int>(detected.size());
   for (std::size_t d = 0; d < detected.size(); ++d) {

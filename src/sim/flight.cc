@@ -13,7 +13,10 @@ namespace patrolmap::sim {
 namespace {
 
 constexpr double kGravity = 9.81;
-constexpr double kTruthMaxDepth = 60.0;  // edges farther than this along the axis are not key locations [m]
+// A view-axis depth jump is a key location when the inverse depth (what optical
+// flow measures) changes by at least this much [1/m]: 6 m -> 48 m is one,
+// 22 m -> 35 m behind a gap is not.
+constexpr double kMinInverseDepthChange = 0.05;
 
 Eigen::Matrix3d WorldFromBody(double heading) {
   return Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -93,14 +96,14 @@ std::string TruthTable(const std::vector<TruthKeyLocation>& truth) {
 
 Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, const ProgressCallback& progress) {
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/cam0/data"));
-  Renderer renderer(&flight.scene, flight.camera);
+  Renderer renderer(&flight.scene, flight.camera, flight.lighting);
   std::ostringstream table;
   table << "#timestamp [ns],filename\n";
   cv::Mat image;
   const int frames = FrameCount(flight);
   for (int frame = 0; frame < frames; ++frame) {
     const TimestampNs timestamp = FrameTimestamp(flight, frame);
-    renderer.Render(CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz)), &image);
+    renderer.Render(CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz)), &image, frame);
     const std::string name = std::to_string(timestamp) + ".png";
     if (!cv::imwrite(folder + "/cam0/data/" + name, image)) {
       return Status::IoError(folder + "/cam0/data/" + name + ": cannot write image");
@@ -163,9 +166,7 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
   for (int frame = 1; frame < FrameCount(flight); ++frame) {
     const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
     const double depth = AxisDepth(&renderer, pose, centre, &depths);
-    const bool jump = std::abs(std::min(depth, kTruthMaxDepth) - std::min(previous_depth, kTruthMaxDepth)) >
-                      0.25 * std::min(depth, previous_depth);
-    if (jump && std::min(depth, previous_depth) < kTruthMaxDepth) {
+    if (std::abs(1.0 / depth - 1.0 / previous_depth) >= kMinInverseDepthChange) {
       TruthKeyLocation event;
       event.timestamp_ns = FrameTimestamp(flight, frame);
       event.frame_index = frame;

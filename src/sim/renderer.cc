@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/core.hpp>
+
 #include "patrolmap/core/status.h"
 
 namespace patrolmap::sim {
@@ -32,6 +34,19 @@ std::uint8_t Bilinear(const cv::Mat& image, double u, double v, bool wrap) {
 
 }  // namespace
 
+Lighting DrawLighting(std::uint32_t seed, int flight) {
+  cv::RNG rng(seed * 7368787u + static_cast<std::uint32_t>(flight) * 9973u + 3u);
+  Lighting lighting;
+  lighting.gain = rng.uniform(0.7, 1.3);
+  lighting.gamma = rng.uniform(0.8, 1.25);
+  lighting.sun_azimuth = rng.uniform(0.0, 2 * M_PI);
+  lighting.sun_elevation = rng.uniform(20.0, 60.0) * M_PI / 180.0;
+  lighting.ambient = 0.55;
+  lighting.noise_sigma = 2.0;
+  lighting.noise_seed = seed * 31u + static_cast<std::uint32_t>(flight);
+  return lighting;
+}
+
 Eigen::Matrix3d WorldFromCameraRotation(double yaw) {
   const Eigen::Vector3d forward(std::cos(yaw), std::sin(yaw), 0.0);
   const Eigen::Vector3d right(std::sin(yaw), -std::cos(yaw), 0.0);
@@ -57,11 +72,37 @@ std::uint8_t SampleTexture(const Texture& texture, double u, double v, double fo
   return Bilinear(texture.levels[level], u * scale, v * scale, wrap);
 }
 
-Renderer::Renderer(const Scene* scene, const CameraIntrinsics& camera) : scene_(scene), camera_(camera) {
+Renderer::Renderer(const Scene* scene, const CameraIntrinsics& camera, const Lighting& lighting)
+    : scene_(scene), camera_(camera), lighting_(lighting) {
   PATROLMAP_CHECK(scene != nullptr && camera.valid());
   for (const Wall& wall : scene->walls) {
     PATROLMAP_CHECK(wall.texture >= 0 && wall.texture < static_cast<int>(scene->textures.size()));
+    const Eigen::Vector2d along = (wall.end - wall.start).normalized();
+    normals_.emplace_back(along.y(), -along.x());
   }
+  sun_ = std::cos(lighting.sun_elevation) * Eigen::Vector2d(std::cos(lighting.sun_azimuth), std::sin(lighting.sun_azimuth));
+  ground_shade_ = static_cast<float>(lighting.ambient + (1.0 - lighting.ambient) * std::sin(lighting.sun_elevation));
+  exposure_.resize(4 * 400);
+  for (std::size_t i = 0; i < exposure_.size(); ++i) {
+    const double normalised = std::min(1.0, lighting.gain * (i / 4.0) / 255.0);
+    exposure_[i] = static_cast<std::uint8_t>(255.0 * std::pow(normalised, 1.0 / lighting.gamma) + 0.5);
+  }
+}
+
+std::uint8_t Renderer::Expose(double linear) const {
+  const std::size_t index = std::min(exposure_.size() - 1, static_cast<std::size_t>(std::max(0.0, linear) * 4.0));
+  return exposure_[index];
+}
+
+void Renderer::AddNoise(std::uint64_t frame, cv::Mat* image) const {
+  if (lighting_.noise_sigma <= 0.0) return;
+  cv::RNG rng(lighting_.noise_seed * 1000003ull + frame);
+  cv::Mat noise(image->size(), CV_16SC1);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, lighting_.noise_sigma);
+  cv::Mat sum;
+  image->convertTo(sum, CV_16SC1);
+  sum += noise;
+  sum.convertTo(*image, CV_8UC1);
 }
 
 void Renderer::IntersectColumn(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction) {
@@ -75,25 +116,40 @@ void Renderer::IntersectColumn(const Eigen::Vector2d& origin, const Eigen::Vecto
     const double depth = Cross(offset, along) / denominator;
     const double fraction = Cross(offset, direction) / denominator;
     if (depth < kNearestDepth || fraction < 0.0 || fraction > 1.0) continue;
-    hits_.push_back({depth, fraction * along.norm(), static_cast<int>(i)});
+    const Eigen::Vector2d seen_side = normals_[i].dot(direction) < 0 ? normals_[i] : Eigen::Vector2d(-normals_[i]);
+    const double lit = std::max(0.0, seen_side.dot(sun_));
+    const float shade = static_cast<float>(lighting_.ambient + (1.0 - lighting_.ambient) * lit);
+    hits_.push_back({depth, fraction * along.norm(), static_cast<int>(i), shade});
   }
   std::sort(hits_.begin(), hits_.end(), [](const Hit& a, const Hit& b) { return a.depth < b.depth; });
 }
 
 std::uint8_t Renderer::ShadeGround(const Eigen::Vector2d& point, double depth) const {
-  if (scene_->ground_texture < 0) return scene_->ground_grey;
+  if (scene_->ground_texture < 0) return Expose(scene_->ground_grey * ground_shade_);
   const Texture& texture = scene_->textures[scene_->ground_texture];
   const double footprint = depth * texture.texels_per_metre / camera_.fx;
-  return SampleTexture(texture, point.x() * texture.texels_per_metre, point.y() * texture.texels_per_metre,
-                       footprint, true);
+  return Expose(ground_shade_ * SampleTexture(texture, point.x() * texture.texels_per_metre,
+                                              point.y() * texture.texels_per_metre, footprint, true));
 }
 
 std::uint8_t Renderer::ShadeWall(const Hit& hit, double z) const {
   const Wall& wall = scene_->walls[hit.wall];
   const Texture& texture = scene_->textures[wall.texture];
   const double footprint = hit.depth * texture.texels_per_metre / camera_.fx;
-  return SampleTexture(texture, hit.s * texture.texels_per_metre, (wall.height - z) * texture.texels_per_metre,
-                       footprint, false);
+  return Expose(hit.shade * SampleTexture(texture, hit.s * texture.texels_per_metre,
+                                          (wall.height - z) * texture.texels_per_metre, footprint, false));
+}
+
+// True when a ray that passes over the top of wall hits_[index] comes down on
+// the roof of that wall's box before leaving it.
+bool Renderer::HitsRoof(std::size_t index, double height, double slope) const {
+  const int box = scene_->walls[hits_[index].wall].box;
+  if (box < 0) return false;
+  for (std::size_t next = index + 1; next < hits_.size(); ++next) {
+    const Wall& wall = scene_->walls[hits_[next].wall];
+    if (wall.box == box) return height - slope * hits_[next].depth <= wall.height;
+  }
+  return false;
 }
 
 void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction,
@@ -101,11 +157,17 @@ void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vect
   const double height = pose.position.z();
   for (int row = 0; row < image->rows; ++row) {
     const double slope = (row - camera_.cy) / camera_.fy;  // metres down per metre of depth
-    std::uint8_t grey = slope > 0.0 ? 0 : scene_->sky_grey;
+    std::uint8_t grey = slope > 0.0 ? 0 : Expose(scene_->sky_grey);
     bool shaded = false;
-    for (const Hit& hit : hits_) {
+    for (std::size_t i = 0; i < hits_.size(); ++i) {
+      const Hit& hit = hits_[i];
       const double z = height - slope * hit.depth;
-      if (z > scene_->walls[hit.wall].height) continue;  // the ray passes over this wall
+      if (z > scene_->walls[hit.wall].height) {  // the ray passes over this wall ...
+        if (!HitsRoof(i, height, slope)) continue;
+        grey = Expose(ground_shade_ * scene_->roof_grey[scene_->walls[hit.wall].box]);  // ... onto its box's roof
+        shaded = true;
+        break;
+      }
       if (z >= 0.0) grey = ShadeWall(hit, z);
       shaded = z >= 0.0;
       break;
@@ -118,7 +180,7 @@ void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vect
   }
 }
 
-void Renderer::Render(const CameraPose& pose, cv::Mat* image) {
+void Renderer::Render(const CameraPose& pose, cv::Mat* image, std::uint64_t frame) {
   image->create(camera_.height, camera_.width, CV_8UC1);
   const Eigen::Matrix3d rotation = WorldFromCameraRotation(pose.yaw);
   const Eigen::Vector2d forward = rotation.col(2).head<2>();
@@ -128,6 +190,7 @@ void Renderer::Render(const CameraPose& pose, cv::Mat* image) {
     IntersectColumn(pose.position.head<2>(), direction);
     ShadeColumn(column, pose, direction, image);
   }
+  AddNoise(frame, image);
 }
 
 void Renderer::ColumnDepths(const CameraPose& pose, std::vector<double>* depths) {

@@ -4,6 +4,7 @@
 #include <opencv2/core.hpp>
 
 #include "patrolmap/sim/flight.h"
+#include "patrolmap/sim/village.h"
 
 namespace patrolmap::sim {
 namespace {
@@ -12,16 +13,13 @@ constexpr double kBuildingDepth = 8.0;  // extent of each near building away fro
 
 // Adds a box building whose street facade runs from (x0, y) to (x1, y).
 void AddBuilding(double x0, double x1, double y, double height, std::uint32_t seed, Scene* scene) {
-  const double length = x1 - x0;
   const int front = static_cast<int>(scene->textures.size());
-  scene->textures.push_back(MakeFacadeTexture(length, height, seed));
+  scene->textures.push_back(MakeFacadeTexture(x1 - x0, height, seed));
   scene->textures.push_back(MakeFacadeTexture(kBuildingDepth, height, seed + 1));
-  const int side = front + 1;
-  const Eigen::Vector2d a(x0, y), b(x1, y), c(x1, y + kBuildingDepth), d(x0, y + kBuildingDepth);
-  scene->walls.push_back({a, b, height, front});
-  scene->walls.push_back({b, c, height, side});
-  scene->walls.push_back({c, d, height, front});
-  scene->walls.push_back({d, a, height, side});
+  const std::size_t first_wall = scene->walls.size();
+  AddBox(Eigen::Vector2d(0.5 * (x0 + x1), y + kBuildingDepth / 2), 0.0, x1 - x0, kBuildingDepth, height, front, scene);
+  scene->walls[first_wall + 1].texture = front + 1;
+  scene->walls[first_wall + 3].texture = front + 1;
 }
 
 struct Facade {

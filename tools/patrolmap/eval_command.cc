@@ -19,10 +19,11 @@ struct EvalArguments {
   bool json = false;
   bool verbose = false;
   double tolerance_s = 1.0;
+  double min_span_s = 2.0;
 };
 
-nlohmann::json ScoreJson(const eval::KeyLocationScore& score, double tolerance_s) {
-  return {{"tolerance_s", tolerance_s},       {"nodes", score.detected},
+nlohmann::json ScoreJson(const eval::KeyLocationScore& score, double tolerance_s, double min_span_s) {
+  return {{"tolerance_s", tolerance_s},       {"min_span_s", min_span_s}, {"nodes", score.detected},
           {"expected", score.expected},       {"true_positives", score.true_positives},
           {"false_positives", score.false_positives}, {"missed", score.missed},
           {"precision", score.precision()},   {"recall", score.recall()}};
@@ -64,12 +65,13 @@ int RunEval(const EvalArguments& arguments) {
     spdlog::error("{}", status.message());
     return 1;
   }
-  const eval::KeyLocationScore score = eval::ScoreKeyLocations(detected, edges, {arguments.tolerance_s});
+  const eval::KeyLocationScore score =
+      eval::ScoreKeyLocations(detected, edges, {arguments.tolerance_s, arguments.min_span_s});
   if (arguments.json) {
     const nlohmann::json report = {{"schema", "patrolmap.eval/1"},
                                    {"flight", source->info().flight_id},
                                    {"frames", source->info().frame_count},
-                                   {"key_locations", ScoreJson(score, arguments.tolerance_s)}};
+                                   {"key_locations", ScoreJson(score, arguments.tolerance_s, arguments.min_span_s)}};
     std::printf("%s\n", report.dump(2).c_str());
     return 0;
   }
@@ -87,6 +89,10 @@ Command AddEvalCommand(CLI::App* app) {
   app->add_flag("--json", arguments->json, "print JSON instead of a table");
   app->add_flag("-v,--verbose", arguments->verbose, "list every expected span and every false node");
   app->add_option("--tolerance", arguments->tolerance_s, "slack around each expected span [s]")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app->add_option("--min-span", arguments->min_span_s,
+                  "passages and facades shorter than this merge into their neighbours [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   return [arguments] { return RunEval(*arguments); };

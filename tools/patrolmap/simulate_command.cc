@@ -1,4 +1,4 @@
-// patrolmap simulate --route street --seed N --out DIR
+// patrolmap simulate --route double-loop|inner-loop|l-shape|street|WAYPOINTS.csv --seed N --out DIR
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -7,41 +7,68 @@
 
 #include "commands.h"
 #include "patrolmap/sim/flight.h"
+#include "patrolmap/sim/route.h"
+#include "patrolmap/sim/village.h"
 #include "progress.h"
 
 namespace patrolmap::tools {
 namespace {
 
 struct SimulateArguments {
-  std::string route = "street";
+  std::string route = "double-loop";
   std::string out;
   std::uint32_t seed = 1;
-  bool static_camera = false;
-  double speed_mps = 2.5;
-  int walls = 3;
+  std::string resolution = "752x480";
   double mount_deg = 90.0;
-  bool irregular = false;
-  double yaw_wobble_deg = 0.0;
-  double speed_variation = 0.0;
-  double yaw_period_s = 12.0;
-  double speed_period_s = 12.0;
+  double speed_mps = 0.0;  // 0: the route's default (street 2.5, village 1.3)
+  bool plain_lighting = false;
+  sim::RouteOptions flight;
+  sim::StreetOptions street;
 };
 
+Status ParseResolution(const std::string& text, int* width, int* height) {
+  if (std::sscanf(text.c_str(), "%dx%d", width, height) != 2 || *width < 32 || *height < 24) {
+    return Status::InvalidArgument("--resolution must look like 752x480, got '" + text + "'");
+  }
+  return Status::Ok();
+}
+
+Status BuildFlight(const SimulateArguments& arguments, sim::SimulatedFlight* flight) {
+  if (arguments.route == "street") {
+    sim::StreetOptions street = arguments.street;
+    street.seed = arguments.seed;
+    street.mount_angle_deg = arguments.mount_deg;
+    if (arguments.speed_mps > 0.0) street.speed_mps = arguments.speed_mps;
+    *flight = sim::MakeStreetFlight(street);
+    return Status::Ok();
+  }
+  sim::Route route;
+  const bool preset = arguments.route.find('.') == std::string::npos && arguments.route.find('/') == std::string::npos;
+  PATROLMAP_RETURN_IF_ERROR(preset ? sim::RoutePreset(arguments.route, &route)
+                                   : sim::ReadWaypoints(arguments.route, &route));
+  sim::Village village = sim::MakeVillage({arguments.seed});
+  flight->scene = std::move(village.scene);
+  flight->mount_angle = arguments.mount_deg * M_PI / 180.0;
+  sim::RouteOptions options = arguments.flight;
+  options.seed = arguments.seed;
+  if (arguments.speed_mps > 0.0) options.speed_mps = arguments.speed_mps;
+  flight->flight_id = route.name;
+  return sim::FlyRoute(route, options, flight);
+}
+
 int RunSimulate(const SimulateArguments& arguments) {
-  sim::StreetOptions street;
-  street.seed = arguments.seed;
-  street.static_camera = arguments.static_camera;
-  street.speed_mps = arguments.speed_mps;
-  street.walls = arguments.walls;
-  street.mount_angle_deg = arguments.mount_deg;
-  street.irregular = arguments.irregular;
-  street.yaw_wobble_deg = arguments.yaw_wobble_deg;
-  street.speed_variation = arguments.speed_variation;
-  street.yaw_period_s = arguments.yaw_period_s;
-  street.speed_period_s = arguments.speed_period_s;
-  sim::SimulatedFlight flight = sim::MakeStreetFlight(street);
-  flight.flight_id = arguments.route + "-" + std::to_string(arguments.seed);
-  Status status;
+  sim::SimulatedFlight flight;
+  int width = 0, height = 0;
+  Status status = ParseResolution(arguments.resolution, &width, &height);
+  if (status.ok()) status = BuildFlight(arguments, &flight);
+  if (!status.ok()) {
+    spdlog::error("{}", status.message());
+    return status.code() == StatusCode::kInvalidArgument ? 2 : 1;
+  }
+  flight.flight_id += "-" + std::to_string(arguments.seed);
+  if (!arguments.plain_lighting) flight.lighting = sim::DrawLighting(arguments.seed, 1);
+  flight.camera = flight.camera.Scaled(static_cast<double>(width) / flight.camera.width);
+  flight.camera.height = height;
   {
     Progress progress("simulate");
     status = sim::WriteEurocLog(flight, arguments.out,
@@ -56,36 +83,62 @@ int RunSimulate(const SimulateArguments& arguments) {
   return 0;
 }
 
+void AddStreetOptions(CLI::App* app, sim::StreetOptions* street) {
+  app->add_option("--walls", street->walls, "street: facades along the street")->check(CLI::Range(1, 100))->capture_default_str();
+  app->add_flag("--irregular", street->irregular, "street: draw facade lengths, gaps, depths and heights from the seed");
+  app->add_option("--yaw-wobble", street->yaw_wobble_deg, "street: heading swing amplitude [deg]")
+      ->check(CLI::Range(0.0, 45.0))
+      ->capture_default_str();
+  app->add_option("--yaw-period", street->yaw_period_s, "street: period of the heading swing [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  app->add_option("--speed-variation", street->speed_variation, "street: speed swing as a fraction of the speed")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  app->add_option("--speed-period", street->speed_period_s, "street: period of the speed swing [s]")
+      ->check(CLI::Range(1.0, 600.0))
+      ->capture_default_str();
+  app->add_flag("--static", street->static_camera, "street: hover in place for 10 s (no ego-motion)");
+}
+
+void AddRouteOptions(CLI::App* app, sim::RouteOptions* flight) {
+  app->add_option("--speed-jitter", flight->speed_jitter, "village: smooth speed variation, fraction of the speed")
+      ->check(CLI::Range(0.0, 0.9))
+      ->capture_default_str();
+  app->add_option("--altitude", flight->altitude_m, "village: flight height [m]")->check(CLI::Range(0.5, 30.0))->capture_default_str();
+  app->add_option("--altitude-changes", flight->altitude_changes, "village: sudden climbs or descents during the flight")
+      ->check(CLI::Range(0, 20))
+      ->capture_default_str();
+  app->add_option("--altitude-change", flight->altitude_change_m, "village: size of each altitude change [m]")
+      ->check(CLI::Range(0.1, 10.0))
+      ->capture_default_str();
+  app->add_option("--turn-radius", flight->turn_radius_m, "village: radius of the turns at corners [m]")
+      ->check(CLI::Range(0.5, 50.0))
+      ->capture_default_str();
+}
+
 }  // namespace
 
 Command AddSimulateCommand(CLI::App* app) {
   auto arguments = std::make_shared<SimulateArguments>();
-  app->add_option("--route", arguments->route, "route preset")
-      ->check(CLI::IsMember({"street"}))
+  app->add_option("--route", arguments->route,
+                  "double-loop (~400 m), inner-loop (~142 m), l-shape (~85 m) through the village, street, or a "
+                  "CSV file of x,y waypoints [m] in the village frame")
       ->capture_default_str();
-  app->add_option("--seed", arguments->seed, "seed of the textures")->capture_default_str();
+  app->add_option("--seed", arguments->seed, "seed of the world, textures and flight")->capture_default_str();
   app->add_option("-o,--out", arguments->out, "folder of the EuRoC-layout log to write")->required();
-  app->add_option("--speed", arguments->speed_mps, "flight speed [m/s]")->check(CLI::PositiveNumber)->capture_default_str();
-  app->add_option("--walls", arguments->walls, "facades along the street")->check(CLI::Range(1, 100))->capture_default_str();
-  app->add_option("--mount", arguments->mount_deg, "camera mount: angle of the optical axis from the flight "
-                  "direction, towards the left [deg]")
+  app->add_option("--resolution", arguments->resolution, "image size WxH (intrinsics scale with the width)")
+      ->capture_default_str();
+  app->add_option("--mount", arguments->mount_deg,
+                  "camera mount: angle of the optical axis from the flight direction, towards the left [deg]")
       ->check(CLI::Range(20.0, 90.0))
       ->capture_default_str();
-  app->add_flag("--irregular", arguments->irregular, "draw facade lengths, gaps, depths and heights from the seed");
-  app->add_option("--yaw-wobble", arguments->yaw_wobble_deg, "heading swing amplitude [deg]")
-      ->check(CLI::Range(0.0, 45.0))
-      ->capture_default_str();
-  app->add_option("--speed-variation", arguments->speed_variation,
-                  "speed swing as a fraction of --speed")
-      ->check(CLI::Range(0.0, 0.9))
-      ->capture_default_str();
-  app->add_option("--yaw-period", arguments->yaw_period_s, "period of the heading swing [s]")
-      ->check(CLI::Range(1.0, 600.0))
-      ->capture_default_str();
-  app->add_option("--speed-period", arguments->speed_period_s, "period of the speed swing [s]")
-      ->check(CLI::Range(1.0, 600.0))
-      ->capture_default_str();
-  app->add_flag("--static", arguments->static_camera, "hover in place for 10 s (no ego-motion)");
+  app->add_option("--speed", arguments->speed_mps, "mean speed [m/s] (default: street 2.5, village 1.3)")
+      ->check(CLI::NonNegativeNumber);
+  app->add_flag("--plain-lighting", arguments->plain_lighting,
+                "no sun shading, exposure change or sensor noise (default: drawn from the seed)");
+  AddRouteOptions(app, &arguments->flight);
+  AddStreetOptions(app, &arguments->street);
   return [arguments] { return RunSimulate(*arguments); };
 }
 

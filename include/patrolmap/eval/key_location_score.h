@@ -9,10 +9,12 @@
 // peak. Each such span is an expected node; a detection of the right kind
 // inside a span (widened by the tolerance on both sides) is a true positive,
 // every other detection a false positive, and an expected span with no
-// detection a miss. Spans that cannot be expected are optional (matched when a
-// detection falls there, never missed): the open spans before the first and
-// after the last edge, and spans between two edges of the same kind (a depth
-// step, not a passage or a facade).
+// detection a miss. Before spans are formed, a run of edges of one kind (a
+// depth change in steps) counts as its first edge, and a passage or facade
+// shorter than min_span_s is merged into its neighbours (a slit that short
+// does not separate two facades for a detector that smooths over seconds).
+// The open spans before the first and after the last edge are optional:
+// matched when a detection falls there, never missed.
 #pragma once
 
 #include <string>
@@ -39,6 +41,7 @@ struct ExpectedSpan {
 
 struct KeyLocationScoreOptions {
   double tolerance_s = 1.0;  // a span accepts detections this long before its start and after its end [s]
+  double min_span_s = 2.0;   // shorter passages and facades merge into their neighbours [s]
 };
 
 enum class Verdict { kTruePositive, kFalsePositive };
@@ -60,7 +63,7 @@ struct KeyLocationScore {
 };
 
 // Builds the spans from edges sorted by time.
-std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& edges);
+std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& edges, double min_span_s);
 
 KeyLocationScore ScoreKeyLocations(const std::vector<KeyLocation>& detected, const std::vector<TruthEdge>& edges,
                                    const KeyLocationScoreOptions& options = {});

@@ -31,6 +31,7 @@ struct SimulatedFlight {
   double frame_rate_hz = 30.0;
   double imu_rate_hz = 200.0;
   double mount_angle = 1.5707963267948966;  // optical axis from body x towards body y (left) [rad]
+  Lighting lighting;                        // of this flight (default: plain texture, no noise)
   double duration_s = 0.0;
   std::function<PlatformState(double)> trajectory;  // state at time t in [0, duration_s]
 };
@@ -38,7 +39,8 @@ struct SimulatedFlight {
 // Camera pose of the platform state for the flight's mount angle.
 CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& state);
 
-// Ground-truth key location: a vertical building edge crossing the optical axis.
+// Ground-truth key location: a vertical building edge crossing the optical axis
+// with a jump of the inverse depth along the axis of at least 0.05 1/m.
 struct TruthKeyLocation {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;

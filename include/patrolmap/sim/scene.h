@@ -25,6 +25,7 @@ struct Wall {
   Eigen::Vector2d end = Eigen::Vector2d::Zero();
   double height = 0.0;
   int texture = 0;  // index into Scene::textures
+  int box = -1;     // the closed box this wall belongs to (its roof is drawn), -1 for a lone wall
 };
 
 struct Scene {
@@ -34,6 +35,7 @@ struct Scene {
   double ground_tile_metres = 8.0;    // side of one ground texture tile [m]
   std::uint8_t sky_grey = 215;
   std::uint8_t ground_grey = 110;
+  std::vector<std::uint8_t> roof_grey;  // per box id
 };
 
 // A procedural facade texture: plaster or brick noise, a grid of windows and
