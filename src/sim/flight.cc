@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "patrolmap/core/files.h"
@@ -94,24 +95,121 @@ std::string TruthTable(const std::vector<TruthKeyLocation>& truth) {
   return out.str();
 }
 
-Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, const ProgressCallback& progress) {
-  PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/cam0/data"));
+std::string PlacesTable(const SimulatedFlight& flight) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "#timestamp [ns],frame_index,x [m],y [m],z [m],camera_yaw [rad]\n";
+  for (int frame = 0; frame < FrameCount(flight); ++frame) {
+    const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
+    out << FrameTimestamp(flight, frame) << "," << frame << "," << pose.position.x() << "," << pose.position.y()
+        << "," << pose.position.z() << "," << std::remainder(pose.yaw, 2 * M_PI) << "\n";
+  }
+  return out.str();
+}
+
+std::string ObjectsTable(const std::vector<WorldObject>& objects) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "#id,label,x [m],y [m],yaw [rad],length [m],width [m],height [m]\n";
+  for (const WorldObject& o : objects) {
+    out << o.id << "," << ToString(o.label) << "," << o.centre.x() << "," << o.centre.y() << "," << o.yaw << ","
+        << o.length << "," << o.width << "," << o.height << "\n";
+  }
+  return out.str();
+}
+
+std::string ChangesTable(const std::vector<ObjectChange>& changes) {
+  std::ostringstream out;
+  out.precision(9);
+  out << "#id,label,state,x_before [m],y_before [m],x_after [m],y_after [m]\n";
+  for (const ObjectChange& c : changes) {
+    out << c.id << "," << ToString(c.label) << "," << ToString(c.state) << "," << c.before.x() << "," << c.before.y()
+        << "," << c.after.x() << "," << c.after.y() << "\n";
+  }
+  return out.str();
+}
+
+std::string GpsTable(const SimulatedFlight& flight, const LogOptions& options) {
+  constexpr double kEarthRadius = 6378137.0, kRateHz = 10.0, kSigma = 1.5;
+  cv::RNG rng(static_cast<std::uint64_t>(flight.lighting.noise_seed) * 97u + 1u);
+  std::ostringstream out;
+  out.precision(10);
+  out << "#timestamp [ns],latitude [deg],longitude [deg],altitude [m]\n";
+  const double lat0 = options.gps_origin_latitude * M_PI / 180.0;
+  for (double t = 0.0; t <= flight.duration_s; t += 1.0 / kRateHz) {
+    const Eigen::Vector3d p = flight.trajectory(t).position;
+    const double north = p.y() + rng.gaussian(kSigma), east = p.x() + rng.gaussian(kSigma);
+    out << SecondsToNs(t) << "," << options.gps_origin_latitude + north / kEarthRadius * 180.0 / M_PI << ","
+        << options.gps_origin_longitude + east / (kEarthRadius * std::cos(lat0)) * 180.0 / M_PI << ","
+        << options.gps_origin_altitude_m + p.z() + rng.gaussian(2 * kSigma) << "\n";
+  }
+  return out.str();
+}
+
+// Accumulates the per-frame tables while frames are rendered.
+struct FrameTables {
+  std::ostringstream images, depth, detections, detection_truth;
+  FrameTables() {
+    images << "#timestamp [ns],filename\n";
+    depth << "#timestamp [ns],filename\n";
+    detections << "#timestamp [ns],label,confidence,x_min [px],y_min [px],x_max [px],y_max [px],"
+                  "x_c [m],y_c [m],z_c [m]\n";
+    detection_truth << "#timestamp [ns],detection,object_id\n";
+    detections.precision(6);
+  }
+};
+
+void AppendDetections(TimestampNs timestamp, const std::vector<Detection>& found, FrameTables* tables) {
+  for (std::size_t i = 0; i < found.size(); ++i) {
+    const Detection& d = found[i];
+    tables->detections << timestamp << "," << ToString(d.label) << "," << d.confidence << "," << d.box.x << ","
+                       << d.box.y << "," << d.box.br().x << "," << d.box.br().y << "," << d.centroid.x() << ","
+                       << d.centroid.y() << "," << d.centroid.z() << "\n";
+    tables->detection_truth << timestamp << "," << i << "," << d.truth_id << "\n";
+  }
+}
+
+Status WriteImage(const std::string& path, const cv::Mat& image) {
+  return cv::imwrite(path, image) ? Status::Ok() : Status::IoError(path + ": cannot write image");
+}
+
+Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
+                   const ProgressCallback& progress, FrameTables* tables) {
   Renderer renderer(&flight.scene, flight.camera, flight.lighting);
-  std::ostringstream table;
-  table << "#timestamp [ns],filename\n";
-  cv::Mat image;
+  const int detector_step = std::max(1, static_cast<int>(std::lround(flight.frame_rate_hz / options.detector.rate_hz)));
+  cv::Mat image, depth;
   const int frames = FrameCount(flight);
   for (int frame = 0; frame < frames; ++frame) {
     const TimestampNs timestamp = FrameTimestamp(flight, frame);
-    renderer.Render(CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz)), &image, frame);
+    const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
     const std::string name = std::to_string(timestamp) + ".png";
-    if (!cv::imwrite(folder + "/cam0/data/" + name, image)) {
-      return Status::IoError(folder + "/cam0/data/" + name + ": cannot write image");
+    renderer.Render(pose, &image, frame);
+    PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/cam0/data/" + name, image));
+    tables->images << timestamp << "," << name << "\n";
+    if (options.depth) {
+      renderer.RenderDepth(pose, &depth);
+      PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/depth0/data/" + name, depth));
+      tables->depth << timestamp << "," << name << "\n";
     }
-    table << timestamp << "," << name << "\n";
+    if (options.detections && frame % detector_step == 0) {
+      AppendDetections(timestamp, DetectObjects(flight.objects, flight.scene, flight.camera, pose, options.detector, frame),
+                       tables);
+    }
     if (progress) progress(frame + 1, frames);
   }
-  return WriteFileAtomically(folder + "/cam0/data.csv", table.str());
+  return Status::Ok();
+}
+
+Status WriteOptionalTables(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
+                           const FrameTables& tables) {
+  if (options.depth) PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/depth0/data.csv", tables.depth.str()));
+  if (options.detections) {
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/objects0/data.csv", tables.detections.str()));
+    PATROLMAP_RETURN_IF_ERROR(
+        WriteFileAtomically(folder + "/groundtruth/detections.csv", tables.detection_truth.str()));
+  }
+  if (options.gps) PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/gps0/data.csv", GpsTable(flight, options)));
+  return Status::Ok();
 }
 
 // Depth along the optical axis of the first wall at least as tall as the camera.
@@ -182,20 +280,29 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
   return truth;
 }
 
-Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, const ProgressCallback& progress) {
+Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
+                     const ProgressCallback& progress) {
   if (!flight.trajectory || flight.duration_s <= 0.0) return Status::InvalidArgument("flight has no trajectory");
-  for (const char* sub : {"/imu0", "/state_groundtruth_estimate0", "/groundtruth"}) {
+  for (const char* sub : {"/cam0/data", "/imu0", "/state_groundtruth_estimate0", "/groundtruth"}) {
     PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + sub));
   }
+  if (options.depth) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/depth0/data"));
+  if (options.detections) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/objects0"));
+  if (options.gps) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/gps0"));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight)));
-  PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, progress));
+  FrameTables tables;
+  PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, options, progress, &tables));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/data.csv", tables.images.str()));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(
       folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +
                                         "rate_hz: " + std::to_string(flight.imu_rate_hz) + "\n"));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/imu0/data.csv", ImuTable(flight)));
-  PATROLMAP_RETURN_IF_ERROR(
-      WriteFileAtomically(folder + "/state_groundtruth_estimate0/data.csv", StateTable(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/state_groundtruth_estimate0/data.csv", StateTable(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/places.csv", PlacesTable(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/objects.csv", ObjectsTable(flight.objects)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/changes.csv", ChangesTable(flight.changes)));
+  PATROLMAP_RETURN_IF_ERROR(WriteOptionalTables(flight, folder, options, tables));
   return WriteFileAtomically(folder + "/groundtruth/key_locations.csv", TruthTable(KeyLocationTruth(flight)));
 }
 

@@ -152,31 +152,59 @@ bool Renderer::HitsRoof(std::size_t index, double height, double slope) const {
   return false;
 }
 
+// What the ray of a pixel row sees in the current column (hits_ already found).
+Renderer::Surface Renderer::SurfaceAt(double height, double slope) const {
+  for (std::size_t i = 0; i < hits_.size(); ++i) {
+    const Hit& hit = hits_[i];
+    const Wall& wall = scene_->walls[hit.wall];
+    const double z = height - slope * hit.depth;
+    if (z > wall.height) {  // the ray passes over this wall, maybe onto its box's roof
+      if (HitsRoof(i, height, slope)) return {SurfaceKind::kRoof, static_cast<int>(i), (height - wall.height) / slope};
+      continue;
+    }
+    if (z >= 0.0) return {SurfaceKind::kWall, static_cast<int>(i), hit.depth};
+    break;  // the ray reaches the ground before this wall
+  }
+  if (slope > 0.0) return {SurfaceKind::kGround, -1, height / slope};
+  return {SurfaceKind::kSky, -1, 0.0};
+}
+
 void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction,
                            cv::Mat* image) const {
   const double height = pose.position.z();
   for (int row = 0; row < image->rows; ++row) {
     const double slope = (row - camera_.cy) / camera_.fy;  // metres down per metre of depth
-    std::uint8_t grey = slope > 0.0 ? 0 : Expose(scene_->sky_grey);
-    bool shaded = false;
-    for (std::size_t i = 0; i < hits_.size(); ++i) {
-      const Hit& hit = hits_[i];
-      const double z = height - slope * hit.depth;
-      if (z > scene_->walls[hit.wall].height) {  // the ray passes over this wall ...
-        if (!HitsRoof(i, height, slope)) continue;
-        grey = Expose(ground_shade_ * scene_->roof_grey[scene_->walls[hit.wall].box]);  // ... onto its box's roof
-        shaded = true;
+    const Surface surface = SurfaceAt(height, slope);
+    std::uint8_t grey = 0;
+    switch (surface.kind) {
+      case SurfaceKind::kWall:
+        grey = ShadeWall(hits_[surface.hit], height - slope * surface.depth);
         break;
-      }
-      if (z >= 0.0) grey = ShadeWall(hit, z);
-      shaded = z >= 0.0;
-      break;
-    }
-    if (!shaded && slope > 0.0) {
-      const double depth = height / slope;
-      grey = ShadeGround(pose.position.head<2>() + depth * direction, depth);
+      case SurfaceKind::kRoof:
+        grey = Expose(ground_shade_ * scene_->roof_grey[scene_->walls[hits_[surface.hit].wall].box]);
+        break;
+      case SurfaceKind::kGround:
+        grey = ShadeGround(pose.position.head<2>() + surface.depth * direction, surface.depth);
+        break;
+      case SurfaceKind::kSky:
+        grey = Expose(scene_->sky_grey);
+        break;
     }
     image->at<std::uint8_t>(row, column) = grey;
+  }
+}
+
+void Renderer::RenderDepth(const CameraPose& pose, cv::Mat* depth_mm) {
+  depth_mm->create(camera_.height, camera_.width, CV_16UC1);
+  const Eigen::Matrix3d rotation = WorldFromCameraRotation(pose.yaw);
+  for (int column = 0; column < camera_.width; ++column) {
+    const Eigen::Vector2d direction =
+        rotation.col(2).head<2>() + ((column - camera_.cx) / camera_.fx) * rotation.col(0).head<2>();
+    IntersectColumn(pose.position.head<2>(), direction);
+    for (int row = 0; row < camera_.height; ++row) {
+      const double depth = SurfaceAt(pose.position.z(), (row - camera_.cy) / camera_.fy).depth;
+      depth_mm->at<std::uint16_t>(row, column) = static_cast<std::uint16_t>(std::min(65535.0, depth * 1000.0 + 0.5));
+    }
   }
 }
 

@@ -22,6 +22,10 @@ struct SimulateArguments {
   double mount_deg = 90.0;
   double speed_mps = 0.0;  // 0: the route's default (street 2.5, village 1.3)
   bool plain_lighting = false;
+  int flights = 1;
+  int objects = 12;
+  sim::ChangeSpec changes;
+  sim::LogOptions log;
   sim::RouteOptions flight;
   sim::StreetOptions street;
 };
@@ -33,7 +37,8 @@ Status ParseResolution(const std::string& text, int* width, int* height) {
   return Status::Ok();
 }
 
-Status BuildFlight(const SimulateArguments& arguments, sim::SimulatedFlight* flight) {
+// The world and flight path of flight `number` (1-based) of a series; objects are added by the caller.
+Status BuildFlight(const SimulateArguments& arguments, int number, sim::SimulatedFlight* flight) {
   if (arguments.route == "street") {
     sim::StreetOptions street = arguments.street;
     street.seed = arguments.seed;
@@ -50,37 +55,81 @@ Status BuildFlight(const SimulateArguments& arguments, sim::SimulatedFlight* fli
   flight->scene = std::move(village.scene);
   flight->mount_angle = arguments.mount_deg * M_PI / 180.0;
   sim::RouteOptions options = arguments.flight;
-  options.seed = arguments.seed;
+  options.seed = arguments.seed * 100u + static_cast<std::uint32_t>(number);
   if (arguments.speed_mps > 0.0) options.speed_mps = arguments.speed_mps;
   flight->flight_id = route.name;
   return sim::FlyRoute(route, options, flight);
 }
 
-int RunSimulate(const SimulateArguments& arguments) {
+std::string FlightFolder(const SimulateArguments& arguments, int number) {
+  if (arguments.flights == 1) return arguments.out;
+  return arguments.out + "/flight_" + std::to_string(number);
+}
+
+// The objects of flight `number`: placed for the first, changed from the previous one after.
+std::vector<sim::WorldObject> NextObjects(const SimulateArguments& arguments, int number,
+                                          const std::vector<sim::WorldObject>& previous,
+                                          std::vector<sim::ObjectChange>* changes) {
+  changes->clear();
+  if (arguments.route == "street" || arguments.objects == 0) return {};
+  if (number == 1) return sim::PlaceObjects(arguments.objects, arguments.seed);
+  return sim::ChangeObjects(previous, arguments.changes, arguments.seed * 1000u + static_cast<std::uint32_t>(number),
+                            changes);
+}
+
+Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<sim::WorldObject>* objects) {
   sim::SimulatedFlight flight;
   int width = 0, height = 0;
-  Status status = ParseResolution(arguments.resolution, &width, &height);
-  if (status.ok()) status = BuildFlight(arguments, &flight);
-  if (!status.ok()) {
-    spdlog::error("{}", status.message());
-    return status.code() == StatusCode::kInvalidArgument ? 2 : 1;
-  }
-  flight.flight_id += "-" + std::to_string(arguments.seed);
-  if (!arguments.plain_lighting) flight.lighting = sim::DrawLighting(arguments.seed, 1);
+  PATROLMAP_RETURN_IF_ERROR(ParseResolution(arguments.resolution, &width, &height));
+  PATROLMAP_RETURN_IF_ERROR(BuildFlight(arguments, number, &flight));
+  flight.flight_id += "-" + std::to_string(arguments.seed) + (arguments.flights > 1 ? "-f" + std::to_string(number) : "");
   flight.camera = flight.camera.Scaled(static_cast<double>(width) / flight.camera.width);
   flight.camera.height = height;
-  {
-    Progress progress("simulate");
-    status = sim::WriteEurocLog(flight, arguments.out,
-                                [&progress](int done, int total) { progress.Update(done, total); });
+  if (!arguments.plain_lighting) flight.lighting = sim::DrawLighting(arguments.seed, number);
+  flight.objects = NextObjects(arguments, number, *objects, &flight.changes);
+  sim::AddObjects(flight.objects, &flight.scene);
+  *objects = flight.objects;
+  const std::string folder = FlightFolder(arguments, number);
+  Progress progress("simulate");
+  PATROLMAP_RETURN_IF_ERROR(sim::WriteEurocLog(flight, folder, arguments.log,
+                                               [&progress](int done, int total) { progress.Update(done, total); }));
+  std::printf("%s: %d frames at %.0f Hz (%.1f s), %zu objects, written to %s\n", flight.flight_id.c_str(),
+              sim::FrameCount(flight), flight.frame_rate_hz, flight.duration_s, flight.objects.size(), folder.c_str());
+  return Status::Ok();
+}
+
+int RunSimulate(const SimulateArguments& arguments) {
+  std::vector<sim::WorldObject> objects;
+  for (int number = 1; number <= arguments.flights; ++number) {
+    const Status status = WriteFlight(arguments, number, &objects);
+    if (!status.ok()) {
+      spdlog::error("{}", status.message());
+      return status.code() == StatusCode::kInvalidArgument ? 2 : 1;
+    }
   }
-  if (!status.ok()) {
-    spdlog::error("{}", status.message());
-    return 1;
-  }
-  std::printf("%s: %d frames at %.0f Hz (%.1f s) written to %s\n", flight.flight_id.c_str(), sim::FrameCount(flight),
-              flight.frame_rate_hz, flight.duration_s, arguments.out.c_str());
   return 0;
+}
+
+void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
+  app->add_option("--flights", arguments->flights, "flights of a patrol series, written to OUT/flight_1 ... (lighting, "
+                  "flight path jitter and objects change between them)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app->add_option("--objects", arguments->objects, "village: movable objects (crates, barrels, vehicles) in flight 1")
+      ->check(CLI::Range(0, 200))
+      ->capture_default_str();
+  app->add_option("--remove-fraction", arguments->changes.remove_fraction, "series: share of objects removed per flight")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--move-fraction", arguments->changes.move_fraction, "series: share of objects moved 2-6 m per flight")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app->add_option("--added", arguments->changes.added, "series: objects added per flight")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
+  app->add_flag("--detections", arguments->log.detections, "write objects0/ from a simulated object detector");
+  app->add_flag("--depth", arguments->log.depth, "write depth0/ (16-bit PNG depth along the optical axis, mm)");
+  app->add_flag("--gps", arguments->log.gps, "write gps0/ (10 Hz, 1.5 m noise)");
 }
 
 void AddStreetOptions(CLI::App* app, sim::StreetOptions* street) {
@@ -138,6 +187,7 @@ Command AddSimulateCommand(CLI::App* app) {
   app->add_flag("--plain-lighting", arguments->plain_lighting,
                 "no sun shading, exposure change or sensor noise (default: drawn from the seed)");
   AddRouteOptions(app, &arguments->flight);
+  AddPatrolOptions(app, arguments.get());
   AddStreetOptions(app, &arguments->street);
   return [arguments] { return RunSimulate(*arguments); };
 }

@@ -10,6 +10,7 @@
 
 #include "patrolmap/core/status.h"
 #include "patrolmap/core/types.h"
+#include "patrolmap/sim/objects.h"
 #include "patrolmap/sim/renderer.h"
 #include "patrolmap/sim/scene.h"
 
@@ -34,6 +35,19 @@ struct SimulatedFlight {
   Lighting lighting;                        // of this flight (default: plain texture, no noise)
   double duration_s = 0.0;
   std::function<PlatformState(double)> trajectory;  // state at time t in [0, duration_s]
+  std::vector<WorldObject> objects;    // movable objects (already added to the scene)
+  std::vector<ObjectChange> changes;   // against the previous flight of a patrol series
+};
+
+// Optional parts of a written log.
+struct LogOptions {
+  bool detections = false;  // objects0/data.csv from the simulated detector
+  bool depth = false;       // depth0/: 16-bit PNG depth along the optical axis [mm]
+  bool gps = false;         // gps0/data.csv at 10 Hz with 1.5 m noise
+  DetectorOptions detector;
+  double gps_origin_latitude = 47.3572;  // village origin (the paper's site is near Birmensdorf) [deg]
+  double gps_origin_longitude = 8.4370;
+  double gps_origin_altitude_m = 480.0;
 };
 
 // Camera pose of the platform state for the flight's mount angle.
@@ -67,8 +81,10 @@ using ProgressCallback = std::function<void(int, int)>;
 
 // Renders every frame and writes the log into `folder`: meta.yaml,
 // cam0/{data.csv,data/,sensor.yaml}, imu0/{data.csv,sensor.yaml},
-// state_groundtruth_estimate0/data.csv and groundtruth/key_locations.csv.
-Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder,
+// state_groundtruth_estimate0/data.csv, and groundtruth/ with
+// key_locations.csv, places.csv (camera position and heading per frame),
+// objects.csv and changes.csv; objects0/, depth0/ and gps0/ as `options` ask.
+Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options = {},
                      const ProgressCallback& progress = {});
 
 // A straight street: `walls` near facades of `wall_length_m` separated by gaps of

@@ -52,6 +52,10 @@ class Renderer {
   // seeds the sensor noise, so a frame renders the same every time.
   void Render(const CameraPose& pose, cv::Mat* image, std::uint64_t frame = 0);
 
+  // Depth along the optical axis of every pixel [mm] (CV_16UC1, 0 for sky,
+  // 65535 beyond 65.5 m).
+  void RenderDepth(const CameraPose& pose, cv::Mat* depth_mm);
+
   // Distance along the optical axis of the first surface seen by each column's
   // central ray (the horizon row); +inf for sky. For ground truth and tests.
   void ColumnDepths(const CameraPose& pose, std::vector<double>* depths);
@@ -63,6 +67,13 @@ class Renderer {
     int wall = 0;
     float shade = 1.0f;  // illumination of the wall's side that the ray sees
   };
+  enum class SurfaceKind { kWall, kRoof, kGround, kSky };
+  struct Surface {
+    SurfaceKind kind = SurfaceKind::kSky;
+    int hit = -1;        // index into hits_ for walls and roofs
+    double depth = 0.0;  // along the optical axis [m]; 0 for sky
+  };
+  Surface SurfaceAt(double height, double slope) const;
   void IntersectColumn(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction);
   void ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction, cv::Mat* image) const;
   std::uint8_t ShadeGround(const Eigen::Vector2d& point, double depth) const;
