@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "patrolmap/eval/key_location_score.h"
+#include "patrolmap/eval/loop_closure_score.h"
 #include "test_util.h"
 
 namespace patrolmap::eval {
@@ -106,6 +107,64 @@ TEST(ReadFiles, RunAndTruthTablesRoundTripAndBadLinesAreNamed) {
   ASSERT_EQ(edges.size(), 2u);
   EXPECT_TRUE(edges[0].opening);
   EXPECT_EQ(ReadTruthEdges(dir / "nolog", &edges).code(), StatusCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace patrolmap::eval
+
+namespace patrolmap::eval {
+namespace {
+
+NodeRecord NodeAt(int node, const char* flight, double t) { return {node, flight, SecondsToNs(t), node * 10}; }
+
+TEST(ScoreLoopClosures, CountsPossibleFoundAndFalse) {
+  const std::vector<NodeRecord> nodes = {
+      NodeAt(0, "A", 0),  NodeAt(1, "A", 10), NodeAt(6, "A", 12), NodeAt(2, "A", 40),
+      NodeAt(3, "A", 50), NodeAt(4, "B", 5),  NodeAt(5, "B", 30)};
+  const std::vector<Place> places = {
+      {0, 0, 0},       // 0
+      {20, 0, 0},      // 1
+      {20.2, 0, 0},    // 6: same place as 1 but 2 s later: a neighbour, not a loop closure
+      {1, 1, 0.1},     // 2: back at 0 after 40 s: possible
+      {20.5, 0, 2.0},  // 3: at 1's position looking elsewhere: not the same place
+      {19, 1, 0.1},    // 4: flight B at 1's place: possible
+      {100, 100, 0}};  // 5: nowhere seen before
+  const std::vector<LoopClosureRecord> closures = {{2, 0}, {4, 1}, {5, 0}, {3, 1}};
+  const LoopClosureScore score = ScoreLoopClosures(nodes, places, closures);
+  EXPECT_EQ(score.nodes, 7);
+  EXPECT_EQ(score.possible, 2);
+  EXPECT_EQ(score.found, 2);
+  EXPECT_EQ(score.reported, 4);
+  EXPECT_EQ(score.true_positives, 2);
+  EXPECT_EQ(score.false_positives, 2);
+  EXPECT_DOUBLE_EQ(score.precision(), 0.5);
+  EXPECT_DOUBLE_EQ(score.recall(), 1.0);
+  EXPECT_EQ(score.correct, (std::vector<bool>{true, true, false, false}));
+  LoopClosureScoreOptions wide;
+  wide.max_heading_deg = 180.0;
+  EXPECT_EQ(ScoreLoopClosures(nodes, places, closures, wide).true_positives, 3);  // 3 -> 1 now counts
+}
+
+TEST(ReadFiles, NodesClosuresAndPlaces) {
+  testing::TempDir dir;
+  testing::WriteText(dir / "nodes.csv", "node,flight,timestamp_ns,frame_index\n0,f1,100,3\n1,f2,200,7\n");
+  testing::WriteText(dir / "loop_closures.csv",
+                     "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers\n1,0,7,3,0.4,0.6,80\n");
+  testing::WriteText(dir / "log/groundtruth/places.csv", "#t,frame,x,y,z,yaw\n0,0,1,2,3,0.5\n33,1,2,2,3,0.5\n");
+  std::vector<NodeRecord> nodes;
+  std::vector<LoopClosureRecord> closures;
+  std::vector<Place> places;
+  ASSERT_TRUE(ReadNodesCsv(dir / "nodes.csv", &nodes).ok());
+  ASSERT_TRUE(ReadLoopClosuresCsv(dir / "loop_closures.csv", &closures).ok());
+  ASSERT_TRUE(ReadPlaces(dir / "log", &places).ok());
+  EXPECT_EQ(nodes[1].flight, "f2");
+  EXPECT_EQ(closures[0].matched_node, 0);
+  EXPECT_DOUBLE_EQ(places[1].x, 2.0);
+  testing::WriteText(dir / "log/groundtruth/places.csv", "0,0,1,2,3,0.5\n33,2,2,2,3,0.5\n");
+  EXPECT_NE(ReadPlaces(dir / "log", &places).message().find("places.csv:2: frames must run"), std::string::npos);
+  testing::WriteText(dir / "nodes.csv", "id,flight\n");
+  EXPECT_NE(ReadNodesCsv(dir / "nodes.csv", &nodes).message().find("nodes.csv:1: header must start with 'node'"),
+            std::string::npos);
 }
 
 }  // namespace

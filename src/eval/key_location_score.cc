@@ -113,27 +113,19 @@ Status ReadTruthEdges(const std::string& log, std::vector<TruthEdge>* edges) {
 }
 
 Status ReadKeyLocationsCsv(const std::string& path, std::vector<KeyLocation>* key_locations) {
-  key_locations->clear();
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
-  std::vector<std::string_view> fields;
-  Status status = csv.NextRow(&fields);  // header
-  if (!status.ok()) return status.end_of_stream() ? csv.Error("empty file: no header") : status;
-  if (fields.empty() || fields[0] != "node") return csv.Error("header must start with 'node'");
-  while ((status = csv.NextRow(&fields)).ok()) {
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, KeyLocation* node) {
     if (fields.size() < 5) return csv.Error("expected 5 columns");
-    KeyLocation node;
     std::int64_t index = 0;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "node", &index));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "timestamp_ns", &node.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[2], "frame_index", &node.frame_index));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3], "response", &node.response));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "timestamp_ns", &node->timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[2], "frame_index", &node->frame_index));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3], "response", &node->response));
     if (fields[4] != "peak" && fields[4] != "valley") return csv.Error("kind must be peak or valley");
-    node.node_index = static_cast<int>(index);
-    node.kind = fields[4] == "peak" ? ExtremumKind::kPeak : ExtremumKind::kValley;
-    key_locations->push_back(node);
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
+    node->node_index = static_cast<int>(index);
+    node->kind = fields[4] == "peak" ? ExtremumKind::kPeak : ExtremumKind::kValley;
+    return Status::Ok();
+  };
+  return ReadHeaderedTable(path, "node", parse, key_locations);
 }
 
 }  // namespace patrolmap::eval

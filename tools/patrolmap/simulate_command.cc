@@ -171,7 +171,7 @@ void AddRouteOptions(CLI::App* app, sim::RouteOptions* flight) {
 Command AddSimulateCommand(CLI::App* app) {
   auto arguments = std::make_shared<SimulateArguments>();
   app->add_option("--route", arguments->route,
-                  "double-loop (~400 m), inner-loop (~142 m), l-shape (~85 m) through the village, street, or a "
+                  "double-loop (390 m), inner-loop (137 m), l-shape (82 m) through the village, street, or a "
                   "CSV file of x,y waypoints [m] in the village frame")
       ->capture_default_str();
   app->add_option("--seed", arguments->seed, "seed of the world, textures and flight")->capture_default_str();

@@ -34,10 +34,11 @@ struct Village {
 
 Village MakeVillage(const VillageOptions& options);
 
-// The paper's three experiments through the village: "double-loop" (two laps
-// around both blocks, ~400 m), "inner-loop" (around block A1 through the
-// passage, ~142 m) and "l-shape" (along A1's south side, north through the
-// passage, west along its north side, ~85 m). Fails for other names.
+// The paper's three experiments through the village (paper: ~375, ~155 and
+// ~85 m): "double-loop" (two laps around both blocks, 390 m flown), "inner-loop"
+// (around block A1 through the passage, 137 m) and "l-shape" (along A1's south
+// side, north through the passage, west along its north side, 82 m). Fails
+// for other names.
 Status RoutePreset(const std::string& name, Route* route);
 
 // Adds a box (four walls and a roof) to a scene: footprint centred at `centre`,
