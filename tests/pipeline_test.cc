@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/flow/key_location_detector.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/pipeline/detect.h"
 #include "patrolmap/sim/flight.h"
+#include "patrolmap/sim/route.h"
+#include "patrolmap/sim/village.h"
 #include "test_util.h"
 
 namespace patrolmap::pipeline {
@@ -78,7 +81,7 @@ TEST(Config, PartialFileKeepsOtherDefaults) {
 flow::DetectorOutput RunOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
   const Eigen::Matrix3d camera_from_imu = sim::BodyFromCamera(flight.mount_angle).transpose();
   flow::KeyLocationDetector detector(options, {flight.camera, camera_from_imu});
-  sim::Renderer renderer(&flight.scene, flight.camera);
+  sim::Renderer renderer(&flight.scene, flight.camera, flight.lighting);
   const std::vector<ImuSample> imu = sim::ImuSamples(flight);
   std::size_t next_imu = 0;
   flow::DetectorOutput output;
@@ -91,7 +94,7 @@ flow::DetectorOutput RunOnFlight(const sim::SimulatedFlight& flight, const flow:
     frame.speed_mps = flight.trajectory(i / flight.frame_rate_hz).velocity.norm();
     frame.image.release();
     if (detector.NeedsImage()) {
-      renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(i / flight.frame_rate_hz)), &frame.image);
+      renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(i / flight.frame_rate_hz)), &frame.image, i);
     }
     detector.Process(frame, &output);
   }
@@ -193,6 +196,42 @@ TEST(DetectEndToEnd, SpeedNormalisationRemovesNodesCausedBySpeedChanges) {
   }
   options.response.normalise_by_speed = false;
   EXPECT_NE(DetectOnFlight(flight, options).size(), 5u);
+}
+
+// The paper's experiment 3 as `patrolmap simulate --route l-shape --seed S` flies it (village, objects,
+// lighting and sensor noise of flight 1), scored like `patrolmap eval`. Measured: seed 1: 6 nodes for 5
+// expected, 2 false (a 1.5 s slit in the passage), 1 missed; seed 2: 4 nodes, 0 false, 1 missed (the paper
+// reports 3 false and 1 missed for this experiment). The bounds catch a regression of detection or simulator.
+eval::KeyLocationScore ScoreLShape(std::uint32_t seed) {
+  sim::SimulatedFlight flight;
+  sim::Village village = sim::MakeVillage({seed});
+  flight.scene = std::move(village.scene);
+  flight.lighting = sim::DrawLighting(seed, 1);
+  flight.objects = sim::PlaceObjects(12, seed);
+  sim::AddObjects(flight.objects, &flight.scene);
+  sim::Route route;
+  EXPECT_TRUE(sim::RoutePreset("l-shape", &route).ok());
+  sim::RouteOptions options;
+  options.seed = seed * 100u + 1u;
+  EXPECT_TRUE(sim::FlyRoute(route, options, &flight).ok());
+  std::vector<eval::TruthEdge> edges;
+  for (const sim::TruthKeyLocation& truth : sim::KeyLocationTruth(flight)) {
+    edges.push_back({truth.timestamp_ns, truth.frame_index, truth.opening});
+  }
+  return eval::ScoreKeyLocations(DetectOnFlight(flight, flow::KeyLocationOptions{}), edges);
+}
+
+TEST(DetectEndToEnd, VillageLShapeFlights) {
+  int expected = 0, missed = 0, false_positives = 0;
+  for (std::uint32_t seed : {1u, 2u}) {
+    const eval::KeyLocationScore score = ScoreLShape(seed);
+    EXPECT_LE(score.missed, 1) << seed;
+    EXPECT_LE(score.false_positives, 2) << seed;
+    expected += score.expected, missed += score.missed, false_positives += score.false_positives;
+  }
+  EXPECT_EQ(expected, 10);
+  EXPECT_LE(missed, 2);
+  EXPECT_LE(false_positives, 2);
 }
 
 TEST(DetectEndToEnd, HoveringCameraGivesNoKeyLocation) {
