@@ -1,6 +1,7 @@
 // Per-frame cost of the key-location (flow) stage: edges, LK tracking, polar
 // voting, response, smoothing and extremum detection on rendered street
 // frames. Run with OpenCV on one thread, as on one core of the onboard target.
+#include <cmath>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -9,6 +10,8 @@
 
 #include "patrolmap/flow/key_location_detector.h"
 #include "patrolmap/sim/flight.h"
+#include "patrolmap/sim/route.h"
+#include "patrolmap/sim/village.h"
 
 namespace {
 
@@ -91,6 +94,30 @@ void BM_RenderStreetFrame(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_RenderStreetFrame)->Arg(376)->Arg(752)->Unit(benchmark::kMillisecond);
+
+// Rendering the village along the double loop with 12 objects, lighting and sensor noise, as
+// `patrolmap simulate` does (without writing PNGs).
+void BM_RenderVillageFrame(benchmark::State& state) {
+  sim::SimulatedFlight flight;
+  sim::Village village = sim::MakeVillage({1});
+  flight.scene = std::move(village.scene);
+  flight.objects = sim::PlaceObjects(12, 1);
+  sim::AddObjects(flight.objects, &flight.scene);
+  sim::Route route;
+  sim::RoutePreset("double-loop", &route);
+  sim::FlyRoute(route, sim::RouteOptions{}, &flight);
+  flight.camera = flight.camera.Scaled(state.range(0) / 752.0);
+  sim::Renderer renderer(&flight.scene, flight.camera, sim::DrawLighting(1, 1));
+  cv::Mat image;
+  int frame = 0;
+  for (auto _ : state) {
+    const double t = std::fmod(frame * 7.3, flight.duration_s);  // spread over the whole flight
+    renderer.Render(sim::CameraPoseAt(flight, flight.trajectory(t)), &image, frame++);
+    benchmark::DoNotOptimize(image.data);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RenderVillageFrame)->Arg(376)->Arg(752)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
