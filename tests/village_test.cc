@@ -3,6 +3,8 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "patrolmap/sim/flight.h"
 #include "patrolmap/sim/objects.h"
@@ -167,6 +169,42 @@ TEST(EurocWriter, SameOptionsGiveTheSameLogByteForByte) {
     ++files;
   }
   EXPECT_GT(files, 100);
+}
+
+}  // namespace
+}  // namespace patrolmap::sim
+
+namespace patrolmap::sim {
+namespace {
+
+// Mean absolute horizontal gradient and mean grey of the middle frame of a written log.
+std::pair<double, double> MiddleFrameStatistics(const std::string& log) {
+  std::vector<std::string> names;
+  for (const auto& item : std::filesystem::directory_iterator(log + "/cam0/data")) names.push_back(item.path());
+  std::sort(names.begin(), names.end());
+  const cv::Mat image = cv::imread(names[names.size() / 2], cv::IMREAD_GRAYSCALE);
+  cv::Mat gradient;
+  cv::Sobel(image, gradient, CV_32F, 1, 0);
+  return {cv::mean(cv::abs(gradient))[0], cv::mean(image)[0]};
+}
+
+TEST(EurocWriter, MotionBlurSmearsAlongTheMotion) {
+  testing::TempDir dir;
+  std::pair<double, double> statistics[2];
+  for (int blurred = 0; blurred < 2; ++blurred) {
+    StreetOptions street;
+    street.walls = 2;
+    street.speed_mps = 8.0;
+    SimulatedFlight flight = MakeStreetFlight(street);
+    flight.camera = flight.camera.Scaled(0.5);
+    LogOptions options;
+    options.exposure_s = blurred ? 0.03 : 0.0;  // 24 cm of travel: ~11 px at 5 m
+    const std::string log = dir / (blurred ? "blurred" : "sharp");
+    ASSERT_TRUE(WriteEurocLog(flight, log, options).ok());
+    statistics[blurred] = MiddleFrameStatistics(log);
+  }
+  EXPECT_LT(statistics[1].first, 0.7 * statistics[0].first);   // much less horizontal detail
+  EXPECT_NEAR(statistics[1].second, statistics[0].second, 2.0);  // same brightness
 }
 
 }  // namespace

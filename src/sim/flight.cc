@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "patrolmap/core/files.h"
 
@@ -173,17 +174,37 @@ Status WriteImage(const std::string& path, const cv::Mat& image) {
   return cv::imwrite(path, image) ? Status::Ok() : Status::IoError(path + ": cannot write image");
 }
 
+// Renders frame `frame`; with an exposure time, the mean of kBlurSamples renders spread over it.
+void RenderFrame(const SimulatedFlight& flight, double exposure_s, int frame, Renderer* renderer, cv::Mat* image,
+                 cv::Mat* sum, cv::Mat* sample) {
+  constexpr int kBlurSamples = 5;
+  const double t = frame / flight.frame_rate_hz;
+  if (exposure_s <= 0.0) {
+    renderer->Render(CameraPoseAt(flight, flight.trajectory(t)), image, frame);
+    return;
+  }
+  sum->create(flight.camera.height, flight.camera.width, CV_32FC1);
+  sum->setTo(0.0);
+  for (int i = 0; i < kBlurSamples; ++i) {
+    const double offset = exposure_s * ((i + 0.5) / kBlurSamples - 0.5);
+    const double when = std::clamp(t + offset, 0.0, flight.duration_s);
+    renderer->Render(CameraPoseAt(flight, flight.trajectory(when)), sample, frame);
+    cv::accumulate(*sample, *sum);
+  }
+  sum->convertTo(*image, CV_8UC1, 1.0 / kBlurSamples);
+}
+
 Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
                    const ProgressCallback& progress, FrameTables* tables) {
   Renderer renderer(&flight.scene, flight.camera, flight.lighting);
   const int detector_step = std::max(1, static_cast<int>(std::lround(flight.frame_rate_hz / options.detector.rate_hz)));
-  cv::Mat image, depth;
+  cv::Mat image, depth, sum, sample;
   const int frames = FrameCount(flight);
   for (int frame = 0; frame < frames; ++frame) {
     const TimestampNs timestamp = FrameTimestamp(flight, frame);
     const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
     const std::string name = std::to_string(timestamp) + ".png";
-    renderer.Render(pose, &image, frame);
+    RenderFrame(flight, options.exposure_s, frame, &renderer, &image, &sum, &sample);
     PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/cam0/data/" + name, image));
     tables->images << timestamp << "," << name << "\n";
     if (options.depth) {

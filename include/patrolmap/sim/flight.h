@@ -44,6 +44,7 @@ struct LogOptions {
   bool detections = false;  // objects0/data.csv from the simulated detector
   bool depth = false;       // depth0/: 16-bit PNG depth along the optical axis [mm]
   bool gps = false;         // gps0/data.csv at 10 Hz with 1.5 m noise
+  double exposure_s = 0.0;  // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
   DetectorOptions detector;
   double gps_origin_latitude = 47.3572;  // village origin (the paper's site is near Birmensdorf) [deg]
   double gps_origin_longitude = 8.4370;
