@@ -15,10 +15,15 @@ namespace patrolmap::sim {
 namespace {
 
 constexpr double kGravity = 9.81;
-// A view-axis depth jump is a key location when the inverse depth (what optical
-// flow measures) changes by at least this much [1/m]: 6 m -> 48 m is one,
-// 22 m -> 35 m behind a gap is not.
+// The view axis passes a key location when the inverse depth along it (what
+// optical flow measures) has changed by at least this much since the last one
+// [1/m]: 6 m -> 48 m is one, 22 m -> 35 m behind a gap is not; a wall seen
+// obliquely counts once its gradual change adds up.
 constexpr double kMinInverseDepthChange = 0.05;
+// While the platform turns faster than this, the axis sweeps over the scene by
+// rotation, not by passing buildings: no key location, and the reference
+// restarts after the turn [rad/s] (corner arcs turn at 0.43 rad/s).
+constexpr double kTurnRate = 0.25;
 
 Eigen::Matrix3d WorldFromBody(double heading) {
   return Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -280,23 +285,28 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
   Renderer renderer(&flight.scene, flight.camera);
   std::vector<double> depths;
   const int centre = static_cast<int>(std::lround(flight.camera.cx));
-  CameraPose previous = CameraPoseAt(flight, flight.trajectory(0.0));
-  double previous_depth = AxisDepth(&renderer, previous, centre, &depths);
+  // Inverse depth along the axis at the last event (or the start); sky is 0.
+  double reference = 1.0 / AxisDepth(&renderer, CameraPoseAt(flight, flight.trajectory(0.0)), centre, &depths);
   for (int frame = 1; frame < FrameCount(flight); ++frame) {
-    const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
+    const PlatformState state = flight.trajectory(frame / flight.frame_rate_hz);
+    const CameraPose pose = CameraPoseAt(flight, state);
     const double depth = AxisDepth(&renderer, pose, centre, &depths);
-    if (std::abs(1.0 / depth - 1.0 / previous_depth) >= kMinInverseDepthChange) {
-      TruthKeyLocation event;
-      event.timestamp_ns = FrameTimestamp(flight, frame);
-      event.frame_index = frame;
-      event.opening = depth > previous_depth;
-      event.depth_before = previous_depth;
-      event.depth_after = depth;
-      const Eigen::Vector3d axis = WorldFromCameraRotation(pose.yaw).col(2);
-      event.edge = (pose.position + std::min(depth, previous_depth) * axis).head<2>();
-      truth.push_back(event);
+    const double inverse = 1.0 / depth;
+    if (std::abs(state.yaw_rate) > kTurnRate) {  // the axis sweeps because the platform turns: no event
+      reference = inverse;
+      continue;
     }
-    previous_depth = depth;
+    if (std::abs(inverse - reference) < kMinInverseDepthChange) continue;
+    TruthKeyLocation event;
+    event.timestamp_ns = FrameTimestamp(flight, frame);
+    event.frame_index = frame;
+    event.opening = inverse < reference;
+    event.depth_before = 1.0 / reference;
+    event.depth_after = depth;
+    const Eigen::Vector3d axis = WorldFromCameraRotation(pose.yaw).col(2);
+    event.edge = (pose.position + std::min(depth, event.depth_before) * axis).head<2>();
+    truth.push_back(event);
+    reference = inverse;
   }
   return truth;
 }

@@ -54,8 +54,12 @@ struct LogOptions {
 // Camera pose of the platform state for the flight's mount angle.
 CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& state);
 
-// Ground-truth key location: a vertical building edge crossing the optical axis
-// with a jump of the inverse depth along the axis of at least 0.05 1/m.
+// Ground-truth key location: the optical axis passes from a near surface to a
+// far one (opening) or back (closing) — a building edge crossing the axis —
+// once the inverse depth along the axis has changed by at least 0.05 1/m since
+// the previous key location (a wall seen obliquely counts when its gradual
+// change adds up to that). None while the platform turns faster than
+// 0.25 rad/s (the view sweeps by rotation then, not by passing buildings).
 struct TruthKeyLocation {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
