@@ -94,22 +94,16 @@ KeyLocationScore ScoreKeyLocations(const std::vector<KeyLocation>& detected, con
 }
 
 Status ReadTruthEdges(const std::string& log, std::vector<TruthEdge>* edges) {
-  edges->clear();
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(log + "/groundtruth/key_locations.csv"));
-  std::vector<std::string_view> fields;
-  Status status;
-  while ((status = csv.NextRow(&fields)).ok()) {
+  const auto parse = [edges](const CsvReader& csv, const std::vector<std::string_view>& fields, TruthEdge* edge) {
     if (fields.size() < 3) return csv.Error("expected at least 3 columns");
-    TruthEdge edge;
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &edge.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "frame_index", &edge.frame_index));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &edge->timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "frame_index", &edge->frame_index));
     if (fields[2] != "opening" && fields[2] != "closing") return csv.Error("kind must be opening or closing");
-    if (!edges->empty() && edge.timestamp_ns < edges->back().timestamp_ns) return csv.Error("timestamps go back");
-    edge.opening = fields[2] == "opening";
-    edges->push_back(edge);
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
+    if (!edges->empty() && edge->timestamp_ns < edges->back().timestamp_ns) return csv.Error("timestamps go back");
+    edge->opening = fields[2] == "opening";
+    return Status::Ok();
+  };
+  return ReadTable(log + "/groundtruth/key_locations.csv", nullptr, parse, edges);
 }
 
 Status ReadKeyLocationsCsv(const std::string& path, std::vector<KeyLocation>* key_locations) {
@@ -125,7 +119,7 @@ Status ReadKeyLocationsCsv(const std::string& path, std::vector<KeyLocation>* ke
     node->kind = fields[4] == "peak" ? ExtremumKind::kPeak : ExtremumKind::kValley;
     return Status::Ok();
   };
-  return ReadHeaderedTable(path, "node", parse, key_locations);
+  return ReadTable(path, "node", parse, key_locations);
 }
 
 }  // namespace patrolmap::eval

@@ -72,23 +72,16 @@ LoopClosureScore ScoreLoopClosures(const std::vector<NodeRecord>& nodes, const s
 }
 
 Status ReadPlaces(const std::string& log, std::vector<Place>* places_by_frame) {
-  places_by_frame->clear();
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(log + "/groundtruth/places.csv"));
-  std::vector<std::string_view> fields;
-  Status status;
-  while ((status = csv.NextRow(&fields)).ok()) {
+  const auto parse = [places_by_frame](const CsvReader& csv, const std::vector<std::string_view>& fields, Place* place) {
     if (fields.size() < 6) return csv.Error("expected 6 columns");
     std::int64_t frame = 0;
-    Place place;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "frame_index", &frame));
     if (frame != static_cast<std::int64_t>(places_by_frame->size())) return csv.Error("frames must run 0, 1, 2, ...");
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[2], "x [m]", &place.x));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3], "y [m]", &place.y));
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[5], "camera_yaw [rad]", &place.yaw));
-    places_by_frame->push_back(place);
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[2], "x [m]", &place->x));
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3], "y [m]", &place->y));
+    return csv.ParseDouble(fields[5], "camera_yaw [rad]", &place->yaw);
+  };
+  return ReadTable(log + "/groundtruth/places.csv", nullptr, parse, places_by_frame);
 }
 
 Status ReadNodesCsv(const std::string& path, std::vector<NodeRecord>* nodes) {
@@ -99,7 +92,7 @@ Status ReadNodesCsv(const std::string& path, std::vector<NodeRecord>* nodes) {
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[2], "timestamp_ns", &node->timestamp_ns));
     return csv.ParseInt64(fields[3], "frame_index", &node->frame_index);
   };
-  return ReadHeaderedTable(path, "node", parse, nodes);
+  return ReadTable(path, "node", parse, nodes);
 }
 
 Status ReadLoopClosuresCsv(const std::string& path, std::vector<LoopClosureRecord>* closures) {
@@ -108,7 +101,7 @@ Status ReadLoopClosuresCsv(const std::string& path, std::vector<LoopClosureRecor
     PATROLMAP_RETURN_IF_ERROR(ParseInt(csv, fields[0], "query_node", &row->query_node));
     return ParseInt(csv, fields[1], "matched_node", &row->matched_node);
   };
-  return ReadHeaderedTable(path, "query_node", parse, closures);
+  return ReadTable(path, "query_node", parse, closures);
 }
 
 }  // namespace patrolmap::eval

@@ -42,18 +42,23 @@ class CsvReader {
 // Splits `line` at commas, trimming spaces, tabs and a trailing '\r'.
 void SplitCsvLine(std::string_view line, std::vector<std::string_view>* fields);
 
-// Reads a table whose first line is a header starting with `first_column` (as
-// patrolmap writes its outputs); `parse(csv, fields, &row)` reads each row.
+// Reads a table row by row with `parse(csv, fields, &row)`. With a
+// `first_column`, the first row is a header that must start with it (as
+// patrolmap writes its outputs); with nullptr every row is data (headers are
+// '#' comments, as in EuRoC tables and the simulator's ground truth).
 template <typename Row, typename Parse>
-Status ReadHeaderedTable(const std::string& path, const char* first_column, Parse parse, std::vector<Row>* rows) {
+Status ReadTable(const std::string& path, const char* first_column, Parse parse, std::vector<Row>* rows) {
   rows->clear();
   CsvReader csv;
   PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
   std::vector<std::string_view> fields;
-  Status status = csv.NextRow(&fields);
-  if (!status.ok()) return status.end_of_stream() ? csv.Error("empty file: no header") : status;
-  if (fields.empty() || fields[0] != first_column) {
-    return csv.Error(std::string("header must start with '") + first_column + "'");
+  Status status;
+  if (first_column != nullptr) {
+    status = csv.NextRow(&fields);
+    if (!status.ok()) return status.end_of_stream() ? csv.Error("empty file: no header") : status;
+    if (fields.empty() || fields[0] != first_column) {
+      return csv.Error(std::string("header must start with '") + first_column + "'");
+    }
   }
   while ((status = csv.NextRow(&fields)).ok()) {
     Row row;
