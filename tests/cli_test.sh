@@ -52,9 +52,9 @@ expect "malformed csv" 1 "cam0/data.csv:7: column 'timestamp \[ns\]': not an int
   "$bin" detect "$work/log" --out "$work/out3"
 
 # The committed sample log (flight_logs/sample) still reads, detects and scores: 3 of 3 nodes, none false.
-expect "sample detect" 0 "337 frames, 68 processed, 3 key locations" -- \
+expect "sample detect" 0 "421 frames, 85 processed, 3 key locations" -- \
   "$bin" detect "$source_dir/flight_logs/sample" --out "$work/sample"
-expect "sample eval" 0 "street-1 +337 +3 +3 +3 +0 +0" -- "$bin" eval "$work/sample" --log "$source_dir/flight_logs/sample"
+expect "sample eval" 0 "street-1 +421 +3 +3 +3 +0 +0" -- "$bin" eval "$work/sample" --log "$source_dir/flight_logs/sample"
 expect "eval without outputs" 1 "holds neither key_locations.csv nor loop_closures.csv" -- \
   "$bin" eval "$work/empty" --log "$source_dir/flight_logs/sample"
 expect "unknown route" 2 "unknown route 'zigzag'" -- "$bin" simulate --route zigzag --out "$work/z"
