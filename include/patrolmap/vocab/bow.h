@@ -1,0 +1,28 @@
+// Bag-of-words vectors and their similarity (paper 002 §III-B; the L1 score of
+// Nistér and Stewénius as DBoW2 uses it).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace patrolmap::vocab {
+
+using WordId = std::uint32_t;
+
+// A sparse, L1-normalised TF-IDF vector: words sorted ascending, weights > 0 summing to 1.
+struct BowVector {
+  std::vector<WordId> words;
+  std::vector<float> weights;
+  bool empty() const { return words.empty(); }
+};
+
+// Similarity of two L1-normalised vectors: 1 - |a - b|_1 / 2, in [0, 1]; 1 for
+// identical vectors, 0 for vectors without a common word.
+double L1Score(const BowVector& a, const BowVector& b);
+
+// Builds a BowVector from per-descriptor words and per-word weights (idf):
+// term frequency times weight, L1-normalised; words with weight 0 are dropped.
+void MakeBowVector(const std::vector<WordId>& descriptor_words, const std::vector<float>& word_weights,
+                   BowVector* bow);
+
+}  // namespace patrolmap::vocab
