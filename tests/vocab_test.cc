@@ -110,9 +110,9 @@ TEST(Vocabulary, BadTrainingInputIsRefused) {
 TEST(BowVector, IdenticalScoresOneDisjointZero) {
   const std::vector<float> idf = {1.0f, 2.0f, 0.5f, 1.0f, 0.0f};
   BowVector a, b, c;
-  MakeBowVector({0, 1, 1, 2}, idf, &a);
-  MakeBowVector({0, 1, 1, 2}, idf, &b);
-  MakeBowVector({3, 4}, idf, &c);  // word 4 has idf 0 and is dropped
+  MakeBowVector({0, 1, 1, 2}, idf.data(), &a);
+  MakeBowVector({0, 1, 1, 2}, idf.data(), &b);
+  MakeBowVector({3, 4}, idf.data(), &c);  // word 4 has idf 0 and is dropped
   EXPECT_NEAR(L1Score(a, b), 1.0, 1e-6);
   EXPECT_NEAR(L1Score(a, c), 0.0, 1e-12);
   ASSERT_EQ(c.words, (std::vector<WordId>{3}));
@@ -121,7 +121,7 @@ TEST(BowVector, IdenticalScoresOneDisjointZero) {
   EXPECT_NEAR(sum, 1.0f, 1e-6);
   EXPECT_NEAR(a.weights[1], 4.0 / 5.5, 1e-6);  // tf 2 x idf 2 of 1 + 4 + 0.5
   BowVector d;
-  MakeBowVector({0, 1}, idf, &d);
+  MakeBowVector({0, 1}, idf.data(), &d);
   EXPECT_NEAR(L1Score(a, d), L1Score(d, a), 1e-12);
   EXPECT_GT(L1Score(a, d), 0.3);
   EXPECT_LT(L1Score(a, d), 1.0);
@@ -179,12 +179,12 @@ TEST_F(VocabularyFileTest, EveryCorruptCaseFailsWithAMessage) {
 TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
   const std::vector<float> idf(10, 1.0f);
   BowVector a, b, c, query;
-  MakeBowVector({0, 1, 2, 3}, idf, &a);
-  MakeBowVector({0, 1, 7, 8}, idf, &b);
-  MakeBowVector({5, 6}, idf, &c);
+  MakeBowVector({0, 1, 2, 3}, idf.data(), &a);
+  MakeBowVector({0, 1, 7, 8}, idf.data(), &b);
+  MakeBowVector({5, 6}, idf.data(), &c);
   Database database(10);
   database.Add(a), database.Add(b), database.Add(c);
-  MakeBowVector({0, 1, 2, 3}, idf, &query);
+  MakeBowVector({0, 1, 2, 3}, idf.data(), &query);
   std::vector<QueryResult> results;
   database.Query(query, 3, {}, &results);
   ASSERT_EQ(results.size(), 2u);  // c shares no word

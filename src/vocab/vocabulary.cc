@@ -188,7 +188,7 @@ void Vocabulary::Quantize(const cv::Mat& descriptors, std::vector<WordId>* words
 void Vocabulary::Transform(const cv::Mat& descriptors, BowVector* bow) const {
   std::vector<WordId> words;
   Quantize(descriptors, &words);
-  MakeBowVector(words, idf_, bow);
+  MakeBowVector(words, idf_.data(), bow);
 }
 
 std::uint32_t Vocabulary::AncestorOf(WordId word, int levels_up) const {

@@ -7,7 +7,8 @@
 //   f32       centre scale
 //   arrays    first_child u32[n], child_count u16[n], word i32[n], parent u32[n],
 //             centres u8[n * dimension], idf f32[w], leaf u32[w]
-//   u64       checksum of everything from the version to the last array
+//   u64       checksum of everything from the version to the last array,
+//             chained section by section (so loading reads each byte once)
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -22,9 +23,10 @@ constexpr char kMagic[8] = {'P', 'M', 'V', 'O', 'C', 'A', 'B', '\0'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::size_t kHeaderBytes = 8 + 4 * 6 + 4;
 
-// A fast 64-bit checksum over 8-byte words (and the tail bytes).
-std::uint64_t Checksum(const char* data, std::size_t size) {
-  std::uint64_t hash = 0x9E3779B97F4A7C15ull ^ size;
+// A fast 64-bit checksum over 8-byte words (and the tail bytes), chained
+// section by section from `hash`.
+std::uint64_t Checksum(const char* data, std::size_t size, std::uint64_t hash) {
+  hash ^= size;
   std::size_t i = 0;
   for (; i + 8 <= size; i += 8) {
     std::uint64_t word;
@@ -37,7 +39,7 @@ std::uint64_t Checksum(const char* data, std::size_t size) {
 }
 
 template <typename T>
-void Append(const std::vector<T>& values, std::string* out) {
+void Append(const Array<T>& values, std::string* out) {
   out->append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
 
@@ -46,68 +48,62 @@ void AppendValue(T value, std::string* out) {
   out->append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
+// Reads `count` values straight into `values`, folding their bytes into the checksum.
 template <typename T>
-void Take(const char** cursor, std::size_t count, std::vector<T>* values) {
+bool Take(std::ifstream* stream, std::size_t count, Array<T>* values, std::uint64_t* checksum) {
   values->resize(count);
-  std::memcpy(values->data(), *cursor, count * sizeof(T));
-  *cursor += count * sizeof(T);
+  const std::size_t bytes = count * sizeof(T);
+  if (!stream->read(reinterpret_cast<char*>(values->data()), static_cast<std::streamsize>(bytes))) return false;
+  *checksum = Checksum(reinterpret_cast<const char*>(values->data()), bytes, *checksum);
+  return true;
 }
 
 std::size_t BodyBytes(std::uint64_t nodes, std::uint64_t words, std::uint64_t dimension) {
   return nodes * (4 + 2 + 4 + 4 + dimension) + words * (4 + 4);
 }
 
-Status ReadWhole(const std::string& path, std::string* bytes) {
-  std::error_code error;
-  const auto size = std::filesystem::file_size(path, error);
-  if (error) return Status::NotFound(path + ": cannot read vocabulary: " + error.message());
-  std::ifstream stream(path, std::ios::binary);
-  bytes->resize(size);
-  if (!stream.read(bytes->data(), static_cast<std::streamsize>(size))) return Status::IoError(path + ": read failed");
-  return Status::Ok();
-}
+constexpr std::uint64_t kChecksumSeed = 0x9E3779B97F4A7C15ull;
 
 }  // namespace
 
 // Befriended by Vocabulary to fill its arrays.
 struct VocabularyFile {
-  static Status Parse(const std::string& path, const std::string& bytes, Vocabulary* v) {
-    if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
-      return Status::DataLoss(path + ": not a patrolmap vocabulary file");
-    }
-    if (bytes.size() < kHeaderBytes) return Status::DataLoss(path + ": truncated vocabulary (header incomplete)");
-    std::uint32_t header[6];
-    std::memcpy(header, bytes.data() + 8, sizeof(header));
-    if (header[0] > kVersion) {
-      return Status::DataLoss(path + ": vocabulary format version " + std::to_string(header[0]) +
+  static Status Read(const std::string& path, Vocabulary* v) {
+    std::error_code error;
+    const std::uint64_t size = std::filesystem::file_size(path, error);
+    if (error) return Status::NotFound(path + ": cannot read vocabulary: " + error.message());
+    std::ifstream stream(path, std::ios::binary);
+    char header[kHeaderBytes] = {};
+    stream.read(header, static_cast<std::streamsize>(std::min<std::uint64_t>(size, kHeaderBytes)));
+    if (size < 8 || std::memcmp(header, kMagic, 8) != 0) return Status::DataLoss(path + ": not a patrolmap vocabulary file");
+    if (size < kHeaderBytes) return Status::DataLoss(path + ": truncated vocabulary (header incomplete)");
+    std::uint32_t fields[6];
+    std::memcpy(fields, header + 8, sizeof(fields));
+    if (fields[0] > kVersion) {
+      return Status::DataLoss(path + ": vocabulary format version " + std::to_string(fields[0]) +
                               " is newer than this patrolmap reads (" + std::to_string(kVersion) + ")");
     }
-    const std::uint64_t nodes = header[4], words = header[5], dimension = header[3];
-    const std::size_t expected = kHeaderBytes + BodyBytes(nodes, words, dimension) + 8;
-    if (bytes.size() < expected) {
-      return Status::DataLoss(path + ": truncated vocabulary (" + std::to_string(bytes.size()) + " of " +
+    const std::uint64_t nodes = fields[4], words = fields[5], dimension = fields[3];
+    const std::uint64_t expected = kHeaderBytes + BodyBytes(nodes, words, dimension) + 8;
+    if (size < expected) {
+      return Status::DataLoss(path + ": truncated vocabulary (" + std::to_string(size) + " of " +
                               std::to_string(expected) + " bytes)");
     }
-    if (bytes.size() > expected) return Status::DataLoss(path + ": corrupt vocabulary (trailing bytes)");
-    std::uint64_t stored;
-    std::memcpy(&stored, bytes.data() + expected - 8, 8);
-    if (stored != Checksum(bytes.data() + 8, expected - 16)) {
-      return Status::DataLoss(path + ": corrupt vocabulary (checksum mismatch)");
-    }
+    if (size > expected) return Status::DataLoss(path + ": corrupt vocabulary (trailing bytes)");
     if (nodes == 0 || words == 0 || dimension == 0) return Status::DataLoss(path + ": corrupt vocabulary (empty tree)");
     *v = Vocabulary();
-    v->branching_ = static_cast<int>(header[1]);
-    v->depth_ = static_cast<int>(header[2]);
+    v->branching_ = static_cast<int>(fields[1]);
+    v->depth_ = static_cast<int>(fields[2]);
     v->dimension_ = static_cast<int>(dimension);
-    std::memcpy(&v->scale_, bytes.data() + 8 + 4 * 6, 4);
-    const char* cursor = bytes.data() + kHeaderBytes;
-    Take(&cursor, nodes, &v->first_child_);
-    Take(&cursor, nodes, &v->child_count_);
-    Take(&cursor, nodes, &v->word_);
-    Take(&cursor, nodes, &v->parent_);
-    Take(&cursor, nodes * dimension, &v->centres_);
-    Take(&cursor, words, &v->idf_);
-    Take(&cursor, words, &v->leaf_);
+    std::memcpy(&v->scale_, header + 8 + 4 * 6, 4);
+    std::uint64_t checksum = Checksum(header + 8, kHeaderBytes - 8, kChecksumSeed);
+    const bool read = Take(&stream, nodes, &v->first_child_, &checksum) && Take(&stream, nodes, &v->child_count_, &checksum) &&
+                      Take(&stream, nodes, &v->word_, &checksum) && Take(&stream, nodes, &v->parent_, &checksum) &&
+                      Take(&stream, nodes * dimension, &v->centres_, &checksum) &&
+                      Take(&stream, words, &v->idf_, &checksum) && Take(&stream, words, &v->leaf_, &checksum);
+    std::uint64_t stored = 0;
+    if (!read || !stream.read(reinterpret_cast<char*>(&stored), 8)) return Status::IoError(path + ": read failed");
+    if (stored != checksum) return Status::DataLoss(path + ": corrupt vocabulary (checksum mismatch)");
     return Validate(path, *v);
   }
 
@@ -139,14 +135,20 @@ struct VocabularyFile {
       AppendValue(value, &out);
     }
     AppendValue(v.scale_, &out);
-    Append(v.first_child_, &out);
-    Append(v.child_count_, &out);
-    Append(v.word_, &out);
-    Append(v.parent_, &out);
-    Append(v.centres_, &out);
-    Append(v.idf_, &out);
-    Append(v.leaf_, &out);
-    AppendValue(Checksum(out.data() + 8, out.size() - 8), &out);
+    std::uint64_t checksum = Checksum(out.data() + 8, out.size() - 8, kChecksumSeed);
+    const auto section = [&out, &checksum](const auto& values) {
+      const std::size_t start = out.size();
+      Append(values, &out);
+      checksum = Checksum(out.data() + start, out.size() - start, checksum);
+    };
+    section(v.first_child_);
+    section(v.child_count_);
+    section(v.word_);
+    section(v.parent_);
+    section(v.centres_);
+    section(v.idf_);
+    section(v.leaf_);
+    AppendValue(checksum, &out);
     return out;
   }
 };
@@ -157,9 +159,7 @@ Status Vocabulary::Save(const std::string& path) const {
 }
 
 Status Vocabulary::Load(const std::string& path, Vocabulary* vocabulary) {
-  std::string bytes;
-  PATROLMAP_RETURN_IF_ERROR(ReadWhole(path, &bytes));
-  return VocabularyFile::Parse(path, bytes, vocabulary);
+  return VocabularyFile::Read(path, vocabulary);
 }
 
 }  // namespace patrolmap::vocab

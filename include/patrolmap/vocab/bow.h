@@ -20,9 +20,10 @@ struct BowVector {
 // identical vectors, 0 for vectors without a common word.
 double L1Score(const BowVector& a, const BowVector& b);
 
-// Builds a BowVector from per-descriptor words and per-word weights (idf):
+// Builds a BowVector from per-descriptor words and per-word weights (idf,
+// indexed by word):
 // term frequency times weight, L1-normalised; words with weight 0 are dropped.
-void MakeBowVector(const std::vector<WordId>& descriptor_words, const std::vector<float>& word_weights,
+void MakeBowVector(const std::vector<WordId>& descriptor_words, const float* word_weights,
                    BowVector* bow);
 
 }  // namespace patrolmap::vocab

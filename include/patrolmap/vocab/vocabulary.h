@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,30 @@
 #include "patrolmap/vocab/bow.h"
 
 namespace patrolmap::vocab {
+
+// An allocator whose resize() leaves new elements uninitialised, so loading a
+// large vocabulary writes each byte once (the file read) instead of twice.
+template <typename T>
+struct UninitialisedAllocator : std::allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <typename U>
+  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+  template <typename U>
+  void construct(U* pointer) noexcept {
+    ::new (static_cast<void*>(pointer)) U;
+  }
+  template <typename U, typename... Args>
+  void construct(U* pointer, Args&&... args) {
+    ::new (static_cast<void*>(pointer)) U(std::forward<Args>(args)...);
+  }
+};
+
+template <typename T>
+using Array = std::vector<T, UninitialisedAllocator<T>>;
 
 struct VocabularyOptions {
   int branching = 10;          // k: children per node
@@ -46,7 +71,7 @@ class Vocabulary {
   int dimension() const { return dimension_; }
   int branching() const { return branching_; }
   int depth() const { return depth_; }
-  const std::vector<float>& idf() const { return idf_; }
+  const Array<float>& idf() const { return idf_; }
   bool empty() const { return idf_.empty(); }
 
   // Versioned binary file (vocabulary_file.cc): magic, version, parameters,
@@ -63,18 +88,18 @@ class Vocabulary {
   int depth_ = 0;
   int dimension_ = 0;
   // Per node, in breadth-first order (node 0 is the root):
-  std::vector<std::uint32_t> first_child_;  // index of the first child; children are contiguous
-  std::vector<std::uint16_t> child_count_;  // 0 for a leaf
-  std::vector<std::int32_t> word_;          // word id of a leaf, -1 otherwise
-  std::vector<std::uint32_t> parent_;       // parent node; the root is its own parent
+  Array<std::uint32_t> first_child_;  // index of the first child; children are contiguous
+  Array<std::uint16_t> child_count_;  // 0 for a leaf
+  Array<std::int32_t> word_;          // word id of a leaf, -1 otherwise
+  Array<std::uint32_t> parent_;       // parent node; the root is its own parent
   // node_count x dimension cluster centres in 8 bits: round(centre * scale_),
   // so SIFT (0..255) and RootSIFT (0..1) both use the full range; distances
   // are computed in float against the scaled descriptor.
-  std::vector<std::uint8_t> centres_;
+  Array<std::uint8_t> centres_;
   float scale_ = 1.0f;
   // Per word:
-  std::vector<float> idf_;                  // log(N / n_i); 0 for words no training image had
-  std::vector<std::uint32_t> leaf_;         // node of each word
+  Array<float> idf_;                  // log(N / n_i); 0 for words no training image had
+  Array<std::uint32_t> leaf_;         // node of each word
 };
 
 }  // namespace patrolmap::vocab

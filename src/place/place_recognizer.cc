@@ -1,0 +1,135 @@
+#include "patrolmap/place/place_recognizer.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+
+namespace patrolmap::place {
+namespace {
+
+double Since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+int MethodFlag(FundamentalMethod method) {
+  switch (method) {
+    case FundamentalMethod::kRansac: return cv::FM_RANSAC;
+    case FundamentalMethod::kUsacDefault: return cv::USAC_DEFAULT;
+    case FundamentalMethod::kUsacMagsac: return cv::USAC_MAGSAC;
+  }
+  return cv::USAC_MAGSAC;
+}
+
+// RootSIFT: L1-normalise each descriptor, then take the square root (components in [0, 1]).
+void ToRootSift(cv::Mat* descriptors) {
+  for (int row = 0; row < descriptors->rows; ++row) {
+    float* d = descriptors->ptr<float>(row);
+    double sum = 0.0;
+    for (int i = 0; i < descriptors->cols; ++i) sum += std::abs(d[i]);
+    if (sum <= 0.0) continue;
+    for (int i = 0; i < descriptors->cols; ++i) d[i] = static_cast<float>(std::sqrt(std::abs(d[i]) / sum));
+  }
+}
+
+}  // namespace
+
+bool PlaceOptions::IsValid(std::string* error) const {
+  if (max_features < 8) return *error = "place.max_features must be at least 8", false;
+  if (candidates < 1) return *error = "place.candidates must be at least 1", false;
+  if (!(ratio > 0.0 && ratio <= 1.0)) return *error = "place.ratio must be in (0, 1]", false;
+  if (!(min_matched_fraction >= 0.0 && min_matched_fraction <= 1.0)) {
+    return *error = "place.min_matched_fraction must be in [0, 1]", false;
+  }
+  if (!(inlier_threshold_px > 0.0)) return *error = "place.inlier_threshold_px must be positive", false;
+  if (min_inliers < 8) return *error = "place.min_inliers must be at least 8 (the 8-point algorithm)", false;
+  return true;
+}
+
+PlaceRecognizer::PlaceRecognizer(const vocab::Vocabulary* vocabulary, const PlaceOptions& options)
+    : vocabulary_(vocabulary), options_(options), database_(vocabulary->word_count()) {
+  std::string error;
+  PATROLMAP_CHECK(options.IsValid(&error));
+  PATROLMAP_CHECK(vocabulary != nullptr && !vocabulary->empty() && vocabulary->dimension() == 128);
+}
+
+void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::vector<cv::KeyPoint>* keypoints,
+                      cv::Mat* descriptors) {
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
+  sift->detectAndCompute(image, cv::noArray(), *keypoints, *descriptors);
+  if (descriptors->empty()) *descriptors = cv::Mat(0, 128, CV_32F);
+  if (options.root_sift) ToRootSift(descriptors);
+}
+
+Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
+                                     const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate) const {
+  Verification verification;
+  if (query.rows < 2 || candidate.rows < 2) return verification;
+  std::vector<std::vector<cv::DMatch>> knn;
+  cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
+  std::vector<cv::Point2f> from, to;
+  for (const auto& pair : knn) {
+    if (pair.size() < 2 || pair[0].distance >= options_.ratio * pair[1].distance) continue;
+    from.push_back(query_points[pair[0].queryIdx].pt);
+    to.push_back(candidate_points[pair[0].trainIdx].pt);
+  }
+  verification.matches = static_cast<int>(from.size());
+  verification.matched_fraction = static_cast<double>(from.size()) / std::min(query.rows, candidate.rows);
+  if (verification.matched_fraction < options_.min_matched_fraction || verification.matches < options_.min_inliers) {
+    return verification;
+  }
+  std::vector<unsigned char> mask;
+  const cv::Mat f = cv::findFundamentalMat(from, to, MethodFlag(options_.method), options_.inlier_threshold_px, 0.999,
+                                           2000, mask);
+  verification.inliers = f.empty() ? 0 : cv::countNonZero(mask);
+  verification.accepted = verification.inliers >= options_.min_inliers;
+  return verification;
+}
+
+bool PlaceRecognizer::Allowed(const KeyFrame& query, int node) const {
+  const Node& candidate = nodes_[node];
+  if (candidate.flight != query.flight) return true;
+  return NsToSeconds(query.timestamp_ns - candidate.timestamp_ns) >= options_.exclude_recent_s;
+}
+
+Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* result) {
+  if (key_frame.image.empty() || key_frame.image.type() != CV_8UC1) {
+    return Status::InvalidArgument("key frame " + std::to_string(key_frame.frame_index) + " has no grey image");
+  }
+  *result = PlaceResult();
+  auto start = std::chrono::steady_clock::now();
+  Node node{key_frame.flight, key_frame.timestamp_ns, {}, {}};
+  DescribeFeatures(key_frame.image, options_, &node.keypoints, &node.descriptors);
+  vocab::BowVector bow;
+  vocabulary_->Transform(node.descriptors, &bow);
+  result->features = node.descriptors.rows;
+  result->seconds_features = Since(start);
+
+  start = std::chrono::steady_clock::now();
+  std::vector<vocab::QueryResult> candidates;
+  database_.Query(bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); },
+                  &candidates);
+  result->seconds_query = Since(start);
+
+  start = std::chrono::steady_clock::now();
+  for (const vocab::QueryResult& candidate : candidates) {
+    const Node& other = nodes_[candidate.entry];
+    Verification verification = Verify(node.keypoints, node.descriptors, other.keypoints, other.descriptors);
+    verification.node = static_cast<int>(candidate.entry);
+    verification.bow_score = candidate.score;
+    result->candidates.push_back(verification);
+    if (!verification.accepted) continue;
+    if (!result->match || verification.inliers > result->match->inliers) result->match = verification;
+    if (!options_.accept_best) break;  // the paper stops at the first verified candidate
+  }
+  result->seconds_verify = Since(start);
+
+  start = std::chrono::steady_clock::now();
+  result->node = static_cast<int>(database_.Add(bow));
+  nodes_.push_back(std::move(node));
+  result->seconds_add = Since(start);
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::place

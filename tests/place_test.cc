@@ -1,0 +1,141 @@
+#include <filesystem>
+#include <random>
+
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/place/place_recognizer.h"
+
+namespace patrolmap::place {
+namespace {
+
+const std::string kShared = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data";
+const std::string kOpencvData = "/usr/share/doc/opencv-doc/examples/data";
+
+// A small vocabulary trained on the features of `images`.
+vocab::Vocabulary VocabularyFor(const std::vector<cv::Mat>& images, const PlaceOptions& options) {
+  vocab::Vocabulary vocabulary;
+  std::vector<cv::Mat> descriptors;
+  for (const cv::Mat& image : images) {
+    std::vector<cv::KeyPoint> keypoints;
+    cv::Mat d;
+    DescribeFeatures(image, options, &keypoints, &d);
+    descriptors.push_back(d);
+  }
+  vocab::VocabularyOptions vocabulary_options;
+  vocabulary_options.branching = 8;
+  vocabulary_options.depth = 3;
+  EXPECT_TRUE(vocab::Vocabulary::Train(descriptors, vocabulary_options, &vocabulary).ok());
+  return vocabulary;
+}
+
+// Two views of random 3D points with a known relative pose; descriptors are random per point (plus
+// noise in the second view), and `outliers` extra points per view match nothing.
+TEST(Verify, SyntheticTwoViewGeometryWithOutliers) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> pixel_noise(0.0, 0.3);
+  std::normal_distribution<float> descriptor_noise(0.0f, 3.0f);
+  const double f = 400.0, cx = 320.0, cy = 240.0;
+  std::vector<cv::KeyPoint> a, b;
+  cv::Mat da(0, 128, CV_32F), db(0, 128, CV_32F);
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d p(4.0 * u(rng), 3.0 * u(rng), 8.0 + 4.0 * u(rng));
+    const Eigen::Vector3d q = Eigen::Vector3d(p.x() - 0.8, p.y() - 0.1, p.z() - 0.3);  // camera moved right
+    a.emplace_back(float(f * p.x() / p.z() + cx + pixel_noise(rng)), float(f * p.y() / p.z() + cy + pixel_noise(rng)), 5.f);
+    b.emplace_back(float(f * q.x() / q.z() + cx + pixel_noise(rng)), float(f * q.y() / q.z() + cy + pixel_noise(rng)), 5.f);
+    cv::Mat row(1, 128, CV_32F);
+    cv::randu(row, 0, 255);
+    da.push_back(row);
+    cv::Mat noisy = row.clone();
+    for (int d = 0; d < 128; ++d) noisy.at<float>(d) = std::max(0.0f, noisy.at<float>(d) + descriptor_noise(rng));
+    db.push_back(noisy);
+  }
+  for (int i = 0; i < 200; ++i) {  // clutter in the second view
+    b.emplace_back(float(640 * (u(rng) + 1) / 2), float(480 * (u(rng) + 1) / 2), 5.f);
+    cv::Mat row(1, 128, CV_32F);
+    cv::randu(row, 0, 255);
+    db.push_back(row);
+  }
+  PlaceOptions options;
+  options.root_sift = false;
+  const vocab::Vocabulary vocabulary = [&] {
+    vocab::Vocabulary v;
+    vocab::VocabularyOptions o;
+    o.branching = 4, o.depth = 2;
+    EXPECT_TRUE(vocab::Vocabulary::Train({da, db}, o, &v).ok());
+    return v;
+  }();
+  PlaceRecognizer recognizer(&vocabulary, options);
+  const Verification verification = recognizer.Verify(a, da, b, db);
+  EXPECT_GE(verification.matches, 290);
+  EXPECT_GE(verification.inliers, 280);
+  EXPECT_TRUE(verification.accepted);
+  // Shuffled correspondences break the geometry: few inliers, not accepted.
+  std::vector<cv::KeyPoint> shuffled = b;
+  std::shuffle(shuffled.begin(), shuffled.begin() + 300, rng);
+  const Verification broken = recognizer.Verify(a, da, shuffled, db);
+  EXPECT_FALSE(broken.accepted);
+  EXPECT_LT(broken.inliers, 60);
+}
+
+TEST(Verify, GraffitiPairFromOpencvDoc) {
+  const cv::Mat one = cv::imread(kOpencvData + "/graf1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat three = cv::imread(kOpencvData + "/graf3.png", cv::IMREAD_GRAYSCALE);
+  if (one.empty() || three.empty()) GTEST_SKIP() << "opencv-doc not installed";
+  PlaceOptions options;
+  const vocab::Vocabulary vocabulary = VocabularyFor({one, three}, options);
+  PlaceRecognizer recognizer(&vocabulary, options);
+  std::vector<cv::KeyPoint> ka, kb;
+  cv::Mat da, db;
+  DescribeFeatures(one, options, &ka, &da);
+  DescribeFeatures(three, options, &kb, &db);
+  const Verification verification = recognizer.Verify(ka, da, kb, db);
+  EXPECT_TRUE(verification.accepted) << verification.matches << " matches, " << verification.inliers << " inliers";
+}
+
+// Shared real revisits: EuRoC left_img_0/1 and 2/3, DBoW2 image1/image3 are the same place; image0/image2 not.
+TEST(PlaceRecognizer, RealRevisitsAreFoundAndOthersNot) {
+  if (!std::filesystem::exists(kShared + "/dbow2_demo/image0.png")) GTEST_SKIP() << "shared data not present";
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < 4; ++i) images.push_back(cv::imread(kShared + cv::format("/dbow2_demo/image%d.png", i), 0));
+  for (int i = 0; i < 4; ++i) images.push_back(cv::imread(kShared + cv::format("/euroc_revisit_pairs/left_img_%d.png", i), 0));
+  PlaceOptions options;
+  options.exclude_recent_s = 0.0;
+  const vocab::Vocabulary vocabulary = VocabularyFor(images, options);
+  PlaceRecognizer recognizer(&vocabulary, options);
+  const std::vector<int> expected_match = {-1, -1, -1, 1, -1, 4, -1, 6};  // per image: the earlier node it revisits
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    PlaceResult result;
+    ASSERT_TRUE(recognizer.AddKeyFrame({i < 4 ? "dbow2" : "euroc", SecondsToNs(i), static_cast<std::int64_t>(i), images[i]},
+                                       &result).ok());
+    EXPECT_EQ(result.node, static_cast<int>(i));
+    EXPECT_EQ(result.match ? result.match->node : -1, expected_match[i]) << "image " << i;
+  }
+}
+
+TEST(PlaceRecognizer, RecentNodesOfTheSameFlightAreNotCandidates) {
+  const cv::Mat one = cv::imread(kOpencvData + "/graf1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat three = cv::imread(kOpencvData + "/graf3.png", cv::IMREAD_GRAYSCALE);
+  if (one.empty() || three.empty()) GTEST_SKIP() << "opencv-doc not installed";
+  PlaceOptions options;
+  options.exclude_recent_s = 20.0;
+  const vocab::Vocabulary vocabulary = VocabularyFor({one, three}, options);
+  PlaceRecognizer recognizer(&vocabulary, options);
+  PlaceResult result;
+  ASSERT_TRUE(recognizer.AddKeyFrame({"a", SecondsToNs(0), 0, one}, &result).ok());
+  ASSERT_TRUE(recognizer.AddKeyFrame({"a", SecondsToNs(5), 1, three}, &result).ok());
+  EXPECT_FALSE(result.match.has_value());  // 5 s later in the same flight: a neighbour, not a candidate
+  EXPECT_TRUE(result.candidates.empty());
+  ASSERT_TRUE(recognizer.AddKeyFrame({"a", SecondsToNs(30), 2, three}, &result).ok());
+  ASSERT_TRUE(result.match.has_value());   // 30 s later both earlier nodes are candidates and verify
+  EXPECT_LE(result.match->node, 1);
+  EXPECT_EQ(result.candidates.size(), 1u);  // the first verified candidate ends the search (paper)
+  EXPECT_EQ(recognizer.node_count(), 3);
+  EXPECT_FALSE(recognizer.AddKeyFrame({"b", 0, 4, cv::Mat()}, &result).ok());
+}
+
+}  // namespace
+}  // namespace patrolmap::place
