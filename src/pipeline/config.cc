@@ -92,6 +92,12 @@ class YamlReader {
     }
   }
 
+  void Parse(const std::string& path, const YAML::Node& node, place::FundamentalMethod* value) {
+    if (!place::ParseFundamentalMethod(Scalar(node), value)) {
+      Fail(path, node, "expected ransac, usac or magsac, got '" + Scalar(node) + "'");
+    }
+  }
+
   static std::string Scalar(const YAML::Node& node) { return node.IsScalar() ? node.Scalar() : "(not a scalar)"; }
   static const char* TypeName(const int*) { return "an integer"; }
   static const char* TypeName(const double*) { return "a number"; }
@@ -112,6 +118,7 @@ class YamlWriter {
   }
   void Field(const std::string& path, flow::ResponseQuantity* value) { Slot(path) = flow::ToString(*value); }
   void Field(const std::string& path, flow::SmoothingMode* value) { Slot(path) = flow::ToString(*value); }
+  void Field(const std::string& path, place::FundamentalMethod* value) { Slot(path) = place::ToString(*value); }
 
   YAML::Node root = YAML::Node(YAML::NodeType::Map);
 
@@ -135,7 +142,7 @@ bool Config::IsValid(std::string* error) const {
     *error = "input.frame_rate_hz must be positive";
     return false;
   }
-  return flow.IsValid(error);
+  return flow.IsValid(error) && place.IsValid(error);
 }
 
 Status LoadConfig(const std::string& path, Config* config) {

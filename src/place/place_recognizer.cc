@@ -35,6 +35,23 @@ void ToRootSift(cv::Mat* descriptors) {
 
 }  // namespace
 
+const char* ToString(FundamentalMethod method) {
+  switch (method) {
+    case FundamentalMethod::kRansac: return "ransac";
+    case FundamentalMethod::kUsacDefault: return "usac";
+    case FundamentalMethod::kUsacMagsac: return "magsac";
+  }
+  return "?";
+}
+
+bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method) {
+  for (FundamentalMethod candidate :
+       {FundamentalMethod::kRansac, FundamentalMethod::kUsacDefault, FundamentalMethod::kUsacMagsac}) {
+    if (text == ToString(candidate)) return *method = candidate, true;
+  }
+  return false;
+}
+
 bool PlaceOptions::IsValid(std::string* error) const {
   if (max_features < 8) return *error = "place.max_features must be at least 8", false;
   if (candidates < 1) return *error = "place.candidates must be at least 1", false;

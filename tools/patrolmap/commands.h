@@ -14,5 +14,7 @@ using Command = std::function<int()>;
 Command AddDetectCommand(CLI::App* app);
 Command AddSimulateCommand(CLI::App* app);
 Command AddEvalCommand(CLI::App* app);
+Command AddMapCommand(CLI::App* app);
+Command AddVocabCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "common.h"
 #include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/pipeline/detect.h"
@@ -21,11 +22,6 @@ struct DetectArguments {
   std::string quantity;
   std::string smoothing;
 };
-
-int Fail(const Status& status) {
-  spdlog::error("{}", status.message());
-  return 1;
-}
 
 Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config) {
   if (!arguments.quantity.empty() &&
@@ -58,13 +54,8 @@ void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionRes
 
 int RunDetect(const DetectArguments& arguments) {
   pipeline::Config config;
-  if (!arguments.config.empty()) {
-    const Status status = pipeline::LoadConfig(arguments.config, &config);
-    if (!status.ok()) return Fail(status);
-  }
-  Status status = ApplyOverrides(arguments, &config);
-  std::string error;
-  if (status.ok() && !config.IsValid(&error)) status = Status::InvalidArgument(error);
+  Status status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok()) status = ApplyOverrides(arguments, &config);  // command-line flags win over the file
   if (!status.ok()) return Fail(status);
   std::unique_ptr<io::FrameSource> source;
   status = io::OpenLog(arguments.log, config.input, &source);

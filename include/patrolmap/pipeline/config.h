@@ -8,12 +8,14 @@
 #include "patrolmap/core/status.h"
 #include "patrolmap/flow/options.h"
 #include "patrolmap/io/readers.h"
+#include "patrolmap/place/place_recognizer.h"
 
 namespace patrolmap::pipeline {
 
 struct Config {
   io::ImageFolderOptions input;
   flow::KeyLocationOptions flow;
+  place::PlaceOptions place;
 
   bool IsValid(std::string* error) const;
 };
@@ -52,6 +54,17 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("flow.smoothing.mode", &flow.smoothing.mode);
   visitor->Field("flow.extrema.min_change", &flow.extrema.min_change);
   visitor->Field("flow.extrema.min_time_s", &flow.extrema.min_time_s);
+  place::PlaceOptions& place = config->place;
+  visitor->Field("place.max_features", &place.max_features);
+  visitor->Field("place.root_sift", &place.root_sift);
+  visitor->Field("place.candidates", &place.candidates);
+  visitor->Field("place.exclude_recent_s", &place.exclude_recent_s);
+  visitor->Field("place.ratio", &place.ratio);
+  visitor->Field("place.min_matched_fraction", &place.min_matched_fraction);
+  visitor->Field("place.method", &place.method);
+  visitor->Field("place.inlier_threshold_px", &place.inlier_threshold_px);
+  visitor->Field("place.min_inliers", &place.min_inliers);
+  visitor->Field("place.accept_best", &place.accept_best);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

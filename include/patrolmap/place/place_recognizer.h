@@ -21,6 +21,8 @@
 namespace patrolmap::place {
 
 enum class FundamentalMethod { kRansac, kUsacDefault, kUsacMagsac };
+const char* ToString(FundamentalMethod method);
+bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method);  // ransac, usac, magsac
 
 struct PlaceOptions {
   int max_features = 800;            // SIFT features kept per key frame (strongest first)

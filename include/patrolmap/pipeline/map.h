@@ -1,0 +1,56 @@
+// Mapping a flight log: key locations (flow stage) become nodes, and place
+// recognition closes loops between them (DESIGN.md: io -> flow -> place).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/pipeline/config.h"
+#include "patrolmap/place/place_recognizer.h"
+
+namespace patrolmap::pipeline {
+
+struct MapNode {
+  int node = 0;
+  std::string flight;
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  int features = 0;
+};
+
+struct MapLoopClosure {
+  int query_node = 0;
+  int matched_node = 0;
+  std::int64_t query_frame = 0;
+  std::int64_t matched_frame = 0;
+  place::Verification verification;
+};
+
+struct MapResult {
+  std::vector<MapNode> nodes;
+  std::vector<MapLoopClosure> loop_closures;
+  // Summed over key frames [s] (the paper's Table IV split).
+  double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
+};
+
+// Which frames become nodes: the detector's key locations, or every processed frame.
+struct KeyFrameSelection {
+  bool every_frame = false;
+  std::vector<std::int64_t> frames;  // ascending, when not every_frame
+};
+
+using MapProgress = std::function<void(std::int64_t, std::int64_t)>;
+
+// Reads `log` again, describes each selected frame at the flow stage's scale
+// and passes it through `recognizer` (which may already hold earlier flights).
+Status RecognisePlaces(const std::string& log, const Config& config, const KeyFrameSelection& selection,
+                       place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress = {});
+
+// Writes DIR/nodes.csv (node,flight,timestamp_ns,frame_index,features) and
+// DIR/loop_closures.csv (query_node,matched_node,query_frame,matched_frame,
+// bow_score,matched_fraction,inliers), each atomically.
+Status WriteMapOutputs(const MapResult& result, const std::string& folder);
+
+}  // namespace patrolmap::pipeline

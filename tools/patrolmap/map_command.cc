@@ -1,0 +1,88 @@
+// patrolmap map LOG --out DIR [--config FILE] [--vocabulary FILE] [--every-frame]
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "common.h"
+#include "patrolmap/pipeline/detect.h"
+#include "patrolmap/pipeline/map.h"
+#include "progress.h"
+
+namespace patrolmap::tools {
+namespace {
+
+struct MapArguments {
+  std::string log;
+  std::string out = "patrolmap_map";
+  std::string config;
+  std::string vocabulary = "vocab/default.pmvoc";
+  bool every_frame = false;
+};
+
+// Key frames from the flow stage (also writes its outputs beside the map's).
+Status SelectKeyFrames(const MapArguments& arguments, const pipeline::Config& config,
+                       pipeline::KeyFrameSelection* selection) {
+  selection->every_frame = arguments.every_frame;
+  if (arguments.every_frame) return Status::Ok();
+  std::unique_ptr<io::FrameSource> source;
+  PATROLMAP_RETURN_IF_ERROR(io::OpenLog(arguments.log, config.input, &source));
+  pipeline::DetectionResult detection;
+  {
+    Progress progress("detect");
+    PATROLMAP_RETURN_IF_ERROR(pipeline::RunDetection(source.get(), config.flow, &detection,
+                                                     [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
+  }
+  for (const KeyLocation& node : detection.key_locations) selection->frames.push_back(node.frame_index);
+  return pipeline::WriteDetectionOutputs(detection, arguments.out);
+}
+
+void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& result) {
+  const double nodes = std::max<std::size_t>(1, result.nodes.size());
+  std::printf("%s: %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
+              "verification, %.2f ms database update; outputs in %s\n",
+              arguments.log.c_str(), result.nodes.size(), result.loop_closures.size(),
+              1e3 * result.seconds_features / nodes, 1e3 * result.seconds_query / nodes,
+              1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
+}
+
+int RunMap(const MapArguments& arguments) {
+  pipeline::Config config;
+  vocab::Vocabulary vocabulary;
+  pipeline::KeyFrameSelection selection;
+  Status status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok()) status = vocab::Vocabulary::Load(arguments.vocabulary, &vocabulary);
+  if (status.ok() && vocabulary.dimension() != 128) {
+    status = Status::InvalidArgument(arguments.vocabulary + ": not a SIFT vocabulary");
+  }
+  if (status.ok()) status = SelectKeyFrames(arguments, config, &selection);
+  if (!status.ok()) return Fail(status);
+  place::PlaceRecognizer recognizer(&vocabulary, config.place);
+  pipeline::MapResult result;
+  {
+    Progress progress("places");
+    status = pipeline::RecognisePlaces(arguments.log, config, selection, &recognizer, &result,
+                                       [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
+  }
+  if (status.ok()) status = pipeline::WriteMapOutputs(result, arguments.out);
+  if (!status.ok()) return Fail(status);
+  PrintSummary(arguments, result);
+  return 0;
+}
+
+}  // namespace
+
+Command AddMapCommand(CLI::App* app) {
+  auto arguments = std::make_shared<MapArguments>();
+  app->add_option("log", arguments->log, "flight log (as for detect)")->required();
+  app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
+  app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
+  app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file (patrolmap vocab build)")
+      ->capture_default_str();
+  app->add_flag("--every-frame", arguments->every_frame,
+                "make every processed frame a node (image collections; judging place recognition alone)");
+  app->footer("Writes OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
+  return [arguments] { return RunMap(*arguments); };
+}
+
+}  // namespace patrolmap::tools

@@ -1,0 +1,89 @@
+// patrolmap vocab build INPUTS... --out FILE [-k K] [-L L] [--every N] [--seed S]
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "commands.h"
+#include "common.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/place/place_recognizer.h"
+#include "patrolmap/vocab/vocabulary.h"
+#include "progress.h"
+
+namespace patrolmap::tools {
+namespace {
+
+struct VocabArguments {
+  std::vector<std::string> inputs;
+  std::string out;
+  std::string config;
+  int every = 15;
+  vocab::VocabularyOptions options;
+};
+
+// Features of every `every`-th frame of a log, at the flow stage's scale.
+Status CollectFeatures(const std::string& input, const VocabArguments& arguments, const pipeline::Config& config,
+                       std::vector<cv::Mat>* images) {
+  std::unique_ptr<io::FrameSource> source;
+  PATROLMAP_RETURN_IF_ERROR(io::OpenLog(input, config.input, &source));
+  Progress progress("features");
+  Frame frame;
+  Status status;
+  std::int64_t next = 0;
+  cv::Mat small;
+  while ((status = source->Next(next % arguments.every == 0, &frame)).ok()) {
+    next = frame.index + 1;
+    if (frame.image.empty() || frame.index % arguments.every != 0) continue;
+    cv::resize(frame.image, small, cv::Size(), config.flow.frames.scale, config.flow.frames.scale, cv::INTER_AREA);
+    std::vector<cv::KeyPoint> keypoints;
+    cv::Mat descriptors;
+    place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+    images->push_back(descriptors);
+    progress.Update(frame.index, source->info().frame_count);
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+int RunBuild(const VocabArguments& arguments) {
+  pipeline::Config config;
+  Status status = LoadCheckedConfig(arguments.config, &config);
+  std::vector<cv::Mat> images;
+  for (std::size_t i = 0; status.ok() && i < arguments.inputs.size(); ++i) {
+    status = CollectFeatures(arguments.inputs[i], arguments, config, &images);
+  }
+  std::size_t descriptors = 0;
+  for (const cv::Mat& image : images) descriptors += image.rows;
+  vocab::Vocabulary vocabulary;
+  if (status.ok()) {
+    Progress progress("train");
+    status = vocab::Vocabulary::Train(images, arguments.options, &vocabulary,
+                                      [&progress](std::size_t d, std::size_t t) { progress.Update(d, t); });
+  }
+  if (status.ok()) status = vocabulary.Save(arguments.out);
+  if (!status.ok()) return Fail(status);
+  std::printf("%s: %d words (k=%d, L=%d) from %zu descriptors of %zu images\n", arguments.out.c_str(),
+              vocabulary.word_count(), arguments.options.branching, arguments.options.depth, descriptors, images.size());
+  return 0;
+}
+
+}  // namespace
+
+Command AddVocabCommand(CLI::App* app) {
+  auto arguments = std::make_shared<VocabArguments>();
+  app->require_subcommand(1);
+  CLI::App* build = app->add_subcommand("build", "train a vocabulary tree on the SIFT features of logs or image folders");
+  build->add_option("inputs", arguments->inputs, "logs, image folders, patterns or videos")->required();
+  build->add_option("-o,--out", arguments->out, "vocabulary file to write")->required();
+  build->add_option("-c,--config", arguments->config, "YAML configuration (features: place.*, scale: flow.frames.scale)");
+  build->add_option("-k,--branching", arguments->options.branching, "children per node")->capture_default_str();
+  build->add_option("-L,--depth", arguments->options.depth, "levels below the root")->capture_default_str();
+  build->add_option("--every", arguments->every, "use every n-th frame")->check(CLI::PositiveNumber)->capture_default_str();
+  build->add_option("--seed", arguments->options.seed, "k-means++ seed")->capture_default_str();
+  build->add_option("--max-iterations", arguments->options.max_iterations, "k-means iteration cap per node")
+      ->capture_default_str();
+  return [arguments] { return RunBuild(*arguments); };
+}
+
+}  // namespace patrolmap::tools
