@@ -1,4 +1,4 @@
-// patrolmap map LOG --out DIR [--config FILE] [--vocabulary FILE] [--every-frame]
+// patrolmap map LOG [LOG ...] --out DIR [--config FILE] [--vocabulary FILE] [--every-frame]
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -13,20 +13,22 @@ namespace patrolmap::tools {
 namespace {
 
 struct MapArguments {
-  std::string log;
+  std::vector<std::string> logs;
   std::string out = "patrolmap_map";
   std::string config;
   std::string vocabulary = "vocab/default.pmvoc";
   bool every_frame = false;
 };
 
-// Key frames from the flow stage (also writes its outputs beside the map's).
-Status SelectKeyFrames(const MapArguments& arguments, const pipeline::Config& config,
+// Key frames of `log` from the flow stage; its outputs go to OUT, or to
+// OUT/<flight> when several logs are mapped together.
+Status SelectKeyFrames(const MapArguments& arguments, const std::string& log, const pipeline::Config& config,
                        pipeline::KeyFrameSelection* selection) {
   selection->every_frame = arguments.every_frame;
+  selection->frames.clear();
   if (arguments.every_frame) return Status::Ok();
   std::unique_ptr<io::FrameSource> source;
-  PATROLMAP_RETURN_IF_ERROR(io::OpenLog(arguments.log, config.input, &source));
+  PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
   pipeline::DetectionResult detection;
   {
     Progress progress("detect");
@@ -34,14 +36,15 @@ Status SelectKeyFrames(const MapArguments& arguments, const pipeline::Config& co
                                                      [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
   }
   for (const KeyLocation& node : detection.key_locations) selection->frames.push_back(node.frame_index);
-  return pipeline::WriteDetectionOutputs(detection, arguments.out);
+  const bool several = arguments.logs.size() > 1;
+  return pipeline::WriteDetectionOutputs(detection, several ? arguments.out + "/" + source->info().flight_id : arguments.out);
 }
 
 void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& result) {
   const double nodes = std::max<std::size_t>(1, result.nodes.size());
-  std::printf("%s: %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
+  std::printf("%zu log(s): %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
               "verification, %.2f ms database update; outputs in %s\n",
-              arguments.log.c_str(), result.nodes.size(), result.loop_closures.size(),
+              arguments.logs.size(), result.nodes.size(), result.loop_closures.size(),
               1e3 * result.seconds_features / nodes, 1e3 * result.seconds_query / nodes,
               1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
 }
@@ -55,14 +58,16 @@ int RunMap(const MapArguments& arguments) {
   if (status.ok() && vocabulary.dimension() != 128) {
     status = Status::InvalidArgument(arguments.vocabulary + ": not a SIFT vocabulary");
   }
-  if (status.ok()) status = SelectKeyFrames(arguments, config, &selection);
   if (!status.ok()) return Fail(status);
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   pipeline::MapResult result;
-  {
+  for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
+    status = SelectKeyFrames(arguments, arguments.logs[i], config, &selection);
     Progress progress("places");
-    status = pipeline::RecognisePlaces(arguments.log, config, selection, &recognizer, &result,
-                                       [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
+    if (status.ok()) {
+      status = pipeline::RecognisePlaces(arguments.logs[i], config, selection, &recognizer, &result,
+                                         [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
+    }
   }
   if (status.ok()) status = pipeline::WriteMapOutputs(result, arguments.out);
   if (!status.ok()) return Fail(status);
@@ -74,7 +79,9 @@ int RunMap(const MapArguments& arguments) {
 
 Command AddMapCommand(CLI::App* app) {
   auto arguments = std::make_shared<MapArguments>();
-  app->add_option("log", arguments->log, "flight log (as for detect)")->required();
+  app->add_option("logs", arguments->logs, "flight log(s) as for detect; several are matched in order through one "
+                  "database, so later flights close loops against earlier ones")
+      ->required();
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
   app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file (patrolmap vocab build)")
