@@ -1,8 +1,10 @@
 #include <cmath>
 #include <functional>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
 
 #include "patrolmap/eval/key_location_score.h"
@@ -261,6 +263,72 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
   const std::string svg = testing::ReadText(dir / "out/response.svg");
   EXPECT_NE(svg.find("<polyline"), std::string::npos);
   EXPECT_EQ(svg.find("nan"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace patrolmap::pipeline
+
+#include "patrolmap/eval/loop_closure_score.h"
+#include "patrolmap/pipeline/map.h"
+
+namespace patrolmap::pipeline {
+namespace {
+
+// The same street flown twice under different lighting; every processed frame of both flights is a node.
+// Loop closures of the second flight against the first are scored against the simulator's places.
+TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
+  testing::TempDir dir;
+  Config config;
+  config.place.exclude_recent_s = 1e9;  // only the other flight counts here
+  std::vector<cv::Mat> training;
+  for (int flight = 1; flight <= 2; ++flight) {
+    sim::StreetOptions street;
+    street.walls = 2;
+    street.speed_mps = 5.0;
+    sim::SimulatedFlight simulated = sim::MakeStreetFlight(street);
+    simulated.flight_id = "street-" + std::to_string(flight);
+    simulated.lighting = sim::DrawLighting(7, flight);
+    ASSERT_TRUE(sim::WriteEurocLog(simulated, dir / simulated.flight_id).ok());
+  }
+  // A small vocabulary from the first flight's frames.
+  std::unique_ptr<io::FrameSource> source;
+  ASSERT_TRUE(io::OpenLog(dir / "street-1", {}, &source).ok());
+  Frame frame;
+  while (source->Next(true, &frame).ok()) {
+    if (frame.index % 10 != 0) continue;
+    cv::Mat small, descriptors;
+    std::vector<cv::KeyPoint> keypoints;
+    cv::resize(frame.image, small, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+    training.push_back(descriptors);
+  }
+  vocab::VocabularyOptions vocabulary_options;
+  vocabulary_options.branching = 8;
+  vocabulary_options.depth = 3;
+  vocab::Vocabulary vocabulary;
+  ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, &vocabulary).ok());
+  place::PlaceRecognizer recognizer(&vocabulary, config.place);
+  MapResult result;
+  KeyFrameSelection every;
+  every.every_frame = true;
+  for (const char* flight : {"street-1", "street-2"}) {
+    ASSERT_TRUE(RecognisePlaces(dir / flight, config, every, &recognizer, &result).ok());
+  }
+  ASSERT_TRUE(WriteMapOutputs(result, dir / "run").ok());
+  // Score with the ground-truth places of both logs, as `patrolmap eval` does.
+  std::vector<eval::NodeRecord> nodes;
+  std::vector<eval::LoopClosureRecord> closures;
+  ASSERT_TRUE(eval::ReadNodesCsv(dir / "run/nodes.csv", &nodes).ok());
+  ASSERT_TRUE(eval::ReadLoopClosuresCsv(dir / "run/loop_closures.csv", &closures).ok());
+  std::vector<eval::Place> places;
+  std::map<std::string, std::vector<eval::Place>> by_flight;
+  for (const char* flight : {"street-1", "street-2"}) ASSERT_TRUE(eval::ReadPlaces(dir / flight, &by_flight[flight]).ok());
+  for (const eval::NodeRecord& node : nodes) places.push_back(by_flight[node.flight][node.frame_index]);
+  const eval::LoopClosureScore score = eval::ScoreLoopClosures(nodes, places, closures);
+  EXPECT_EQ(score.nodes, 68);
+  EXPECT_EQ(score.possible, 34);
+  EXPECT_GE(score.found, 32);  // measured: 34
+  EXPECT_EQ(score.false_positives, 0);
 }
 
 }  // namespace
