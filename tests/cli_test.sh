@@ -59,5 +59,19 @@ expect "eval without outputs" 1 "holds neither key_locations.csv nor loop_closur
   "$bin" eval "$work/empty" --log "$source_dir/flight_logs/sample"
 expect "unknown route" 2 "unknown route 'zigzag'" -- "$bin" simulate --route zigzag --out "$work/z"
 
+# Place recognition: map the sample with the shipped vocabulary; bad vocabularies are named.
+expect "map sample" 0 "1 log\(s\): 3 nodes" -- \
+  "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/map"
+[[ -s "$work/map/nodes.csv" && -s "$work/map/loop_closures.csv" ]] || { echo "FAIL map outputs missing"; failures=$((failures + 1)); }
+expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \
+  "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$work/nothing.pmvoc" --out "$work/map2"
+head -c 1000 "$source_dir/vocab/default.pmvoc" > "$work/cut.pmvoc"
+expect "truncated vocabulary" 1 "cut.pmvoc: truncated vocabulary" -- \
+  "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$work/cut.pmvoc" --out "$work/map3"
+expect "vocab build" 0 "words \(k=4, L=2\)" -- \
+  "$bin" vocab build "$source_dir/flight_logs/sample" -k 4 -L 2 --every 30 --out "$work/small.pmvoc"
+expect "vocab build bad k" 1 "branching k must be in" -- \
+  "$bin" vocab build "$source_dir/flight_logs/sample" -k 1 --out "$work/bad.pmvoc"
+
 echo "cli: $passes passed, $failures failed"
 [[ $failures -eq 0 ]]
