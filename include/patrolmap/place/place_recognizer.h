@@ -33,7 +33,7 @@ struct PlaceOptions {
   double min_matched_fraction = 0.1; // matches / features of the smaller frame (paper: 0.5)
   FundamentalMethod method = FundamentalMethod::kUsacMagsac;
   double inlier_threshold_px = 1.5;  // epipolar distance for a RANSAC inlier [pixels]
-  int min_inliers = 50;              // a verified match needs this many inliers (chosen on double-loop seed 1: true >= 56, false <= 38)
+  int min_inliers = 50;              // a verified match needs this many inliers (chosen on experiment 3 seed 1: true >= 56, false <= 38)
   bool accept_best = false;          // verify every candidate and keep the best (paper: the first that passes)
 
   bool IsValid(std::string* error) const;
