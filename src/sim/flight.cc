@@ -21,8 +21,9 @@ constexpr double kGravity = 9.81;
 // obliquely counts once its gradual change adds up.
 constexpr double kMinInverseDepthChange = 0.05;
 // While the platform turns faster than this, the axis sweeps over the scene by
-// rotation, not by passing buildings: no key location, and the reference
-// restarts after the turn [rad/s] (corner arcs turn at 0.43 rad/s).
+// rotation, not by passing buildings: no key location during the turn, one
+// after it when the view before and after differs enough [rad/s] (corner arcs
+// turn at 0.43 rad/s).
 constexpr double kTurnRate = 0.25;
 
 Eigen::Matrix3d WorldFromBody(double heading) {
@@ -292,10 +293,9 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
     const CameraPose pose = CameraPoseAt(flight, state);
     const double depth = AxisDepth(&renderer, pose, centre, &depths);
     const double inverse = 1.0 / depth;
-    if (std::abs(state.yaw_rate) > kTurnRate) {  // the axis sweeps because the platform turns: no event
-      reference = inverse;
-      continue;
-    }
+    // While turning the axis sweeps by rotation: no event, and the reference stays at its value from
+    // before the turn, so the first straight frame compares the views before and after the turn.
+    if (std::abs(state.yaw_rate) > kTurnRate) continue;
     if (std::abs(inverse - reference) < kMinInverseDepthChange) continue;
     TruthKeyLocation event;
     event.timestamp_ns = FrameTimestamp(flight, frame);
@@ -314,6 +314,10 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
 Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
                      const ProgressCallback& progress) {
   if (!flight.trajectory || flight.duration_s <= 0.0) return Status::InvalidArgument("flight has no trajectory");
+  if (options.truth_only) {
+    PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/groundtruth"));
+    return WriteFileAtomically(folder + "/groundtruth/key_locations.csv", TruthTable(KeyLocationTruth(flight)));
+  }
   for (const char* sub : {"/cam0/data", "/imu0", "/state_groundtruth_estimate0", "/groundtruth"}) {
     PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + sub));
   }

@@ -45,6 +45,7 @@ struct LogOptions {
   bool depth = false;       // depth0/: 16-bit PNG depth along the optical axis [mm]
   bool gps = false;         // gps0/data.csv at 10 Hz with 1.5 m noise
   double exposure_s = 0.0;  // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
+  bool truth_only = false;  // write only groundtruth/key_locations.csv (after a change of its definition)
   DetectorOptions detector;
   double gps_origin_latitude = 47.3572;  // village origin (the paper's site is near Birmensdorf) [deg]
   double gps_origin_longitude = 8.4370;
@@ -59,7 +60,8 @@ CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& stat
 // once the inverse depth along the axis has changed by at least 0.05 1/m since
 // the previous key location (a wall seen obliquely counts when its gradual
 // change adds up to that). None while the platform turns faster than
-// 0.25 rad/s (the view sweeps by rotation then, not by passing buildings).
+// 0.25 rad/s (the view sweeps by rotation then, not by passing buildings); one
+// right after a turn when the views before and after it differ that much.
 struct TruthKeyLocation {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
