@@ -23,6 +23,7 @@ struct SimulateArguments {
   double speed_mps = 0.0;  // 0: the route's default (street 2.5, village 1.3)
   bool plain_lighting = false;
   int flights = 1;
+  int first_flight = 1;  // number of the first flight written (earlier ones only advance the object changes)
   int objects = 12;
   sim::ChangeSpec changes;
   sim::LogOptions log;
@@ -62,7 +63,7 @@ Status BuildFlight(const SimulateArguments& arguments, int number, sim::Simulate
 }
 
 std::string FlightFolder(const SimulateArguments& arguments, int number) {
-  if (arguments.flights == 1) return arguments.out;
+  if (arguments.flights == arguments.first_flight) return arguments.out;
   return arguments.out + "/flight_" + std::to_string(number);
 }
 
@@ -87,8 +88,9 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   flight.camera.height = height;
   if (!arguments.plain_lighting) flight.lighting = sim::DrawLighting(arguments.seed, number);
   flight.objects = NextObjects(arguments, number, *objects, &flight.changes);
-  sim::AddObjects(flight.objects, &flight.scene);
   *objects = flight.objects;
+  if (number < arguments.first_flight) return Status::Ok();  // only its objects matter for later flights
+  sim::AddObjects(flight.objects, &flight.scene);
   const std::string folder = FlightFolder(arguments, number);
   Progress progress("simulate");
   PATROLMAP_RETURN_IF_ERROR(sim::WriteEurocLog(flight, folder, arguments.log,
@@ -98,7 +100,8 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   return Status::Ok();
 }
 
-int RunSimulate(const SimulateArguments& arguments) {
+int RunSimulate(SimulateArguments arguments) {
+  if (arguments.first_flight > 1) arguments.flights = arguments.first_flight;
   std::vector<sim::WorldObject> objects;
   for (int number = 1; number <= arguments.flights; ++number) {
     const Status status = WriteFlight(arguments, number, &objects);
@@ -127,6 +130,10 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
   app->add_option("--added", arguments->changes.added, "series: objects added per flight")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  app->add_option("--flight-number", arguments->first_flight,
+                  "write only flight N of the series (its lighting, path jitter and objects after N-1 changes) "
+                  "to OUT; --flights is then raised to N")
+      ->check(CLI::Range(1, 100));
   app->add_flag("--detections", arguments->log.detections, "write objects0/ from a simulated object detector");
   app->add_flag("--depth", arguments->log.depth, "write depth0/ (16-bit PNG depth along the optical axis, mm)");
   app->add_flag("--gps", arguments->log.gps, "write gps0/ (10 Hz, 1.5 m noise)");
