@@ -94,6 +94,14 @@ TEST(Verify, GraffitiPairFromOpencvDoc) {
   DescribeFeatures(three, options, &kb, &db);
   const Verification verification = recognizer.Verify(ka, da, kb, db);
   EXPECT_TRUE(verification.accepted) << verification.matches << " matches, " << verification.inliers << " inliers";
+  // The same with the 8-bit descriptors nodes keep (RootSIFT scaled by 255): about the same matches.
+  cv::Mat ca, cb;
+  da.convertTo(ca, CV_8U, 255.0);
+  db.convertTo(cb, CV_8U, 255.0);
+  const Verification compact = recognizer.Verify(ka, ca, kb, cb);
+  EXPECT_TRUE(compact.accepted);
+  EXPECT_NEAR(compact.matches, verification.matches, 0.05 * verification.matches);
+  EXPECT_EQ(recognizer.Verify(ka, da, kb, cb).matches, 0);  // float against 8-bit is refused, not mixed
 }
 
 // Shared real revisits: EuRoC left_img_0/1 and 2/3, DBoW2 image1/image3 are the same place; image0/image2 not.

@@ -33,6 +33,13 @@ void ToRootSift(cv::Mat* descriptors) {
   }
 }
 
+// 8-bit copy of float descriptors: RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is.
+cv::Mat Compact(const cv::Mat& descriptors, bool root_sift) {
+  cv::Mat compact;
+  descriptors.convertTo(compact, CV_8U, root_sift ? 255.0 : 1.0);
+  return compact;
+}
+
 }  // namespace
 
 const char* ToString(FundamentalMethod method) {
@@ -82,7 +89,7 @@ void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::ve
 Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
                                      const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate) const {
   Verification verification;
-  if (query.rows < 2 || candidate.rows < 2) return verification;
+  if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
   std::vector<std::vector<cv::DMatch>> knn;
   cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
   std::vector<cv::Point2f> from, to;
@@ -121,6 +128,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   vocab::BowVector bow;
   vocabulary_->Transform(node.descriptors, &bow);
   result->features = node.descriptors.rows;
+  if (options_.compact_descriptors) node.descriptors = Compact(node.descriptors, options_.root_sift);
   result->seconds_features = Since(start);
 
   start = std::chrono::steady_clock::now();

@@ -65,6 +65,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.inlier_threshold_px", &place.inlier_threshold_px);
   visitor->Field("place.min_inliers", &place.min_inliers);
   visitor->Field("place.accept_best", &place.accept_best);
+  visitor->Field("place.compact_descriptors", &place.compact_descriptors);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep
