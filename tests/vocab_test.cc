@@ -202,3 +202,52 @@ TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
 
 }  // namespace
 }  // namespace patrolmap::vocab
+
+#include <atomic>
+#include <thread>
+
+namespace patrolmap::vocab {
+namespace {
+
+// Three threads query while one adds 2,000 entries; every answer must be well formed, and a query
+// for an entry already added when the query starts must find it with score 1.
+TEST(Database, QueriesRunConcurrentlyWithAdds) {
+  constexpr int kWords = 500, kEntries = 2000;
+  const std::vector<float> idf(kWords, 1.0f);
+  std::vector<BowVector> vectors(kEntries);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<WordId> word(0, kWords - 1);
+  for (BowVector& bow : vectors) {
+    std::vector<WordId> words(30);
+    for (WordId& w : words) w = word(rng);
+    MakeBowVector(words, idf.data(), &bow);
+  }
+  Database database(kWords);
+  std::atomic<int> added{0};
+  std::atomic<int> bad{0};
+  std::thread writer([&] {
+    for (const BowVector& bow : vectors) database.Add(bow), ++added;
+  });
+  std::vector<std::thread> readers;
+  for (int r = 0; r < 3; ++r) {
+    readers.emplace_back([&, r] {
+      std::vector<QueryResult> results;
+      for (int i = 0; i < 300; ++i) {
+        const int known = added.load();
+        if (known == 0) continue;
+        const int target = (i * 7 + r) % known;
+        database.Query(vectors[target], 3, {}, &results);
+        const bool found = !results.empty() && results[0].score > 0.999;
+        for (const QueryResult& q : results) bad += q.score > 1.0 || q.entry >= static_cast<EntryId>(kEntries);
+        bad += !found;
+      }
+    });
+  }
+  writer.join();
+  for (std::thread& reader : readers) reader.join();
+  EXPECT_EQ(bad.load(), 0);
+  EXPECT_EQ(database.size(), static_cast<std::size_t>(kEntries));
+}
+
+}  // namespace
+}  // namespace patrolmap::vocab

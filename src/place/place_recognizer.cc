@@ -68,6 +68,7 @@ bool PlaceOptions::IsValid(std::string* error) const {
   }
   if (!(inlier_threshold_px > 0.0)) return *error = "place.inlier_threshold_px must be positive", false;
   if (min_inliers < 8) return *error = "place.min_inliers must be at least 8 (the 8-point algorithm)", false;
+  if (max_topological_gap < 0) return *error = "place.max_topological_gap must not be negative", false;
   return true;
 }
 
@@ -113,8 +114,17 @@ Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_poin
 
 bool PlaceRecognizer::Allowed(const KeyFrame& query, int node) const {
   const Node& candidate = nodes_[node];
+  if (!Plausible(query, node)) return false;
   if (candidate.flight != query.flight) return true;
   return NsToSeconds(query.timestamp_ns - candidate.timestamp_ns) >= options_.exclude_recent_s;
+}
+
+bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
+  if (options_.max_topological_gap <= 0) return true;
+  const auto last = last_match_.find(query.flight);
+  if (last == last_match_.end() || last->second < 0) return true;
+  const int anchor = last->second;
+  return nodes_[node].flight == nodes_[anchor].flight && std::abs(node - anchor) <= options_.max_topological_gap;
 }
 
 Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* result) {
@@ -150,6 +160,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   }
   result->seconds_verify = Since(start);
 
+  last_match_[key_frame.flight] = result->match ? result->match->node : -1;
   start = std::chrono::steady_clock::now();
   result->node = static_cast<int>(database_.Add(bow));
   nodes_.push_back(std::move(node));

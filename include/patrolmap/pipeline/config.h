@@ -66,6 +66,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.min_inliers", &place.min_inliers);
   visitor->Field("place.accept_best", &place.accept_best);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
+  visitor->Field("place.max_topological_gap", &place.max_topological_gap);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

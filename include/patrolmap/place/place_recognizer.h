@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,10 @@ struct PlaceOptions {
   // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already): a quarter
   // of the memory per node; matching distances are computed from the 8-bit values.
   bool compact_descriptors = true;
+  // Reject topologically implausible candidates (the paper's future work): when the previous node
+  // of the query's flight closed a loop to node m, a candidate must lie on m's flight within this
+  // many nodes of m along the path. 0 turns the check off.
+  int max_topological_gap = 0;
 
   bool IsValid(std::string* error) const;
 };
@@ -97,11 +102,13 @@ class PlaceRecognizer {
     cv::Mat descriptors;
   };
   bool Allowed(const KeyFrame& query, int node) const;
+  bool Plausible(const KeyFrame& query, int node) const;
 
   const vocab::Vocabulary* vocabulary_;
   PlaceOptions options_;
   vocab::Database database_;
   std::vector<Node> nodes_;
+  std::map<std::string, int> last_match_;  // per flight: loop closure of its latest node, -1 for none
 };
 
 }  // namespace patrolmap::place
