@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
@@ -40,6 +42,34 @@ cv::Mat Compact(const cv::Mat& descriptors, bool root_sift) {
   return compact;
 }
 
+// Ratio-test matches of query features among the candidate features of the same group.
+void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& query_groups, const cv::Mat& candidate,
+                       const std::vector<std::uint32_t>& candidate_groups, double ratio,
+                       std::vector<std::pair<int, int>>* matches) {
+  std::multimap<std::uint32_t, int> by_group;
+  for (int j = 0; j < candidate.rows; ++j) by_group.emplace(candidate_groups[j], j);
+  for (int i = 0; i < query.rows; ++i) {
+    double best = std::numeric_limits<double>::max(), second = best;
+    int best_index = -1;
+    const auto range = by_group.equal_range(query_groups[i]);
+    for (auto it = range.first; it != range.second; ++it) {
+      const double distance = cv::norm(query.row(i), candidate.row(it->second), cv::NORM_L2);
+      if (distance < best) second = best, best = distance, best_index = it->second;
+      else if (distance < second) second = distance;
+    }
+    if (best_index >= 0 && best < ratio * second) matches->emplace_back(i, best_index);
+  }
+}
+
+void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std::vector<std::pair<int, int>>* matches) {
+  std::vector<std::vector<cv::DMatch>> knn;
+  cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
+  for (const auto& pair : knn) {
+    if (pair.size() < 2 || pair[0].distance >= ratio * pair[1].distance) continue;
+    matches->emplace_back(pair[0].queryIdx, pair[0].trainIdx);
+  }
+}
+
 }  // namespace
 
 const char* ToString(FundamentalMethod method) {
@@ -69,6 +99,7 @@ bool PlaceOptions::IsValid(std::string* error) const {
   if (!(inlier_threshold_px > 0.0)) return *error = "place.inlier_threshold_px must be positive", false;
   if (min_inliers < 8) return *error = "place.min_inliers must be at least 8 (the 8-point algorithm)", false;
   if (max_topological_gap < 0) return *error = "place.max_topological_gap must not be negative", false;
+  if (direct_index_levels_up < 0) return *error = "place.direct_index_levels_up must not be negative", false;
   return true;
 }
 
@@ -88,16 +119,21 @@ void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::ve
 }
 
 Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
-                                     const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate) const {
+                                     const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+                                     const std::vector<std::uint32_t>* query_groups,
+                                     const std::vector<std::uint32_t>* candidate_groups) const {
   Verification verification;
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
-  std::vector<std::vector<cv::DMatch>> knn;
-  cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
+  std::vector<std::pair<int, int>> matches;
+  if (query_groups != nullptr && candidate_groups != nullptr) {
+    MatchWithinGroups(query, *query_groups, candidate, *candidate_groups, options_.ratio, &matches);
+  } else {
+    MatchAll(query, candidate, options_.ratio, &matches);
+  }
   std::vector<cv::Point2f> from, to;
-  for (const auto& pair : knn) {
-    if (pair.size() < 2 || pair[0].distance >= options_.ratio * pair[1].distance) continue;
-    from.push_back(query_points[pair[0].queryIdx].pt);
-    to.push_back(candidate_points[pair[0].trainIdx].pt);
+  for (const auto& [i, j] : matches) {
+    from.push_back(query_points[i].pt);
+    to.push_back(candidate_points[j].pt);
   }
   verification.matches = static_cast<int>(from.size());
   verification.matched_fraction = static_cast<double>(from.size()) / std::min(query.rows, candidate.rows);
@@ -133,10 +169,15 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   }
   *result = PlaceResult();
   auto start = std::chrono::steady_clock::now();
-  Node node{key_frame.flight, key_frame.timestamp_ns, {}, {}};
+  Node node{key_frame.flight, key_frame.timestamp_ns, {}, {}, {}};
   DescribeFeatures(key_frame.image, options_, &node.keypoints, &node.descriptors);
   vocab::BowVector bow;
-  vocabulary_->Transform(node.descriptors, &bow);
+  std::vector<vocab::WordId> words;
+  vocabulary_->Quantize(node.descriptors, &words);
+  vocab::MakeBowVector(words, vocabulary_->idf().data(), &bow);
+  if (options_.direct_index_levels_up > 0) {
+    for (vocab::WordId word : words) node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
+  }
   result->features = node.descriptors.rows;
   if (options_.compact_descriptors) node.descriptors = Compact(node.descriptors, options_.root_sift);
   result->seconds_features = Since(start);
@@ -150,7 +191,9 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   start = std::chrono::steady_clock::now();
   for (const vocab::QueryResult& candidate : candidates) {
     const Node& other = nodes_[candidate.entry];
-    Verification verification = Verify(node.keypoints, node.descriptors, other.keypoints, other.descriptors);
+    const bool direct = options_.direct_index_levels_up > 0;
+    Verification verification = Verify(node.keypoints, node.descriptors, other.keypoints, other.descriptors,
+                                       direct ? &node.groups : nullptr, direct ? &other.groups : nullptr);
     verification.node = static_cast<int>(candidate.entry);
     verification.bow_score = candidate.score;
     result->candidates.push_back(verification);

@@ -67,6 +67,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.accept_best", &place.accept_best);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);
+  visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

@@ -43,6 +43,9 @@ struct PlaceOptions {
   // of the query's flight closed a loop to node m, a candidate must lie on m's flight within this
   // many nodes of m along the path. 0 turns the check off.
   int max_topological_gap = 0;
+  // Direct index: match only features that share the vocabulary node this many levels above
+  // their words (DBoW2's direct index), instead of every feature with every feature. 0 = brute force.
+  int direct_index_levels_up = 0;
 
   bool IsValid(std::string* error) const;
 };
@@ -90,9 +93,12 @@ class PlaceRecognizer {
 
   int node_count() const { return static_cast<int>(nodes_.size()); }
 
-  // Verifies two described frames (matching, fraction rule, F-RANSAC).
+  // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
+  // direct-index node of each feature) matching stays inside equal groups.
   Verification Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
-                      const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate) const;
+                      const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+                      const std::vector<std::uint32_t>* query_groups = nullptr,
+                      const std::vector<std::uint32_t>* candidate_groups = nullptr) const;
 
  private:
   struct Node {
@@ -100,6 +106,7 @@ class PlaceRecognizer {
     TimestampNs timestamp_ns = 0;
     std::vector<cv::KeyPoint> keypoints;
     cv::Mat descriptors;
+    std::vector<std::uint32_t> groups;  // direct-index node of each feature (when enabled)
   };
   bool Allowed(const KeyFrame& query, int node) const;
   bool Plausible(const KeyFrame& query, int node) const;
