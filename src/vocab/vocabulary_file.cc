@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "patrolmap/core/checksum.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/vocab/vocabulary.h"
 
@@ -22,21 +23,6 @@ namespace {
 constexpr char kMagic[8] = {'P', 'M', 'V', 'O', 'C', 'A', 'B', '\0'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::size_t kHeaderBytes = 8 + 4 * 6 + 4;
-
-// A fast 64-bit checksum over 8-byte words (and the tail bytes), chained
-// section by section from `hash`.
-std::uint64_t Checksum(const char* data, std::size_t size, std::uint64_t hash) {
-  hash ^= size;
-  std::size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    std::uint64_t word;
-    std::memcpy(&word, data + i, 8);
-    hash = (hash ^ word) * 0xFF51AFD7ED558CCDull;
-    hash ^= hash >> 29;
-  }
-  for (; i < size; ++i) hash = (hash ^ static_cast<unsigned char>(data[i])) * 0x100000001B3ull;
-  return hash;
-}
 
 template <typename T>
 void Append(const Array<T>& values, std::string* out) {
@@ -62,7 +48,6 @@ std::size_t BodyBytes(std::uint64_t nodes, std::uint64_t words, std::uint64_t di
   return nodes * (4 + 2 + 4 + 4 + dimension) + words * (4 + 4);
 }
 
-constexpr std::uint64_t kChecksumSeed = 0x9E3779B97F4A7C15ull;
 
 }  // namespace
 

@@ -1,0 +1,27 @@
+// The map file: one versioned binary file per patrol series holding the graph,
+// the key-frame thumbnails, features and bag-of-words vectors, so a later
+// flight can be matched without the original logs.
+//
+//   8 bytes  magic "PMMAP\0\0\0"
+//   u32      format version
+//   u32      section count
+//   sections tag (4 bytes), u64 payload length, u64 checksum of the payload, payload
+//            NODE: per node flight, time, frame, thumbnail, GPS, layout
+//            EDGE: per edge the two nodes, kind and verification scores
+//            FEAT: per node keypoints, descriptors and BoW vector
+// Saving is atomic (temporary file, fsync, rename): a crash never leaves a
+// half-written map. Loading a truncated, corrupt, foreign or newer file fails
+// with a message naming the file and the problem.
+#pragma once
+
+#include <string>
+
+#include "patrolmap/core/status.h"
+#include "patrolmap/graph/topo_map.h"
+
+namespace patrolmap::graph {
+
+Status SaveMap(const TopoMap& map, const std::string& path);
+Status LoadMap(const std::string& path, TopoMap* map);
+
+}  // namespace patrolmap::graph

@@ -1,0 +1,73 @@
+// The topological map (DESIGN.md, graph stage): nodes are key locations, edges
+// are traversals (consecutive nodes of one flight) and loop closures (the same
+// place, within or across flights), on Boost.Graph with bundled properties.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <boost/graph/adjacency_list.hpp>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include "patrolmap/core/types.h"
+#include "patrolmap/vocab/bow.h"
+
+namespace patrolmap::graph {
+
+struct NodeData {
+  std::string flight;
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  cv::Mat thumbnail;                     // CV_8UC1 key frame, small (for pictures and exports)
+  std::vector<cv::KeyPoint> keypoints;   // features kept so a later flight can be matched
+  cv::Mat descriptors;                   // without the original log (CV_8U or CV_32F rows)
+  vocab::BowVector bow;
+  std::optional<Eigen::Vector2d> gps;    // latitude, longitude [deg], when the log has them
+  Eigen::Vector2d layout = Eigen::Vector2d::Zero();  // 2D position for pictures (scaleless)
+};
+
+enum class EdgeKind : std::uint8_t { kTraversal = 0, kLoopClosure = 1 };
+const char* ToString(EdgeKind kind);
+
+struct EdgeData {
+  EdgeKind kind = EdgeKind::kTraversal;
+  double bow_score = 0.0;        // loop closures: verification scores
+  double matched_fraction = 0.0;
+  int inliers = 0;
+};
+
+class TopoMap {
+ public:
+  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, NodeData, EdgeData>;
+
+  // Adds a node; ids are 0, 1, 2, ... in order.
+  int AddNode(NodeData node);
+  // Adds an edge between existing nodes; a loop closure needs two distinct nodes.
+  void AddEdge(int a, int b, const EdgeData& edge);
+
+  int node_count() const { return static_cast<int>(boost::num_vertices(graph_)); }
+  int edge_count() const { return static_cast<int>(boost::num_edges(graph_)); }
+  int loop_closure_count() const;
+  const NodeData& node(int id) const { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
+  NodeData& mutable_node(int id) { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
+
+  struct Edge {
+    int a = 0, b = 0;
+    EdgeData data;
+  };
+  std::vector<Edge> Edges() const;                  // in insertion order
+  std::vector<int> Neighbours(int id) const;        // ascending, each once
+  std::vector<int> NodesOfPlace(int id) const;      // nodes joined to `id` by loop closures, `id` included, ascending
+  std::vector<int> Path(int from, int to) const;    // fewest edges, both ends included; empty when unreachable
+  std::vector<std::string> Flights() const;         // in order of first node
+
+ private:
+  Graph graph_;
+  std::vector<Edge> edge_order_;
+};
+
+}  // namespace patrolmap::graph

@@ -1,0 +1,275 @@
+#include "patrolmap/graph/map_file.h"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "patrolmap/core/checksum.h"
+#include "patrolmap/core/files.h"
+
+namespace patrolmap::graph {
+namespace {
+
+constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
+constexpr std::uint32_t kVersion = 1;
+
+class Writer {
+ public:
+  template <typename T>
+  void Value(T value) {
+    bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+  }
+  void String(const std::string& text) {
+    Value(static_cast<std::uint32_t>(text.size()));
+    bytes_.append(text);
+  }
+  void Mat(const cv::Mat& mat) {
+    const cv::Mat continuous = mat.isContinuous() ? mat : mat.clone();
+    Value(static_cast<std::int32_t>(mat.type()));
+    Value(static_cast<std::int32_t>(mat.rows));
+    Value(static_cast<std::int32_t>(mat.cols));
+    bytes_.append(reinterpret_cast<const char*>(continuous.data), continuous.total() * continuous.elemSize());
+  }
+  template <typename T>
+  void Vector(const std::vector<T>& values) {
+    Value(static_cast<std::uint32_t>(values.size()));
+    bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  std::string& bytes() { return bytes_; }
+
+ private:
+  std::string bytes_;
+};
+
+// Reads with bounds checks; any overrun sets failed() and yields zeros.
+class Reader {
+ public:
+  Reader(const char* data, std::size_t size) : data_(data), size_(size) {}
+  template <typename T>
+  T Value() {
+    T value{};
+    if (!Take(sizeof(T))) return value;
+    std::memcpy(&value, data_ + position_ - sizeof(T), sizeof(T));
+    return value;
+  }
+  std::string String() {
+    const std::uint32_t length = Value<std::uint32_t>();
+    if (!Take(length)) return {};
+    return std::string(data_ + position_ - length, length);
+  }
+  cv::Mat Mat() {
+    const int type = Value<std::int32_t>(), rows = Value<std::int32_t>(), cols = Value<std::int32_t>();
+    if (failed_ || rows < 0 || cols < 0 || (type != CV_8UC1 && type != CV_32FC1)) return Fail(), cv::Mat();
+    cv::Mat mat(rows, cols, type);
+    const std::size_t bytes = mat.total() * mat.elemSize();
+    if (!Take(bytes)) return cv::Mat();
+    std::memcpy(mat.data, data_ + position_ - bytes, bytes);
+    return mat;
+  }
+  template <typename T>
+  std::vector<T> Vector() {
+    const std::uint32_t count = Value<std::uint32_t>();
+    if (!Take(static_cast<std::size_t>(count) * sizeof(T))) return {};
+    std::vector<T> values(count);
+    std::memcpy(values.data(), data_ + position_ - count * sizeof(T), count * sizeof(T));
+    return values;
+  }
+  bool failed() const { return failed_; }
+  bool done() const { return position_ == size_; }
+
+ private:
+  void Fail() { failed_ = true; }
+  bool Take(std::size_t bytes) {
+    if (failed_ || bytes > size_ - position_) return failed_ = true, false;
+    position_ += bytes;
+    return true;
+  }
+  const char* data_;
+  std::size_t size_;
+  std::size_t position_ = 0;
+  bool failed_ = false;
+};
+
+struct KeyPointRecord {
+  float x, y, size, angle, response;
+  std::int32_t octave;
+};
+
+std::string NodeSection(const TopoMap& map) {
+  Writer w;
+  w.Value(static_cast<std::uint32_t>(map.node_count()));
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    w.String(n.flight);
+    w.Value(n.timestamp_ns);
+    w.Value(n.frame_index);
+    w.Mat(n.thumbnail);
+    w.Value(static_cast<std::uint8_t>(n.gps.has_value()));
+    const Eigen::Vector2d gps = n.gps.value_or(Eigen::Vector2d::Zero());
+    for (double v : {gps.x(), gps.y(), n.layout.x(), n.layout.y()}) w.Value(v);
+  }
+  return std::move(w.bytes());
+}
+
+std::string EdgeSection(const TopoMap& map) {
+  Writer w;
+  const std::vector<TopoMap::Edge> edges = map.Edges();
+  w.Value(static_cast<std::uint32_t>(edges.size()));
+  for (const TopoMap::Edge& e : edges) {
+    w.Value(static_cast<std::uint32_t>(e.a));
+    w.Value(static_cast<std::uint32_t>(e.b));
+    w.Value(static_cast<std::uint8_t>(e.data.kind));
+    w.Value(e.data.bow_score);
+    w.Value(e.data.matched_fraction);
+    w.Value(static_cast<std::int32_t>(e.data.inliers));
+  }
+  return std::move(w.bytes());
+}
+
+std::string FeatureSection(const TopoMap& map) {
+  Writer w;
+  w.Value(static_cast<std::uint32_t>(map.node_count()));
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    std::vector<KeyPointRecord> points;
+    for (const cv::KeyPoint& k : n.keypoints) points.push_back({k.pt.x, k.pt.y, k.size, k.angle, k.response, k.octave});
+    w.Vector(points);
+    w.Mat(n.descriptors);
+    w.Vector(n.bow.words);
+    w.Vector(n.bow.weights);
+  }
+  return std::move(w.bytes());
+}
+
+void AppendSection(const char (&tag)[5], const std::string& payload, std::string* file) {
+  file->append(tag, 4);
+  const std::uint64_t length = payload.size(), checksum = Checksum(payload.data(), payload.size());
+  file->append(reinterpret_cast<const char*>(&length), 8);
+  file->append(reinterpret_cast<const char*>(&checksum), 8);
+  file->append(payload);
+}
+
+Status Corrupt(const std::string& path, const std::string& what) {
+  return Status::DataLoss(path + ": corrupt map (" + what + ")");
+}
+
+Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
+  const std::uint32_t count = r->Value<std::uint32_t>();
+  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
+    NodeData n;
+    n.flight = r->String();
+    n.timestamp_ns = r->Value<TimestampNs>();
+    n.frame_index = r->Value<std::int64_t>();
+    n.thumbnail = r->Mat();
+    const bool has_gps = r->Value<std::uint8_t>() != 0;
+    double v[4];
+    for (double& value : v) value = r->Value<double>();
+    if (has_gps) n.gps = Eigen::Vector2d(v[0], v[1]);
+    n.layout = Eigen::Vector2d(v[2], v[3]);
+    map->AddNode(std::move(n));
+  }
+  return r->failed() || !r->done() ? Corrupt(path, "node section") : Status::Ok();
+}
+
+Status ParseEdges(const std::string& path, Reader* r, TopoMap* map) {
+  const std::uint32_t count = r->Value<std::uint32_t>();
+  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
+    const auto a = r->Value<std::uint32_t>(), b = r->Value<std::uint32_t>();
+    EdgeData e;
+    const auto kind = r->Value<std::uint8_t>();
+    e.bow_score = r->Value<double>();
+    e.matched_fraction = r->Value<double>();
+    e.inliers = r->Value<std::int32_t>();
+    if (r->failed()) break;
+    if (kind > 1 || a >= static_cast<std::uint32_t>(map->node_count()) ||
+        b >= static_cast<std::uint32_t>(map->node_count()) || (kind == 1 && a == b)) {
+      return Corrupt(path, "edge " + std::to_string(i));
+    }
+    e.kind = static_cast<EdgeKind>(kind);
+    map->AddEdge(static_cast<int>(a), static_cast<int>(b), e);
+  }
+  return r->failed() || !r->done() ? Corrupt(path, "edge section") : Status::Ok();
+}
+
+Status ParseFeatures(const std::string& path, Reader* r, TopoMap* map) {
+  if (r->Value<std::uint32_t>() != static_cast<std::uint32_t>(map->node_count())) return Corrupt(path, "feature count");
+  for (int i = 0; i < map->node_count() && !r->failed(); ++i) {
+    NodeData& n = map->mutable_node(i);
+    for (const KeyPointRecord& k : r->Vector<KeyPointRecord>()) {
+      n.keypoints.emplace_back(cv::Point2f(k.x, k.y), k.size, k.angle, k.response, k.octave);
+    }
+    n.descriptors = r->Mat();
+    n.bow.words = r->Vector<vocab::WordId>();
+    n.bow.weights = r->Vector<float>();
+    if (n.bow.words.size() != n.bow.weights.size() ||
+        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.keypoints.size())) {
+      return Corrupt(path, "features of node " + std::to_string(i));
+    }
+  }
+  return r->failed() || !r->done() ? Corrupt(path, "feature section") : Status::Ok();
+}
+
+Status ParseSection(const std::string& path, const std::string& tag, const char* payload, std::size_t length,
+                    TopoMap* map, bool* nodes, bool* edges) {
+  Reader reader(payload, length);
+  if (tag == "NODE" && !*nodes) {
+    *nodes = true;
+    return ParseNodes(path, &reader, map);
+  }
+  if (tag == "EDGE" && *nodes && !*edges) {
+    *edges = true;
+    return ParseEdges(path, &reader, map);
+  }
+  if (tag == "FEAT" && *nodes) return ParseFeatures(path, &reader, map);
+  return Corrupt(path, "unexpected section " + tag);
+}
+
+}  // namespace
+
+Status SaveMap(const TopoMap& map, const std::string& path) {
+  std::string file(kMagic, 8);
+  const std::uint32_t header[2] = {kVersion, 3};
+  file.append(reinterpret_cast<const char*>(header), sizeof(header));
+  AppendSection("NODE", NodeSection(map), &file);
+  AppendSection("EDGE", EdgeSection(map), &file);
+  AppendSection("FEAT", FeatureSection(map), &file);
+  return WriteFileAtomically(path, file);
+}
+
+Status LoadMap(const std::string& path, TopoMap* map) {
+  std::error_code error;
+  const auto size = std::filesystem::file_size(path, error);
+  if (error) return Status::NotFound(path + ": cannot read map: " + error.message());
+  std::string bytes(size, '\0');
+  std::ifstream(path, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(size));
+  if (size < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) return Status::DataLoss(path + ": not a patrolmap map file");
+  if (size < 16) return Status::DataLoss(path + ": truncated map (header incomplete)");
+  std::uint32_t header[2];
+  std::memcpy(header, bytes.data() + 8, sizeof(header));
+  if (header[0] > kVersion) {
+    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is newer than this patrolmap reads (" +
+                            std::to_string(kVersion) + ")");
+  }
+  *map = TopoMap();
+  std::size_t position = 16;
+  bool nodes = false, edges = false;
+  for (std::uint32_t s = 0; s < header[1]; ++s) {
+    if (size - position < 20) return Status::DataLoss(path + ": truncated map (section " + std::to_string(s) + " header)");
+    const std::string tag(bytes.data() + position, 4);
+    std::uint64_t length, checksum;
+    std::memcpy(&length, bytes.data() + position + 4, 8);
+    std::memcpy(&checksum, bytes.data() + position + 12, 8);
+    position += 20;
+    if (length > size - position) return Status::DataLoss(path + ": truncated map (section " + tag + ")");
+    const char* payload = bytes.data() + position;
+    if (Checksum(payload, length) != checksum) return Corrupt(path, "checksum of section " + tag);
+    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, tag, payload, length, map, &nodes, &edges));
+    position += length;
+  }
+  if (!nodes || !edges) return Corrupt(path, "node or edge section missing");
+  if (position != size) return Corrupt(path, "trailing bytes");
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::graph

@@ -1,0 +1,80 @@
+#include "patrolmap/graph/topo_map.h"
+
+#include <algorithm>
+#include <deque>
+
+#include <boost/graph/breadth_first_search.hpp>
+
+#include "patrolmap/core/status.h"
+
+namespace patrolmap::graph {
+
+const char* ToString(EdgeKind kind) { return kind == EdgeKind::kTraversal ? "traversal" : "loop_closure"; }
+
+int TopoMap::AddNode(NodeData node) { return static_cast<int>(boost::add_vertex(std::move(node), graph_)); }
+
+void TopoMap::AddEdge(int a, int b, const EdgeData& edge) {
+  PATROLMAP_CHECK(a >= 0 && b >= 0 && a < node_count() && b < node_count());
+  PATROLMAP_CHECK(edge.kind != EdgeKind::kLoopClosure || a != b);
+  boost::add_edge(static_cast<Graph::vertex_descriptor>(a), static_cast<Graph::vertex_descriptor>(b), edge, graph_);
+  edge_order_.push_back({a, b, edge});
+}
+
+int TopoMap::loop_closure_count() const {
+  return static_cast<int>(std::count_if(edge_order_.begin(), edge_order_.end(),
+                                        [](const Edge& e) { return e.data.kind == EdgeKind::kLoopClosure; }));
+}
+
+std::vector<TopoMap::Edge> TopoMap::Edges() const { return edge_order_; }
+
+std::vector<int> TopoMap::Neighbours(int id) const {
+  std::vector<int> neighbours;
+  for (auto [it, end] = boost::adjacent_vertices(static_cast<Graph::vertex_descriptor>(id), graph_); it != end; ++it) {
+    neighbours.push_back(static_cast<int>(*it));
+  }
+  std::sort(neighbours.begin(), neighbours.end());
+  neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
+  return neighbours;
+}
+
+std::vector<int> TopoMap::NodesOfPlace(int id) const {
+  std::vector<bool> seen(node_count(), false);
+  std::vector<int> place, stack = {id};
+  seen[id] = true;
+  while (!stack.empty()) {
+    const auto v = static_cast<Graph::vertex_descriptor>(stack.back());
+    stack.pop_back();
+    place.push_back(static_cast<int>(v));
+    for (auto [it, end] = boost::out_edges(v, graph_); it != end; ++it) {
+      const int other = static_cast<int>(boost::target(*it, graph_));
+      if (graph_[*it].kind != EdgeKind::kLoopClosure || seen[other]) continue;
+      seen[other] = true;
+      stack.push_back(other);
+    }
+  }
+  std::sort(place.begin(), place.end());
+  return place;
+}
+
+std::vector<int> TopoMap::Path(int from, int to) const {
+  std::vector<Graph::vertex_descriptor> predecessor(node_count());
+  for (std::size_t i = 0; i < predecessor.size(); ++i) predecessor[i] = i;
+  boost::breadth_first_search(
+      graph_, static_cast<Graph::vertex_descriptor>(from),
+      boost::visitor(boost::make_bfs_visitor(boost::record_predecessors(predecessor.data(), boost::on_tree_edge()))));
+  if (from != to && predecessor[to] == static_cast<Graph::vertex_descriptor>(to)) return {};
+  std::vector<int> path = {to};
+  while (path.back() != from) path.push_back(static_cast<int>(predecessor[path.back()]));
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+std::vector<std::string> TopoMap::Flights() const {
+  std::vector<std::string> flights;
+  for (int i = 0; i < node_count(); ++i) {
+    if (std::find(flights.begin(), flights.end(), node(i).flight) == flights.end()) flights.push_back(node(i).flight);
+  }
+  return flights;
+}
+
+}  // namespace patrolmap::graph

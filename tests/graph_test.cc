@@ -1,0 +1,143 @@
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "patrolmap/graph/map_file.h"
+#include "patrolmap/graph/topo_map.h"
+#include "test_util.h"
+
+namespace patrolmap::graph {
+namespace {
+
+// Flight a: nodes 0-1-2-3 in a row; flight b: 4-5-6. Loop closures 4~1 and 6~3, and 5~1 (same place as 4).
+TopoMap TwoFlights() {
+  TopoMap map;
+  cv::RNG rng(3);
+  for (int i = 0; i < 7; ++i) {
+    NodeData node;
+    node.flight = i < 4 ? "a" : "b";
+    node.timestamp_ns = SecondsToNs(10.0 * i);
+    node.frame_index = 30 * i;
+    node.thumbnail = cv::Mat(12, 16, CV_8UC1);
+    rng.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);
+    for (int k = 0; k < 5; ++k) node.keypoints.emplace_back(cv::Point2f(k * 3.5f, i + 0.25f), 2.0f, 10.0f * k, 0.5f, 1);
+    node.descriptors = cv::Mat(5, 128, CV_8UC1);
+    rng.fill(node.descriptors, cv::RNG::UNIFORM, 0, 255);
+    node.bow.words = {static_cast<vocab::WordId>(i), 100};
+    node.bow.weights = {0.25f, 0.75f};
+    if (i == 2) node.gps = Eigen::Vector2d(47.3572123456789, 8.4370987654321);
+    node.layout = Eigen::Vector2d(i, -i);
+    const int id = map.AddNode(node);
+    if (id != 0 && id != 4) map.AddEdge(id - 1, id, EdgeData{});
+  }
+  map.AddEdge(4, 1, {EdgeKind::kLoopClosure, 0.41, 0.62, 88});
+  map.AddEdge(6, 3, {EdgeKind::kLoopClosure, 0.33, 0.51, 71});
+  map.AddEdge(5, 1, {EdgeKind::kLoopClosure, 0.21, 0.35, 55});
+  return map;
+}
+
+TEST(TopoMap, QueriesUsersNeed) {
+  const TopoMap map = TwoFlights();
+  EXPECT_EQ(map.node_count(), 7);
+  EXPECT_EQ(map.edge_count(), 8);  // 3 + 2 traversals, 3 loop closures
+  EXPECT_EQ(map.loop_closure_count(), 3);
+  EXPECT_EQ(map.Neighbours(1), (std::vector<int>{0, 2, 4, 5}));
+  EXPECT_EQ(map.NodesOfPlace(4), (std::vector<int>{1, 4, 5}));
+  EXPECT_EQ(map.NodesOfPlace(0), (std::vector<int>{0}));
+  EXPECT_EQ(map.Path(0, 6), (std::vector<int>{0, 1, 5, 6}));  // over the loop closure 1~5: 3 edges, not 4
+  EXPECT_EQ(map.Path(2, 2), (std::vector<int>{2}));
+  EXPECT_EQ(map.Flights(), (std::vector<std::string>{"a", "b"}));
+  TopoMap split;
+  split.AddNode({});
+  split.AddNode({});
+  EXPECT_TRUE(split.Path(0, 1).empty());
+}
+
+TEST(TopoMapDeathTest, LoopClosureOntoItselfAborts) {
+  TopoMap map = TwoFlights();
+  EXPECT_DEATH(map.AddEdge(2, 2, {EdgeKind::kLoopClosure, 0, 0, 0}), "check failed");
+}
+
+TEST(MapFile, RoundTripKeepsEverything) {
+  testing::TempDir dir;
+  const TopoMap map = TwoFlights();
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  ASSERT_EQ(loaded.node_count(), map.node_count());
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData &a = map.node(i), &b = loaded.node(i);
+    EXPECT_EQ(a.flight, b.flight);
+    EXPECT_EQ(a.timestamp_ns, b.timestamp_ns);
+    EXPECT_EQ(a.frame_index, b.frame_index);
+    EXPECT_EQ(cv::norm(a.thumbnail, b.thumbnail, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(a.descriptors, b.descriptors, cv::NORM_INF), 0.0);
+    ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
+    EXPECT_EQ(a.keypoints[3].pt, b.keypoints[3].pt);
+    EXPECT_EQ(a.keypoints[3].angle, b.keypoints[3].angle);
+    EXPECT_EQ(a.bow.words, b.bow.words);
+    EXPECT_EQ(a.bow.weights, b.bow.weights);
+    EXPECT_EQ(a.gps.has_value(), b.gps.has_value());
+    EXPECT_EQ(a.layout, b.layout);
+  }
+  EXPECT_EQ(loaded.node(2).gps->x(), 47.3572123456789);  // full precision
+  const auto a = map.Edges(), b = loaded.Edges();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].a, b[i].a);
+    EXPECT_EQ(a[i].b, b[i].b);
+    EXPECT_EQ(a[i].data.kind, b[i].data.kind);
+    EXPECT_EQ(a[i].data.inliers, b[i].data.inliers);
+    EXPECT_EQ(a[i].data.bow_score, b[i].data.bow_score);
+  }
+  // Saving again gives the same bytes.
+  ASSERT_TRUE(SaveMap(loaded, dir / "again.pmap").ok());
+  EXPECT_EQ(testing::ReadText(dir / "m.pmap"), testing::ReadText(dir / "again.pmap"));
+}
+
+class MapFileCorruptTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(SaveMap(TwoFlights(), dir_ / "m.pmap").ok());
+    bytes_ = testing::ReadText(dir_ / "m.pmap");
+  }
+  std::string LoadBytes(const std::string& bytes) {
+    std::ofstream(dir_ / "x.pmap", std::ios::binary) << bytes;
+    TopoMap map;
+    return LoadMap(dir_ / "x.pmap", &map).message();
+  }
+  testing::TempDir dir_;
+  std::string bytes_;
+};
+
+TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
+  EXPECT_NE(LoadBytes(bytes_.substr(0, bytes_.size() - 10)).find("x.pmap: truncated map"), std::string::npos);
+  EXPECT_NE(LoadBytes(bytes_.substr(0, 12)).find("truncated map (header"), std::string::npos);
+  std::string flipped = bytes_;
+  flipped[bytes_.size() / 2] ^= 0x10;
+  EXPECT_NE(LoadBytes(flipped).find("corrupt map (checksum of section"), std::string::npos);
+  EXPECT_NE(LoadBytes("%PDF-1.4 something else").find("not a patrolmap map file"), std::string::npos);
+  std::string newer = bytes_;
+  const std::uint32_t version = 9;
+  std::memcpy(newer.data() + 8, &version, 4);
+  EXPECT_NE(LoadBytes(newer).find("version 9 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
+  TopoMap map;
+  EXPECT_EQ(LoadMap(dir_ / "missing.pmap", &map).code(), StatusCode::kNotFound);
+}
+
+TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {
+  testing::TempDir dir;
+  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
+  const std::string before = testing::ReadText(dir / "m.pmap");
+  std::filesystem::create_directory(dir / "m.pmap.tmp." + std::to_string(::getpid()));  // the temporary cannot be created
+  EXPECT_FALSE(SaveMap(TopoMap(), dir / "m.pmap").ok());
+  EXPECT_EQ(testing::ReadText(dir / "m.pmap"), before);
+}
+
+}  // namespace
+}  // namespace patrolmap::graph
