@@ -63,6 +63,15 @@ expect "unknown route" 2 "unknown route 'zigzag'" -- "$bin" simulate --route zig
 expect "map sample" 0 "1 log\(s\): 3 nodes" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/map"
 [[ -s "$work/map/nodes.csv" && -s "$work/map/loop_closures.csv" ]] || { echo "FAIL map outputs missing"; failures=$((failures + 1)); }
+expect "info" 0 "map.pmap: .* KB, 1 flights, 3 nodes, 2 traversals" -- "$bin" info "$work/map/map.pmap"
+"$bin" -q simulate --route street --walls 3 --speed 4 --resolution 160x102 --plain-lighting --seed 2 --out "$work/second" >/dev/null
+expect "patrol" 0 "1 log\\(s\\): 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
+  --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"
+expect "patrol extends the map" 0 "2 flights, 6 nodes" -- "$bin" info "$work/patrol/map.pmap"
+head -c 300 "$work/map/map.pmap" > "$work/cut.pmap"
+expect "truncated map" 1 "cut.pmap: truncated map" -- "$bin" patrol "$work/second" --map "$work/cut.pmap" \
+  --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol2"
+expect "foreign map" 1 "not a patrolmap map file" -- "$bin" info "$source_dir/README.md"
 expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$work/nothing.pmvoc" --out "$work/map2"
 head -c 1000 "$source_dir/vocab/default.pmvoc" > "$work/cut.pmvoc"

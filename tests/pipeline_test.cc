@@ -314,7 +314,11 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   for (const char* flight : {"street-1", "street-2"}) {
     ASSERT_TRUE(RecognisePlaces(dir / flight, config, every, &recognizer, &result).ok());
   }
-  ASSERT_TRUE(WriteMapOutputs(result, dir / "run").ok());
+  const graph::TopoMap map = BuildTopoMap(result, recognizer);
+  EXPECT_EQ(map.node_count(), 68);
+  EXPECT_EQ(map.loop_closure_count(), static_cast<int>(result.loop_closures.size()));
+  EXPECT_EQ(map.edge_count(), 66 + map.loop_closure_count());  // 33 traversals per flight
+  ASSERT_TRUE(WriteMapOutputs(map, dir / "run").ok());
   // Score with the ground-truth places of both logs, as `patrolmap eval` does.
   std::vector<eval::NodeRecord> nodes;
   std::vector<eval::LoopClosureRecord> closures;

@@ -17,9 +17,17 @@ bool Selected(const KeyFrameSelection& selection, std::int64_t frame, int step) 
   return std::binary_search(selection.frames.begin(), selection.frames.end(), frame);
 }
 
+cv::Mat Thumbnail(const cv::Mat& image) {
+  cv::Mat thumbnail;
+  const double scale = static_cast<double>(kThumbnailWidth) / image.cols;
+  cv::resize(image, thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
+  return thumbnail;
+}
+
 void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, std::map<int, std::int64_t>* frame_of,
             MapResult* result) {
-  result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features});
+  result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
+                           Thumbnail(key_frame.image)});
   (*frame_of)[place.node] = key_frame.frame_index;
   result->seconds_features += place.seconds_features;
   result->seconds_query += place.seconds_query;
@@ -61,19 +69,47 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
   return status.end_of_stream() ? Status::Ok() : status;
 }
 
-Status WriteMapOutputs(const MapResult& result, const std::string& folder) {
+graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
+                            const graph::TopoMap* prior) {
+  graph::TopoMap map;
+  if (prior != nullptr) map = *prior;
+  for (const MapNode& node : result.nodes) {
+    place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
+    graph::NodeData data;
+    data.flight = node.flight;
+    data.timestamp_ns = node.timestamp_ns;
+    data.frame_index = node.frame_index;
+    data.thumbnail = node.thumbnail;
+    data.keypoints = std::move(features.keypoints);
+    data.descriptors = std::move(features.descriptors);
+    data.bow = std::move(features.bow);
+    const int id = map.AddNode(std::move(data));
+    PATROLMAP_CHECK(id == node.node);  // the recognizer and the map number nodes alike
+    if (id > 0 && map.node(id - 1).flight == node.flight) map.AddEdge(id - 1, id, graph::EdgeData{});
+  }
+  for (const MapLoopClosure& closure : result.loop_closures) {
+    const place::Verification& v = closure.verification;
+    map.AddEdge(closure.query_node, closure.matched_node,
+                {graph::EdgeKind::kLoopClosure, v.bow_score, v.matched_fraction, v.inliers});
+  }
+  return map;
+}
+
+Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder));
   std::ostringstream nodes, closures;
   nodes << "node,flight,timestamp_ns,frame_index,features\n";
-  for (const MapNode& n : result.nodes) {
-    nodes << n.node << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.features << "\n";
+  for (int i = 0; i < map.node_count(); ++i) {
+    const graph::NodeData& n = map.node(i);
+    nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.keypoints.size() << "\n";
   }
   closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers\n";
   char line[256];
-  for (const MapLoopClosure& c : result.loop_closures) {
-    std::snprintf(line, sizeof(line), "%d,%d,%lld,%lld,%.4f,%.4f,%d\n", c.query_node, c.matched_node,
-                  static_cast<long long>(c.query_frame), static_cast<long long>(c.matched_frame),
-                  c.verification.bow_score, c.verification.matched_fraction, c.verification.inliers);
+  for (const graph::TopoMap::Edge& e : map.Edges()) {
+    if (e.data.kind != graph::EdgeKind::kLoopClosure) continue;
+    std::snprintf(line, sizeof(line), "%d,%d,%lld,%lld,%.4f,%.4f,%d\n", e.a, e.b,
+                  static_cast<long long>(map.node(e.a).frame_index), static_cast<long long>(map.node(e.b).frame_index),
+                  e.data.bow_score, e.data.matched_fraction, e.data.inliers);
     closures << line;
   }
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/nodes.csv", nodes.str()));

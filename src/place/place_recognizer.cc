@@ -163,6 +163,27 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
   return nodes_[node].flight == nodes_[anchor].flight && std::abs(node - anchor) <= options_.max_topological_gap;
 }
 
+PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
+  const Node& n = nodes_.at(node);
+  return {n.flight, n.timestamp_ns, n.keypoints, n.descriptors, database_.entry(static_cast<vocab::EntryId>(node))};
+}
+
+int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
+  Node node{std::move(features.flight), features.timestamp_ns, std::move(features.keypoints),
+            std::move(features.descriptors), {}};
+  if (options_.direct_index_levels_up > 0) {
+    // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
+    cv::Mat as_float;
+    node.descriptors.convertTo(as_float, CV_32F, node.descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
+    std::vector<vocab::WordId> words;
+    vocabulary_->Quantize(as_float, &words);
+    for (vocab::WordId word : words) node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
+  }
+  const int id = static_cast<int>(database_.Add(features.bow));
+  nodes_.push_back(std::move(node));
+  return id;
+}
+
 Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* result) {
   if (key_frame.image.empty() || key_frame.image.type() != CV_8UC1) {
     return Status::InvalidArgument("key frame " + std::to_string(key_frame.frame_index) + " has no grey image");

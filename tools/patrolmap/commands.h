@@ -16,5 +16,7 @@ Command AddSimulateCommand(CLI::App* app);
 Command AddEvalCommand(CLI::App* app);
 Command AddMapCommand(CLI::App* app);
 Command AddVocabCommand(CLI::App* app);
+Command AddPatrolCommand(CLI::App* app);
+Command AddInfoCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/pipeline/detect.h"
+#include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/map.h"
 #include "progress.h"
 
@@ -14,6 +15,7 @@ namespace {
 
 struct MapArguments {
   std::vector<std::string> logs;
+  std::string prior_map;  // patrol: the map the flight extends
   std::string out = "patrolmap_map";
   std::string config;
   std::string vocabulary = "vocab/default.pmvoc";
@@ -49,17 +51,28 @@ void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& resu
               1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
 }
 
+// Puts a prior map's nodes into the recognizer, in order, so new key frames are matched against them.
+void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer) {
+  for (int i = 0; i < prior.node_count(); ++i) {
+    const graph::NodeData& node = prior.node(i);
+    recognizer->AddDescribedNode({node.flight, node.timestamp_ns, node.keypoints, node.descriptors, node.bow});
+  }
+}
+
 int RunMap(const MapArguments& arguments) {
   pipeline::Config config;
   vocab::Vocabulary vocabulary;
   pipeline::KeyFrameSelection selection;
+  graph::TopoMap prior;
   Status status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok() && !arguments.prior_map.empty()) status = graph::LoadMap(arguments.prior_map, &prior);
   if (status.ok()) status = vocab::Vocabulary::Load(arguments.vocabulary, &vocabulary);
   if (status.ok() && vocabulary.dimension() != 128) {
     status = Status::InvalidArgument(arguments.vocabulary + ": not a SIFT vocabulary");
   }
   if (!status.ok()) return Fail(status);
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
+  SeedRecognizer(prior, &recognizer);
   pipeline::MapResult result;
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = SelectKeyFrames(arguments, arguments.logs[i], config, &selection);
@@ -69,13 +82,28 @@ int RunMap(const MapArguments& arguments) {
                                          [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
     }
   }
-  if (status.ok()) status = pipeline::WriteMapOutputs(result, arguments.out);
+  const graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  if (status.ok()) status = pipeline::WriteMapOutputs(map, arguments.out);
+  if (status.ok()) status = graph::SaveMap(map, arguments.out + "/map.pmap");
   if (!status.ok()) return Fail(status);
   PrintSummary(arguments, result);
   return 0;
 }
 
 }  // namespace
+
+Command AddPatrolCommand(CLI::App* app) {
+  auto arguments = std::make_shared<MapArguments>();
+  arguments->out = "patrolmap_patrol";
+  app->add_option("log", arguments->logs, "the new flight's log")->required()->expected(1);
+  app->add_option("--map", arguments->prior_map, "the map of earlier flights (map.pmap)")->required();
+  app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
+  app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
+  app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file")->capture_default_str();
+  app->footer("Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
+              "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv.");
+  return [arguments] { return RunMap(*arguments); };
+}
 
 Command AddMapCommand(CLI::App* app) {
   auto arguments = std::make_shared<MapArguments>();
@@ -88,7 +116,7 @@ Command AddMapCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_flag("--every-frame", arguments->every_frame,
                 "make every processed frame a node (image collections; judging place recognition alone)");
-  app->footer("Writes OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
+  app->footer("Writes OUT/map.pmap, OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
   return [arguments] { return RunMap(*arguments); };
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "patrolmap/core/status.h"
+#include "patrolmap/graph/topo_map.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/place/place_recognizer.h"
 
@@ -18,7 +19,10 @@ struct MapNode {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
   int features = 0;
+  cv::Mat thumbnail;  // the key frame at kThumbnailWidth pixels wide
 };
+
+constexpr int kThumbnailWidth = 160;
 
 struct MapLoopClosure {
   int query_node = 0;
@@ -48,9 +52,16 @@ using MapProgress = std::function<void(std::int64_t, std::int64_t)>;
 Status RecognisePlaces(const std::string& log, const Config& config, const KeyFrameSelection& selection,
                        place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress = {});
 
-// Writes DIR/nodes.csv (node,flight,timestamp_ns,frame_index,features) and
-// DIR/loop_closures.csv (query_node,matched_node,query_frame,matched_frame,
-// bow_score,matched_fraction,inliers), each atomically.
-Status WriteMapOutputs(const MapResult& result, const std::string& folder);
+// The topological map of a mapping run: the nodes with their thumbnails and
+// features, traversal edges between consecutive nodes of a flight, and the
+// verified loop closures. `prior` (may be null) holds nodes already in the
+// recognizer before this run, which come first with their edges.
+graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
+                            const graph::TopoMap* prior = nullptr);
+
+// Writes the whole map as DIR/nodes.csv (node,flight,timestamp_ns,frame_index,
+// features) and DIR/loop_closures.csv (query_node,matched_node,query_frame,
+// matched_frame,bow_score,matched_fraction,inliers), each atomically.
+Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder);
 
 }  // namespace patrolmap::pipeline

@@ -93,6 +93,19 @@ class PlaceRecognizer {
 
   int node_count() const { return static_cast<int>(nodes_.size()); }
 
+  // What the recognizer keeps of a node: enough to match later flights without the log.
+  struct NodeFeatures {
+    std::string flight;
+    TimestampNs timestamp_ns = 0;
+    std::vector<cv::KeyPoint> keypoints;
+    cv::Mat descriptors;
+    vocab::BowVector bow;
+  };
+  NodeFeatures Features(int node) const;
+
+  // Adds a node described earlier (a prior map's), without querying; returns its id.
+  int AddDescribedNode(NodeFeatures features);
+
   // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
   // direct-index node of each feature) matching stays inside equal groups.
   Verification Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,

@@ -1,0 +1,49 @@
+// patrolmap info MAP
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "common.h"
+#include "patrolmap/graph/map_file.h"
+
+namespace patrolmap::tools {
+namespace {
+
+int RunInfo(const std::string& path) {
+  graph::TopoMap map;
+  const Status status = graph::LoadMap(path, &map);
+  if (!status.ok()) return Fail(status);
+  int within = 0, across = 0, traversals = 0;
+  for (const graph::TopoMap::Edge& edge : map.Edges()) {
+    if (edge.data.kind == graph::EdgeKind::kTraversal) ++traversals;
+    else if (map.node(edge.a).flight == map.node(edge.b).flight) ++within;
+    else ++across;
+  }
+  std::printf("%s: %.1f KB, %zu flights, %d nodes, %d traversals, %d loop closures (%d within flights, %d across)\n",
+              path.c_str(), std::filesystem::file_size(path) / 1024.0, map.Flights().size(), map.node_count(), traversals,
+              within + across, within, across);
+  for (const std::string& flight : map.Flights()) {
+    int nodes = 0;
+    double first = 0.0, last = 0.0;
+    for (int i = 0; i < map.node_count(); ++i) {
+      if (map.node(i).flight != flight) continue;
+      const double t = NsToSeconds(map.node(i).timestamp_ns);
+      if (nodes++ == 0) first = t;
+      last = t;
+    }
+    std::printf("  flight %-24s %4d nodes, %.1f-%.1f s\n", flight.c_str(), nodes, first, last);
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command AddInfoCommand(CLI::App* app) {
+  auto path = std::make_shared<std::string>();
+  app->add_option("map", *path, "map file (map.pmap)")->required();
+  return [path] { return RunInfo(*path); };
+}
+
+}  // namespace patrolmap::tools
