@@ -12,12 +12,14 @@ rm -rf "$out"
 mkdir -p "$out"
 pm=build/tools/patrolmap
 $pm simulate --route l-shape --flights 2 --seed 1 --detections --gps --out "$out/patrol"
-$pm map "$out/patrol/flight_1" "$out/patrol/flight_2" --config config/default.yaml --out "$out/map"
-for flight in 1 2; do
-  rsvg-convert -o "$out/map/l-shape-1-f$flight/response.png" "$out/map/l-shape-1-f$flight/response.svg"
-  $pm eval "$out/map/l-shape-1-f$flight" --log "$out/patrol/flight_$flight" | tee "$out/eval_keylocations_f$flight.txt"
-done
-$pm eval "$out/map" --log "$out/patrol/flight_1" --log "$out/patrol/flight_2" | tee "$out/eval_loopclosures.txt"
-$pm eval "$out/map" --log "$out/patrol/flight_1" --log "$out/patrol/flight_2" --json > "$out/eval_loopclosures.json"
+# Flight 1 makes the map; flight 2 is a later patrol matched against it without flight 1's log.
+$pm map "$out/patrol/flight_1" --config config/default.yaml --out "$out/flight_1"
+$pm patrol "$out/patrol/flight_2" --map "$out/flight_1/map.pmap" --config config/default.yaml --out "$out/flight_2"
+$pm info "$out/flight_2/map.pmap" | tee "$out/map_info.txt"
+for flight in 1 2; do rsvg-convert -o "$out/flight_$flight/response.png" "$out/flight_$flight/response.svg"; done
+# Key locations are scored against the first --log; loop closures against all of them.
+$pm eval "$out/flight_1" --log "$out/patrol/flight_1" | tee "$out/eval_flight_1.txt"
+$pm eval "$out/flight_2" --log "$out/patrol/flight_2" --log "$out/patrol/flight_1" | tee "$out/eval_flight_2.txt"
+$pm eval "$out/flight_2" --log "$out/patrol/flight_2" --log "$out/patrol/flight_1" --json > "$out/eval_flight_2.json"
 echo "logs: $out/patrol/flight_{1,2} (ground truth in groundtruth/ of each)"
-echo "map: $out/map/nodes.csv, $out/map/loop_closures.csv; per flight: $out/map/l-shape-1-f{1,2}/ (key locations, plot)"
+echo "maps: $out/flight_1/map.pmap, then extended by the patrol: $out/flight_2/map.pmap (nodes.csv, loop_closures.csv beside)"
