@@ -141,3 +141,57 @@ TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {
 
 }  // namespace
 }  // namespace patrolmap::graph
+
+#include <signal.h>
+#include <sys/wait.h>
+
+namespace patrolmap::graph {
+namespace {
+
+// A big map with `nodes` nodes of 200 features each (about 50 KB a node on disk).
+TopoMap BigMap(int nodes) {
+  TopoMap map;
+  cv::RNG rng(5);
+  for (int i = 0; i < nodes; ++i) {
+    NodeData node;
+    node.flight = "f";
+    node.thumbnail = cv::Mat(102, 160, CV_8UC1, cv::Scalar(i % 255));
+    node.keypoints.assign(200, cv::KeyPoint(1.0f, 2.0f, 3.0f));
+    node.descriptors = cv::Mat(200, 128, CV_8UC1);
+    rng.fill(node.descriptors, cv::RNG::UNIFORM, 0, 255);
+    map.AddNode(std::move(node));
+    if (i > 0) map.AddEdge(i - 1, i, EdgeData{});
+  }
+  return map;
+}
+
+// A process killed while it saves a large map leaves the previous map as it was.
+TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
+  testing::TempDir dir;
+  const std::string path = dir / "m.pmap";
+  ASSERT_TRUE(SaveMap(TwoFlights(), path).ok());
+  const std::string before = testing::ReadText(path);
+  const TopoMap big = BigMap(3000);  // ~150 MB: the save takes long enough to be interrupted
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    SaveMap(big, path);
+    ::_exit(0);
+  }
+  // Kill it once its temporary file has started to grow.
+  const std::string temporary = path + ".tmp." + std::to_string(child);
+  for (int i = 0; i < 2000 && !(std::filesystem::exists(temporary) && std::filesystem::file_size(temporary) > 0); ++i) {
+    ::usleep(1000);
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the save finished before it could be killed";
+  EXPECT_EQ(testing::ReadText(path), before);
+  TopoMap loaded;
+  EXPECT_TRUE(LoadMap(path, &loaded).ok());
+  EXPECT_EQ(loaded.node_count(), 7);
+}
+
+}  // namespace
+}  // namespace patrolmap::graph
