@@ -71,6 +71,14 @@ expect "patrol extends the map" 0 "2 flights, 6 nodes" -- "$bin" info "$work/pat
 head -c 300 "$work/map/map.pmap" > "$work/cut.pmap"
 expect "truncated map" 1 "cut.pmap: truncated map" -- "$bin" patrol "$work/second" --map "$work/cut.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol2"
+# Exports, read back by real consumers.
+expect "export graphml" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format graphml --out "$work/map.graphml"
+expect "graphml parses" 0 "" -- xmllint --noout "$work/map.graphml"
+expect "graphml nodes" 0 "^6$" -- xmllint --xpath "count(//*[local-name()='node'])" "$work/map.graphml"
+expect "export dot" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format dot --out "$work/map.dot"
+expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
+expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
+expect "export bad format" 2 "format" -- "$bin" export "$work/patrol/map.pmap" --format pdf
 expect "foreign map" 1 "not a patrolmap map file" -- "$bin" info "$source_dir/README.md"
 expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$work/nothing.pmvoc" --out "$work/map2"

@@ -195,3 +195,35 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
 
 }  // namespace
 }  // namespace patrolmap::graph
+
+#include <nlohmann/json.hpp>
+
+#include "patrolmap/graph/export.h"
+
+namespace patrolmap::graph {
+namespace {
+
+TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
+  const TopoMap map = TwoFlights();
+  const std::string graphml = ToGraphML(map);
+  const std::string tag = "<data key=\"lat\">";
+  const std::size_t at = graphml.find(tag);
+  ASSERT_NE(at, std::string::npos);
+  const std::string latitude = graphml.substr(at + tag.size(), graphml.find('<', at + tag.size()) - at - tag.size());
+  EXPECT_EQ(std::stod(latitude), 47.3572123456789);  // exactly the stored double, not 47.3572
+  const nlohmann::json json = nlohmann::json::parse(ToJson(map));
+  EXPECT_EQ(json["graph"]["schema"], "patrolmap.map/1");
+  EXPECT_EQ(json["nodes"].size(), 7u);
+  EXPECT_EQ(json["links"].size(), 8u);
+  EXPECT_EQ(json["links"][5]["kind"], "loop_closure");
+  EXPECT_EQ(json["links"][5]["inliers"], 88);
+  EXPECT_DOUBLE_EQ(json["nodes"][2]["gps"][0].get<double>(), 47.3572123456789);
+  EXPECT_TRUE(json["nodes"][0]["gps"].is_null());
+  const std::string dot = ToDot(map);
+  std::size_t dashed = 0;
+  for (std::size_t at = dot.find("style=dashed"); at != std::string::npos; at = dot.find("style=dashed", at + 1)) ++dashed;
+  EXPECT_EQ(dashed, 3u);
+}
+
+}  // namespace
+}  // namespace patrolmap::graph

@@ -18,5 +18,6 @@ Command AddMapCommand(CLI::App* app);
 Command AddVocabCommand(CLI::App* app);
 Command AddPatrolCommand(CLI::App* app);
 Command AddInfoCommand(CLI::App* app);
+Command AddExportCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

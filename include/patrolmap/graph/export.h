@@ -1,0 +1,20 @@
+// Exports of the topological map for the tools people already use.
+//  - GraphML (NetworkX, Gephi, yEd) with typed attributes at full precision
+//    (17 significant digits: Boost's write_graphml keeps 6, which loses metres
+//    of a latitude);
+//  - DOT for Graphviz (loop closures dashed and green);
+//  - JSON in NetworkX's node-link form ("nodes", "links"), schema
+//    "patrolmap.map/1" in the graph attributes.
+#pragma once
+
+#include <string>
+
+#include "patrolmap/graph/topo_map.h"
+
+namespace patrolmap::graph {
+
+std::string ToGraphML(const TopoMap& map);
+std::string ToDot(const TopoMap& map);
+std::string ToJson(const TopoMap& map);
+
+}  // namespace patrolmap::graph

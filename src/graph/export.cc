@@ -1,0 +1,127 @@
+#include "patrolmap/graph/export.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace patrolmap::graph {
+namespace {
+
+std::string Precise(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string EscapeXml(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string EscapeDot(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+void GraphMLKeys(std::ostringstream* out) {
+  const char* keys[][4] = {{"flight", "node", "string", "flight"},       {"time", "node", "long", "timestamp_ns"},
+                           {"frame", "node", "long", "frame_index"},     {"lat", "node", "double", "latitude"},
+                           {"lon", "node", "double", "longitude"},       {"x", "node", "double", "x"},
+                           {"y", "node", "double", "y"},                 {"kind", "edge", "string", "kind"},
+                           {"bow", "edge", "double", "bow_score"},       {"frac", "edge", "double", "matched_fraction"},
+                           {"inl", "edge", "int", "inliers"}};
+  for (const auto& key : keys) {
+    *out << "  <key id=\"" << key[0] << "\" for=\"" << key[1] << "\" attr.name=\"" << key[3] << "\" attr.type=\""
+         << key[2] << "\"/>\n";
+  }
+}
+
+}  // namespace
+
+std::string ToGraphML(const TopoMap& map) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      << "<graphml xmlns=\"http://graphml.graphdrawing.org/xmlns\">\n";
+  GraphMLKeys(&out);
+  out << "  <graph id=\"patrolmap\" edgedefault=\"undirected\">\n";
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    out << "    <node id=\"n" << i << "\"><data key=\"flight\">" << EscapeXml(n.flight) << "</data><data key=\"time\">"
+        << n.timestamp_ns << "</data><data key=\"frame\">" << n.frame_index << "</data>";
+    if (n.gps) out << "<data key=\"lat\">" << Precise(n.gps->x()) << "</data><data key=\"lon\">" << Precise(n.gps->y()) << "</data>";
+    out << "<data key=\"x\">" << Precise(n.layout.x()) << "</data><data key=\"y\">" << Precise(n.layout.y())
+        << "</data></node>\n";
+  }
+  int index = 0;
+  for (const TopoMap::Edge& e : map.Edges()) {
+    out << "    <edge id=\"e" << index++ << "\" source=\"n" << e.a << "\" target=\"n" << e.b << "\"><data key=\"kind\">"
+        << ToString(e.data.kind) << "</data><data key=\"bow\">" << Precise(e.data.bow_score)
+        << "</data><data key=\"frac\">" << Precise(e.data.matched_fraction) << "</data><data key=\"inl\">"
+        << e.data.inliers << "</data></edge>\n";
+  }
+  out << "  </graph>\n</graphml>\n";
+  return out.str();
+}
+
+std::string ToDot(const TopoMap& map) {
+  std::ostringstream out;
+  out << "graph patrolmap {\n  node [shape=circle, fontsize=10];\n";
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    out << "  n" << i << " [label=\"" << i << "\", flight=\"" << EscapeDot(n.flight) << "\", frame=" << n.frame_index
+        << "];\n";
+  }
+  for (const TopoMap::Edge& e : map.Edges()) {
+    out << "  n" << e.a << " -- n" << e.b;
+    if (e.data.kind == EdgeKind::kLoopClosure) {
+      out << " [kind=loop_closure, style=dashed, color=\"#2a9d3a\", inliers=" << e.data.inliers << "]";
+    }
+    out << ";\n";
+  }
+  out << "}\n";
+  return out.str();
+}
+
+std::string ToJson(const TopoMap& map) {
+  nlohmann::json nodes = nlohmann::json::array(), links = nlohmann::json::array();
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    nlohmann::json node = {{"id", i},
+                           {"flight", n.flight},
+                           {"timestamp_ns", n.timestamp_ns},
+                           {"frame_index", n.frame_index},
+                           {"layout", {n.layout.x(), n.layout.y()}}};
+    node["gps"] = n.gps ? nlohmann::json{n.gps->x(), n.gps->y()} : nlohmann::json(nullptr);
+    nodes.push_back(node);
+  }
+  for (const TopoMap::Edge& e : map.Edges()) {
+    links.push_back({{"source", e.a},
+                     {"target", e.b},
+                     {"kind", ToString(e.data.kind)},
+                     {"bow_score", e.data.bow_score},
+                     {"matched_fraction", e.data.matched_fraction},
+                     {"inliers", e.data.inliers}});
+  }
+  const nlohmann::json document = {{"directed", false},
+                                   {"multigraph", true},
+                                   {"graph", {{"schema", "patrolmap.map/1"}, {"flights", map.Flights()}}},
+                                   {"nodes", nodes},
+                                   {"links", links}};
+  return document.dump(1) + "\n";
+}
+
+}  // namespace patrolmap::graph
