@@ -78,6 +78,8 @@ expect "graphml nodes" 0 "^6$" -- xmllint --xpath "count(//*[local-name()='node'
 expect "export dot" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format dot --out "$work/map.dot"
 expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
 expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
+expect "export svg" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format svg --out "$work/map.svg"
+expect "svg parses" 0 "" -- xmllint --noout "$work/map.svg"
 expect "export bad format" 2 "format" -- "$bin" export "$work/patrol/map.pmap" --format pdf
 expect "foreign map" 1 "not a patrolmap map file" -- "$bin" info "$source_dir/README.md"
 expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \

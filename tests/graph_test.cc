@@ -227,3 +227,63 @@ TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
 
 }  // namespace
 }  // namespace patrolmap::graph
+
+#include "patrolmap/graph/layout.h"
+
+namespace patrolmap::graph {
+namespace {
+
+TEST(Layout, OdometryJacobianMatchesNumericDifferentiation) {
+  const double a[3] = {1.2, -0.7, 0.9}, b[3] = {3.1, 0.4, 1.7};
+  const Eigen::Vector2d step(1.5, 0.3);
+  double residual[3], ja[9], jb[9];
+  OdometryResidual(a, b, step, 0.6, 7.0, residual, ja, jb);
+  const double h = 1e-6;
+  for (int p = 0; p < 3; ++p) {
+    for (int which = 0; which < 2; ++which) {
+      double plus[3], minus[3], rp[3], rm[3];
+      std::copy(which == 0 ? a : b, (which == 0 ? a : b) + 3, plus);
+      std::copy(which == 0 ? a : b, (which == 0 ? a : b) + 3, minus);
+      plus[p] += h, minus[p] -= h;
+      OdometryResidual(which == 0 ? plus : a, which == 0 ? b : plus, step, 0.6, 7.0, rp, nullptr, nullptr);
+      OdometryResidual(which == 0 ? minus : a, which == 0 ? b : minus, step, 0.6, 7.0, rm, nullptr, nullptr);
+      for (int r = 0; r < 3; ++r) {
+        const double numeric = (rp[r] - rm[r]) / (2 * h);
+        EXPECT_NEAR((which == 0 ? ja : jb)[r * 3 + p], numeric, 1e-6) << "residual " << r << " parameter " << p;
+      }
+    }
+  }
+}
+
+// A square loop of 4 x 10 nodes one second apart; the integrated headings drift by 0.01 rad a node.
+TopoMap SquareLoop(LayoutInput* input) {
+  TopoMap map;
+  input->heading.clear();
+  for (int i = 0; i <= 40; ++i) {
+    NodeData node;
+    node.flight = "a";
+    node.timestamp_ns = SecondsToNs(i);
+    map.AddNode(node);
+    if (i > 0) map.AddEdge(i - 1, i, EdgeData{});
+    input->heading.push_back((i / 10) * M_PI / 2 + 0.01 * i);
+  }
+  return map;
+}
+
+TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
+  LayoutInput input;
+  TopoMap open = SquareLoop(&input);
+  ASSERT_TRUE(LayoutMap(input, {}, &open).ok());
+  const double gap = (open.node(40).layout - open.node(0).layout).norm();
+  EXPECT_GT(gap, 2.0);  // the heading drift leaves the loop open
+  TopoMap closed = SquareLoop(&input);
+  closed.AddEdge(40, 0, {EdgeKind::kLoopClosure, 0.5, 0.5, 100});
+  closed.AddEdge(25, 5, {EdgeKind::kLoopClosure, 0.1, 0.2, 50});  // false: opposite sides, 10 m apart
+  ASSERT_TRUE(LayoutMap(input, {}, &closed).ok());
+  EXPECT_LT((closed.node(40).layout - closed.node(0).layout).norm(), 0.3 * gap);
+  EXPECT_GT((closed.node(25).layout - closed.node(5).layout).norm(), 6.0);  // the robust loss keeps them apart
+  EXPECT_NEAR((closed.node(10).layout - closed.node(0).layout).norm(), 10.0, 1.5);  // sides keep their length
+}
+
+}  // namespace
+}  // namespace patrolmap::graph

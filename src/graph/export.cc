@@ -1,5 +1,6 @@
 #include "patrolmap/graph/export.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
@@ -122,6 +123,42 @@ std::string ToJson(const TopoMap& map) {
                                    {"nodes", nodes},
                                    {"links", links}};
   return document.dump(1) + "\n";
+}
+
+std::string ToSvg(const TopoMap& map) {
+  constexpr double kSize = 800.0, kMargin = 40.0;
+  Eigen::Vector2d low(0, 0), high(1, 1);
+  for (int i = 0; i < map.node_count(); ++i) {
+    low = i == 0 ? map.node(i).layout : low.cwiseMin(map.node(i).layout);
+    high = i == 0 ? map.node(i).layout : high.cwiseMax(map.node(i).layout);
+  }
+  const double span = std::max({high.x() - low.x(), high.y() - low.y(), 1e-6});
+  const double scale = (kSize - 2 * kMargin) / span;
+  const auto x = [&](int i) { return Precise(kMargin + (map.node(i).layout.x() - low.x()) * scale); };
+  const auto y = [&](int i) { return Precise(kSize - kMargin - (map.node(i).layout.y() - low.y()) * scale); };
+  const char* colours[] = {"#1d4ed8", "#d97706", "#7c3aed", "#0f766e", "#be123c"};
+  const std::vector<std::string> flights = map.Flights();
+  std::ostringstream out;
+  out << "<?xml version='1.0' encoding='UTF-8'?>\n<svg xmlns='http://www.w3.org/2000/svg' width='" << kSize
+      << "' height='" << kSize << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  for (const TopoMap::Edge& e : map.Edges()) {
+    const bool closure = e.data.kind == EdgeKind::kLoopClosure;
+    const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(e.a).flight) - flights.begin();
+    out << "<line x1='" << x(e.a) << "' y1='" << y(e.a) << "' x2='" << x(e.b) << "' y2='" << y(e.b) << "' stroke='"
+        << (closure ? "#16a34a" : colours[flight % 5]) << "' stroke-width='" << (closure ? 2 : 3) << "'"
+        << (closure ? " stroke-dasharray='6 4'" : "") << "/>\n";
+  }
+  for (int i = 0; i < map.node_count(); ++i) {
+    const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(i).flight) - flights.begin();
+    out << "<circle cx='" << x(i) << "' cy='" << y(i) << "' r='6' fill='" << colours[flight % 5] << "'/><text x='" << x(i)
+        << "' y='" << y(i) << "' dx='8' dy='-8' font-size='11'>" << i << "</text>\n";
+  }
+  for (std::size_t f = 0; f < flights.size(); ++f) {
+    out << "<text x='10' y='" << 18 + 16 * f << "' font-size='12' fill='" << colours[f % 5] << "'>" << EscapeXml(flights[f])
+        << "</text>\n";
+  }
+  out << "<text x='10' y='" << 18 + 16 * flights.size() << "' font-size='12' fill='#16a34a'>loop closure</text>\n</svg>\n";
+  return out.str();
 }
 
 }  // namespace patrolmap::graph

@@ -107,7 +107,7 @@ std::string NodeSection(const TopoMap& map) {
     w.Mat(n.thumbnail);
     w.Value(static_cast<std::uint8_t>(n.gps.has_value()));
     const Eigen::Vector2d gps = n.gps.value_or(Eigen::Vector2d::Zero());
-    for (double v : {gps.x(), gps.y(), n.layout.x(), n.layout.y()}) w.Value(v);
+    for (double v : {gps.x(), gps.y(), n.layout.x(), n.layout.y(), n.heading}) w.Value(v);
   }
   return std::move(w.bytes());
 }
@@ -163,10 +163,11 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
     n.frame_index = r->Value<std::int64_t>();
     n.thumbnail = r->Mat();
     const bool has_gps = r->Value<std::uint8_t>() != 0;
-    double v[4];
+    double v[5];
     for (double& value : v) value = r->Value<double>();
     if (has_gps) n.gps = Eigen::Vector2d(v[0], v[1]);
     n.layout = Eigen::Vector2d(v[2], v[3]);
+    n.heading = v[4];
     map->AddNode(std::move(n));
   }
   return r->failed() || !r->done() ? Corrupt(path, "node section") : Status::Ok();

@@ -24,10 +24,31 @@ cv::Mat Thumbnail(const cv::Mat& image) {
   return thumbnail;
 }
 
-void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, std::map<int, std::int64_t>* frame_of,
-            MapResult* result) {
+// Integrates the yaw rate about the measured up axis (the accelerometer's mean
+// direction), so the IMU may be mounted any way round.
+class YawIntegrator {
+ public:
+  void Add(const std::vector<ImuSample>& samples) {
+    for (const ImuSample& sample : samples) {
+      if (sample.accel.norm() > 1.0) up_ = (0.99 * up_ + 0.01 * sample.accel.normalized()).normalized();
+      if (has_previous_) yaw_ += sample.gyro.dot(up_) * NsToSeconds(sample.timestamp_ns - previous_ns_);
+      previous_ns_ = sample.timestamp_ns;
+      has_previous_ = true;
+    }
+  }
+  double yaw() const { return yaw_; }
+
+ private:
+  Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
+  double yaw_ = 0.0;
+  TimestampNs previous_ns_ = 0;
+  bool has_previous_ = false;
+};
+
+void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, double heading,
+            std::map<int, std::int64_t>* frame_of, MapResult* result) {
   result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
-                           Thumbnail(key_frame.image)});
+                           Thumbnail(key_frame.image), heading});
   (*frame_of)[place.node] = key_frame.frame_index;
   result->seconds_features += place.seconds_features;
   result->seconds_query += place.seconds_query;
@@ -54,8 +75,10 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
   std::int64_t next = 0;
   place::KeyFrame key_frame;
   key_frame.flight = source->info().flight_id;
+  YawIntegrator yaw;
   while ((status = source->Next(Selected(selection, next, step), &frame)).ok()) {
     next = frame.index + 1;
+    yaw.Add(frame.imu);
     if (frame.image.empty() || !Selected(selection, frame.index, step)) continue;
     if (scale < 1.0) cv::resize(frame.image, key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
     else key_frame.image = frame.image;
@@ -63,7 +86,7 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
     key_frame.frame_index = frame.index;
     place::PlaceResult place;
     PATROLMAP_RETURN_IF_ERROR(recognizer->AddKeyFrame(key_frame, &place));
-    Record(key_frame, place, &frame_of, result);
+    Record(key_frame, place, yaw.yaw(), &frame_of, result);
     if (progress) progress(frame.index, source->info().frame_count);
   }
   return status.end_of_stream() ? Status::Ok() : status;
@@ -80,6 +103,7 @@ graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognize
     data.timestamp_ns = node.timestamp_ns;
     data.frame_index = node.frame_index;
     data.thumbnail = node.thumbnail;
+    data.heading = node.heading;
     data.keypoints = std::move(features.keypoints);
     data.descriptors = std::move(features.descriptors);
     data.bow = std::move(features.bow);

@@ -24,6 +24,7 @@ int RunExport(const ExportArguments& arguments) {
   if (!status.ok()) return Fail(status);
   const std::string text = arguments.format == "graphml" ? graph::ToGraphML(map)
                            : arguments.format == "dot"   ? graph::ToDot(map)
+                           : arguments.format == "svg"   ? graph::ToSvg(map)
                                                          : graph::ToJson(map);
   if (arguments.out.empty()) {
     std::fwrite(text.data(), 1, text.size(), stdout);
@@ -38,8 +39,9 @@ int RunExport(const ExportArguments& arguments) {
 Command AddExportCommand(CLI::App* app) {
   auto arguments = std::make_shared<ExportArguments>();
   app->add_option("map", arguments->map, "map file (map.pmap)")->required();
-  app->add_option("-f,--format", arguments->format, "graphml (NetworkX, Gephi, yEd), dot (Graphviz) or json (node-link)")
-      ->check(CLI::IsMember({"graphml", "dot", "json"}))
+  app->add_option("-f,--format", arguments->format,
+                  "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link) or svg (the layout, like paper Fig. 5)")
+      ->check(CLI::IsMember({"graphml", "dot", "json", "svg"}))
       ->capture_default_str();
   app->add_option("-o,--out", arguments->out, "file to write (default: standard output)");
   return [arguments] { return RunExport(*arguments); };

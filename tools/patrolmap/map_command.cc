@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/pipeline/detect.h"
+#include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/map.h"
 #include "progress.h"
@@ -82,7 +83,8 @@ int RunMap(const MapArguments& arguments) {
                                          [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
     }
   }
-  const graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  if (status.ok()) status = graph::LayoutMap(graph::LayoutInputOf(map), graph::LayoutOptions{}, &map);
   if (status.ok()) status = pipeline::WriteMapOutputs(map, arguments.out);
   if (status.ok()) status = graph::SaveMap(map, arguments.out + "/map.pmap");
   if (!status.ok()) return Fail(status);

@@ -4,7 +4,8 @@
 //    of a latitude);
 //  - DOT for Graphviz (loop closures dashed and green);
 //  - JSON in NetworkX's node-link form ("nodes", "links"), schema
-//    "patrolmap.map/1" in the graph attributes.
+//    "patrolmap.map/1" in the graph attributes;
+//  - SVG of the layout.
 #pragma once
 
 #include <string>
@@ -16,5 +17,8 @@ namespace patrolmap::graph {
 std::string ToGraphML(const TopoMap& map);
 std::string ToDot(const TopoMap& map);
 std::string ToJson(const TopoMap& map);
+// A picture like the paper's Fig. 5 from the layout: each flight's path in its
+// own colour, numbered nodes, loop closures as green dashed lines.
+std::string ToSvg(const TopoMap& map);
 
 }  // namespace patrolmap::graph

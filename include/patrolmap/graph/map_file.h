@@ -6,7 +6,7 @@
 //   u32      format version
 //   u32      section count
 //   sections tag (4 bytes), u64 payload length, u64 checksum of the payload, payload
-//            NODE: per node flight, time, frame, thumbnail, GPS, layout
+//            NODE: per node flight, time, frame, thumbnail, GPS, layout, heading
 //            EDGE: per edge the two nodes, kind and verification scores
 //            FEAT: per node keypoints, descriptors and BoW vector
 // Saving is atomic (temporary file, fsync, rename): a crash never leaves a

@@ -27,6 +27,7 @@ struct NodeData {
   cv::Mat descriptors;                   // without the original log (CV_8U or CV_32F rows)
   vocab::BowVector bow;
   std::optional<Eigen::Vector2d> gps;    // latitude, longitude [deg], when the log has them
+  double heading = 0.0;                  // integrated gyro yaw at the node [rad] (0 without an IMU)
   Eigen::Vector2d layout = Eigen::Vector2d::Zero();  // 2D position for pictures (scaleless)
 };
 

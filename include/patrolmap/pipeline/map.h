@@ -19,7 +19,8 @@ struct MapNode {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
   int features = 0;
-  cv::Mat thumbnail;  // the key frame at kThumbnailWidth pixels wide
+  cv::Mat thumbnail;    // the key frame at kThumbnailWidth pixels wide
+  double heading = 0;   // gyro yaw integrated since the start of the flight [rad]
 };
 
 constexpr int kThumbnailWidth = 160;
