@@ -80,6 +80,11 @@ expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
 expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
 expect "export svg" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format svg --out "$work/map.svg"
 expect "svg parses" 0 "" -- xmllint --noout "$work/map.svg"
+expect "export geojson" 0 "FeatureCollection" -- "$bin" export "$work/map/map.pmap" --format geojson
+expect "export kml" 0 "" -- "$bin" export "$work/map/map.pmap" --format kml --out "$work/map.kml"
+expect "kml parses" 0 "" -- xmllint --noout "$work/map.kml"
+"$bin" -q map "$work/second" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/nogps" >/dev/null
+expect "geojson without gps" 1 "no node has a GPS position" -- "$bin" export "$work/nogps/map.pmap" --format geojson
 expect "export bad format" 2 "format" -- "$bin" export "$work/patrol/map.pmap" --format pdf
 expect "foreign map" 1 "not a patrolmap map file" -- "$bin" info "$source_dir/README.md"
 expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \

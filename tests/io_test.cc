@@ -269,6 +269,23 @@ TEST(Euroc, SpeedIsInterpolatedFromTheStateTable) {
   EXPECT_DOUBLE_EQ(*frames[2].speed_mps, 1.0);
 }
 
+TEST(Euroc, GpsIsInterpolatedAtFrameTimes) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/gps0/data.csv", "#t,lat,lon,alt\n1000000000,47.0,8.0,500\n1100000000,47.0002,8.0004,510\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_TRUE(frames[1].gps.has_value());
+  EXPECT_NEAR(frames[1].gps->x(), 47.0001, 1e-12);
+  EXPECT_NEAR(frames[1].gps->y(), 8.0002, 1e-12);
+  EXPECT_NEAR(frames[1].gps->z(), 505.0, 1e-9);
+  WriteText(log + "/gps0/data.csv", "1000000000,47.0,8.0\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("gps0/data.csv:1: expected at least 4 columns"), std::string::npos);
+}
+
 TEST(Euroc, RealSensorYamlFromSharedData) {
   const std::string path = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/sensorLeft.yaml";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data not present";

@@ -125,6 +125,81 @@ std::string ToJson(const TopoMap& map) {
   return document.dump(1) + "\n";
 }
 
+bool HasGps(const TopoMap& map) {
+  for (int i = 0; i < map.node_count(); ++i) {
+    if (map.node(i).gps) return true;
+  }
+  return false;
+}
+
+namespace {
+
+nlohmann::json LonLat(const NodeData& node) { return {node.gps->y(), node.gps->x()}; }
+
+// Nodes of each flight that have GPS, in order.
+std::vector<std::vector<int>> FlightPaths(const TopoMap& map) {
+  const std::vector<std::string> flights = map.Flights();
+  std::vector<std::vector<int>> paths(flights.size());
+  for (int i = 0; i < map.node_count(); ++i) {
+    if (!map.node(i).gps) continue;
+    paths[std::find(flights.begin(), flights.end(), map.node(i).flight) - flights.begin()].push_back(i);
+  }
+  return paths;
+}
+
+}  // namespace
+
+std::string ToGeoJson(const TopoMap& map) {
+  nlohmann::json features = nlohmann::json::array();
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    if (!n.gps) continue;
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "Point"}, {"coordinates", LonLat(n)}}},
+                        {"properties", {{"node", i}, {"flight", n.flight}, {"timestamp_ns", n.timestamp_ns}}}});
+  }
+  const std::vector<std::string> flights = map.Flights();
+  const std::vector<std::vector<int>> paths = FlightPaths(map);
+  for (std::size_t f = 0; f < paths.size(); ++f) {
+    if (paths[f].size() < 2) continue;
+    nlohmann::json line = nlohmann::json::array();
+    for (int i : paths[f]) line.push_back(LonLat(map.node(i)));
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", line}}},
+                        {"properties", {{"flight", flights[f]}, {"kind", "path"}}}});
+  }
+  for (const TopoMap::Edge& e : map.Edges()) {
+    if (e.data.kind != EdgeKind::kLoopClosure || !map.node(e.a).gps || !map.node(e.b).gps) continue;
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", {LonLat(map.node(e.a)), LonLat(map.node(e.b))}}}},
+                        {"properties", {{"kind", "loop_closure"}, {"query_node", e.a}, {"matched_node", e.b},
+                                        {"inliers", e.data.inliers}}}});
+  }
+  return nlohmann::json({{"type", "FeatureCollection"}, {"features", features}}).dump(1) + "\n";
+}
+
+std::string ToKml(const TopoMap& map) {
+  std::ostringstream out;
+  const auto coordinate = [](const NodeData& n) { return Precise(n.gps->y()) + "," + Precise(n.gps->x()) + ",0"; };
+  out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n"
+      << "<name>patrolmap</name>\n";
+  for (int i = 0; i < map.node_count(); ++i) {
+    if (!map.node(i).gps) continue;
+    out << "<Placemark><name>" << i << "</name><description>" << EscapeXml(map.node(i).flight)
+        << "</description><Point><coordinates>" << coordinate(map.node(i)) << "</coordinates></Point></Placemark>\n";
+  }
+  const std::vector<std::string> flights = map.Flights();
+  const std::vector<std::vector<int>> paths = FlightPaths(map);
+  for (std::size_t f = 0; f < paths.size(); ++f) {
+    if (paths[f].size() < 2) continue;
+    out << "<Placemark><name>" << EscapeXml(flights[f]) << "</name><LineString><coordinates>";
+    for (int i : paths[f]) out << coordinate(map.node(i)) << " ";
+    out << "</coordinates></LineString></Placemark>\n";
+  }
+  out << "</Document>\n</kml>\n";
+  return out.str();
+}
+
 std::string ToSvg(const TopoMap& map) {
   constexpr double kSize = 800.0, kMargin = 40.0;
   Eigen::Vector2d low(0, 0), high(1, 1);

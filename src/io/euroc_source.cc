@@ -158,6 +158,14 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
   return Status::Ok();
 }
 
+// gps0/data.csv: timestamp, latitude [deg], longitude [deg], altitude [m].
+Status ReadGpsTable(const std::string& path, std::vector<GpsSample>* samples) {
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, GpsSample* sample) {
+    return ParseVector(csv, fields, 1, "latitude, longitude, altitude", &sample->position);
+  };
+  return ReadTimedTable(path, 4, parse, samples);
+}
+
 }  // namespace
 
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source) {
@@ -171,13 +179,15 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   std::vector<ImageEntry> entries;
   std::vector<ImuSample> imu;
   std::vector<SpeedSample> speeds;
+  std::vector<GpsSample> gps;
   PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, &entries));
   PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &speeds));
+  if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
   if (!imu.empty() && !info.camera_from_imu) {
     spdlog::warn("{}: imu0 present but cam0/sensor.yaml missing: camera-IMU rotation unknown", log);
   }
   *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu),
-                                              std::move(speeds));
+                                              std::move(speeds), std::move(gps));
   return Status::Ok();
 }
 

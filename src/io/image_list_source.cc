@@ -7,9 +7,9 @@
 namespace patrolmap::io {
 
 ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries,
-                                 std::vector<ImuSample> imu, std::vector<SpeedSample> speeds)
+                                 std::vector<ImuSample> imu, std::vector<SpeedSample> speeds, std::vector<GpsSample> gps)
     : info_(std::move(info)), entries_(std::move(entries)), imu_(std::move(imu)),
-      speeds_(std::move(speeds)) {
+      speeds_(std::move(speeds)), gps_(std::move(gps)) {
   info_.frame_count = static_cast<std::int64_t>(entries_.size());
   info_.has_imu = !imu_.empty();
   info_.has_speed = !speeds_.empty();
@@ -26,6 +26,7 @@ Status ImageListSource::Next(bool decode_image, Frame* frame) {
     frame->timestamp_ns = entry.timestamp_ns;
     frame->index = index;
     frame->speed_mps = SpeedAt(entry.timestamp_ns);
+    frame->gps = GpsAt(entry.timestamp_ns);
     return Status::Ok();
   }
   return Status::EndOfStream();
@@ -65,6 +66,18 @@ std::optional<double> ImageListSource::SpeedAt(TimestampNs timestamp_ns) const {
   const double span = static_cast<double>(after->timestamp_ns - before.timestamp_ns);
   const double weight = static_cast<double>(timestamp_ns - before.timestamp_ns) / span;
   return before.speed_mps + weight * (after->speed_mps - before.speed_mps);
+}
+
+std::optional<Eigen::Vector3d> ImageListSource::GpsAt(TimestampNs timestamp_ns) const {
+  if (gps_.empty()) return std::nullopt;
+  const auto after = std::lower_bound(gps_.begin(), gps_.end(), timestamp_ns,
+                                      [](const GpsSample& sample, TimestampNs t) { return sample.timestamp_ns < t; });
+  if (after == gps_.begin()) return after->position;
+  if (after == gps_.end()) return gps_.back().position;
+  const GpsSample& before = *(after - 1);
+  const double weight = static_cast<double>(timestamp_ns - before.timestamp_ns) /
+                        static_cast<double>(after->timestamp_ns - before.timestamp_ns);
+  return Eigen::Vector3d(before.position + weight * (after->position - before.position));
 }
 
 }  // namespace patrolmap::io

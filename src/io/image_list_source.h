@@ -19,11 +19,16 @@ struct SpeedSample {
   double speed_mps = 0.0;
 };
 
+struct GpsSample {
+  TimestampNs timestamp_ns = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // latitude, longitude [deg], altitude [m]
+};
+
 class ImageListSource : public FrameSource {
  public:
   // `imu` and `speeds` must be sorted by time (the EuRoC reader checks this).
   ImageListSource(LogInfo info, std::vector<ImageEntry> entries, std::vector<ImuSample> imu = {},
-                  std::vector<SpeedSample> speeds = {});
+                  std::vector<SpeedSample> speeds = {}, std::vector<GpsSample> gps = {});
 
   Status Next(bool decode_image, Frame* frame) override;
   const LogInfo& info() const override { return info_; }
@@ -31,12 +36,14 @@ class ImageListSource : public FrameSource {
  private:
   void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);
   std::optional<double> SpeedAt(TimestampNs timestamp_ns) const;
+  std::optional<Eigen::Vector3d> GpsAt(TimestampNs timestamp_ns) const;
   bool Decode(std::int64_t index, const std::string& path, cv::Mat* image);
 
   LogInfo info_;
   std::vector<ImageEntry> entries_;
   std::vector<ImuSample> imu_;
   std::vector<SpeedSample> speeds_;
+  std::vector<GpsSample> gps_;
   std::size_t next_entry_ = 0;
   std::size_t next_imu_ = 0;
   cv::Size first_size_;

@@ -46,9 +46,10 @@ class YawIntegrator {
 };
 
 void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, double heading,
-            std::map<int, std::int64_t>* frame_of, MapResult* result) {
+            const std::optional<Eigen::Vector3d>& gps, std::map<int, std::int64_t>* frame_of, MapResult* result) {
   result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
-                           Thumbnail(key_frame.image), heading});
+                           Thumbnail(key_frame.image), heading,
+                           gps ? std::optional<Eigen::Vector2d>(gps->head<2>()) : std::nullopt});
   (*frame_of)[place.node] = key_frame.frame_index;
   result->seconds_features += place.seconds_features;
   result->seconds_query += place.seconds_query;
@@ -86,7 +87,7 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
     key_frame.frame_index = frame.index;
     place::PlaceResult place;
     PATROLMAP_RETURN_IF_ERROR(recognizer->AddKeyFrame(key_frame, &place));
-    Record(key_frame, place, yaw.yaw(), &frame_of, result);
+    Record(key_frame, place, yaw.yaw(), frame.gps, &frame_of, result);
     if (progress) progress(frame.index, source->info().frame_count);
   }
   return status.end_of_stream() ? Status::Ok() : status;
@@ -104,6 +105,7 @@ graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognize
     data.frame_index = node.frame_index;
     data.thumbnail = node.thumbnail;
     data.heading = node.heading;
+    data.gps = node.gps;
     data.keypoints = std::move(features.keypoints);
     data.descriptors = std::move(features.descriptors);
     data.bow = std::move(features.bow);

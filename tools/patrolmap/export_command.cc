@@ -22,7 +22,13 @@ int RunExport(const ExportArguments& arguments) {
   graph::TopoMap map;
   Status status = graph::LoadMap(arguments.map, &map);
   if (!status.ok()) return Fail(status);
+  const bool geographic = arguments.format == "geojson" || arguments.format == "kml";
+  if (geographic && !graph::HasGps(map)) {
+    return Fail(Status::InvalidArgument(arguments.map + ": no node has a GPS position (the logs had no gps0/)"));
+  }
   const std::string text = arguments.format == "graphml" ? graph::ToGraphML(map)
+                           : arguments.format == "geojson" ? graph::ToGeoJson(map)
+                           : arguments.format == "kml"     ? graph::ToKml(map)
                            : arguments.format == "dot"   ? graph::ToDot(map)
                            : arguments.format == "svg"   ? graph::ToSvg(map)
                                                          : graph::ToJson(map);
@@ -40,8 +46,9 @@ Command AddExportCommand(CLI::App* app) {
   auto arguments = std::make_shared<ExportArguments>();
   app->add_option("map", arguments->map, "map file (map.pmap)")->required();
   app->add_option("-f,--format", arguments->format,
-                  "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link) or svg (the layout, like paper Fig. 5)")
-      ->check(CLI::IsMember({"graphml", "dot", "json", "svg"}))
+                  "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link), svg (the layout, like paper Fig. 5), "
+                  "geojson or kml (with GPS)")
+      ->check(CLI::IsMember({"graphml", "dot", "json", "svg", "geojson", "kml"}))
       ->capture_default_str();
   app->add_option("-o,--out", arguments->out, "file to write (default: standard output)");
   return [arguments] { return RunExport(*arguments); };

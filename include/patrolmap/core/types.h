@@ -43,6 +43,7 @@ struct Frame {
   cv::Mat image;                   // CV_8UC1; empty when the caller asked not to decode
   std::vector<ImuSample> imu;      // samples with previous timestamp < t <= timestamp_ns
   std::optional<double> speed_mps; // known platform speed, when the log carries it
+  std::optional<Eigen::Vector3d> gps;  // latitude, longitude [deg], altitude [m], when the log carries it
 };
 
 // Kind of extremum of the smoothed scene-flow response (paper 002 §III-A).

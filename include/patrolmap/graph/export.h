@@ -20,5 +20,11 @@ std::string ToJson(const TopoMap& map);
 // A picture like the paper's Fig. 5 from the layout: each flight's path in its
 // own colour, numbered nodes, loop closures as green dashed lines.
 std::string ToSvg(const TopoMap& map);
+// GeoJSON (RFC 7946: [longitude, latitude]) and KML of the nodes with GPS:
+// a point per node, a line per flight, a line per loop closure. Only for maps
+// whose nodes have GPS positions (HasGps).
+bool HasGps(const TopoMap& map);
+std::string ToGeoJson(const TopoMap& map);
+std::string ToKml(const TopoMap& map);
 
 }  // namespace patrolmap::graph

@@ -21,6 +21,7 @@ struct MapNode {
   int features = 0;
   cv::Mat thumbnail;    // the key frame at kThumbnailWidth pixels wide
   double heading = 0;   // gyro yaw integrated since the start of the flight [rad]
+  std::optional<Eigen::Vector2d> gps;  // latitude, longitude [deg] at the key frame, when the log has GPS
 };
 
 constexpr int kThumbnailWidth = 160;
