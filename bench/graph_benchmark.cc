@@ -1,10 +1,12 @@
 // Map file speed and size for 10,000 nodes of 200 features each (8-bit
 // descriptors, a 160x102 thumbnail and a 150-word BoW vector per node).
+#include <cmath>
 #include <filesystem>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 
+#include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 
 namespace {
@@ -50,6 +52,22 @@ void BM_LoadMap10k(benchmark::State& state) {
   state.counters["nodes"] = map.node_count();
 }
 BENCHMARK(BM_LoadMap10k)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// Layout of the same 10,000 nodes: 4 flights of 2,500 nodes one second apart with smoothly
+// turning headings, and a loop closure every 7th node from the second flight on.
+void BM_Layout10k(benchmark::State& state) {
+  graph::TopoMap map = TenThousandNodes();
+  for (int i = 0; i < map.node_count(); ++i) {
+    map.mutable_node(i).timestamp_ns = SecondsToNs(i % 2500);
+    map.mutable_node(i).heading = 0.01 * (i % 2500) + 0.3 * std::sin(0.05 * (i % 2500));
+  }
+  const graph::LayoutInput input = graph::LayoutInputOf(map);
+  for (auto _ : state) {
+    if (!graph::LayoutMap(input, graph::LayoutOptions{}, &map).ok()) state.SkipWithError("layout failed");
+  }
+  state.counters["loop_closures"] = map.loop_closure_count();
+}
+BENCHMARK(BM_Layout10k)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
