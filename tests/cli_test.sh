@@ -75,6 +75,12 @@ expect "truncated map" 1 "cut.pmap: truncated map" -- "$bin" patrol "$work/secon
 expect "export graphml" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format graphml --out "$work/map.graphml"
 expect "graphml parses" 0 "" -- xmllint --noout "$work/map.graphml"
 expect "graphml nodes" 0 "^6$" -- xmllint --xpath "count(//*[local-name()='node'])" "$work/map.graphml"
+"$bin" export "$work/patrol/map.pmap" --format json --out "$work/map.json" >/dev/null
+expect "networkx reads graphml and json" 0 "graphml 6 4 json 6 4" -- /usr/bin/python3 -c "
+import json, networkx as nx
+g = nx.read_graphml('$work/map.graphml')
+j = nx.node_link_graph(json.load(open('$work/map.json')))
+print('graphml', g.number_of_nodes(), g.number_of_edges(), 'json', j.number_of_nodes(), j.number_of_edges())"
 expect "export dot" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format dot --out "$work/map.dot"
 expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
 expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
