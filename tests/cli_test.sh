@@ -86,6 +86,10 @@ expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
 expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
 expect "export svg" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format svg --out "$work/map.svg"
 expect "svg parses" 0 "" -- xmllint --noout "$work/map.svg"
+expect "svg with truth" 0 "missed loop closure" -- "$bin" export "$work/patrol/map.pmap" --format svg \
+  --log "$source_dir/flight_logs/sample" --log "$work/second"
+expect "svg truth needs every flight" 2 "no --log holds the places" -- "$bin" export "$work/patrol/map.pmap" \
+  --format svg --log "$work/second"
 expect "export geojson" 0 "FeatureCollection" -- "$bin" export "$work/map/map.pmap" --format geojson
 expect "export kml" 0 "" -- "$bin" export "$work/map/map.pmap" --format kml --out "$work/map.kml"
 expect "kml parses" 0 "" -- xmllint --noout "$work/map.kml"

@@ -287,3 +287,28 @@ TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
 
 }  // namespace
 }  // namespace patrolmap::graph
+
+namespace patrolmap::graph {
+namespace {
+
+TEST(Export, SvgColoursLoopClosuresByTruth) {
+  const TopoMap map = TwoFlights();
+  const std::string plain = ToSvg(map);
+  EXPECT_EQ(plain.find("#dc2626"), std::string::npos);
+  SvgTruth truth;
+  truth.loop_closure_correct = {true, false, true};  // 4~1 correct, 6~3 false, 5~1 correct
+  truth.missed = {{6, 2}};
+  const std::string judged = ToSvg(map, &truth);
+  const auto count = [&judged](const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = judged.find(what); at != std::string::npos; at = judged.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("stroke='#16a34a'"), 2u);  // correct closures
+  EXPECT_EQ(count("stroke='#dc2626'"), 1u);  // the false one
+  EXPECT_EQ(count("stroke='#2563eb'"), 1u);  // the missed pair
+  EXPECT_NE(judged.find("missed loop closure"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace patrolmap::graph

@@ -49,10 +49,12 @@ LoopClosureScore ScoreLoopClosures(const std::vector<NodeRecord>& nodes, const s
   std::map<int, std::size_t> index_of;
   for (std::size_t i = 0; i < nodes.size(); ++i) index_of[nodes[i].node] = i;
   std::vector<bool> possible(nodes.size(), false), found(nodes.size(), false);
+  std::vector<int> earlier(nodes.size(), -1);
   for (std::size_t q = 0; q < nodes.size(); ++q) {
     for (std::size_t e = 0; e < nodes.size() && !possible[q]; ++e) {
       possible[q] = Before(nodes[e], flight[e], nodes[q], flight[q], options.min_gap_s) &&
                     SamePlace(places[e], places[q], options);
+      if (possible[q]) earlier[q] = static_cast<int>(e);
     }
   }
   for (const LoopClosureRecord& closure : closures) {
@@ -67,6 +69,7 @@ LoopClosureScore ScoreLoopClosures(const std::vector<NodeRecord>& nodes, const s
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     score.possible += possible[i];
     score.found += possible[i] && found[i];
+    if (possible[i] && !found[i]) score.missed.emplace_back(static_cast<int>(i), earlier[i]);
   }
   return score;
 }

@@ -200,7 +200,7 @@ std::string ToKml(const TopoMap& map) {
   return out.str();
 }
 
-std::string ToSvg(const TopoMap& map) {
+std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
   constexpr double kSize = 800.0, kMargin = 40.0;
   Eigen::Vector2d low(0, 0), high(1, 1);
   for (int i = 0; i < map.node_count(); ++i) {
@@ -211,17 +211,27 @@ std::string ToSvg(const TopoMap& map) {
   const double scale = (kSize - 2 * kMargin) / span;
   const auto x = [&](int i) { return Precise(kMargin + (map.node(i).layout.x() - low.x()) * scale); };
   const auto y = [&](int i) { return Precise(kSize - kMargin - (map.node(i).layout.y() - low.y()) * scale); };
-  const char* colours[] = {"#1d4ed8", "#d97706", "#7c3aed", "#0f766e", "#be123c"};
+  // Flight colours stay clear of the verdict colours (green, red, blue).
+  const char* colours[] = {"#374151", "#d97706", "#7c3aed", "#0f766e", "#a16207"};
   const std::vector<std::string> flights = map.Flights();
   std::ostringstream out;
   out << "<?xml version='1.0' encoding='UTF-8'?>\n<svg xmlns='http://www.w3.org/2000/svg' width='" << kSize
       << "' height='" << kSize << "' font-family='sans-serif'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  std::size_t closure_index = 0;
   for (const TopoMap::Edge& e : map.Edges()) {
     const bool closure = e.data.kind == EdgeKind::kLoopClosure;
     const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(e.a).flight) - flights.begin();
+    std::string colour = colours[flight % 5];
+    if (closure) {
+      const bool correct = truth == nullptr || truth->loop_closure_correct.at(closure_index++);
+      colour = correct ? "#16a34a" : "#dc2626";
+    }
     out << "<line x1='" << x(e.a) << "' y1='" << y(e.a) << "' x2='" << x(e.b) << "' y2='" << y(e.b) << "' stroke='"
-        << (closure ? "#16a34a" : colours[flight % 5]) << "' stroke-width='" << (closure ? 2 : 3) << "'"
-        << (closure ? " stroke-dasharray='6 4'" : "") << "/>\n";
+        << colour << "' stroke-width='" << (closure ? 2 : 3) << "'" << (closure ? " stroke-dasharray='6 4'" : "") << "/>\n";
+  }
+  for (const auto& [a, b] : truth != nullptr ? truth->missed : std::vector<std::pair<int, int>>{}) {
+    out << "<line x1='" << x(a) << "' y1='" << y(a) << "' x2='" << x(b) << "' y2='" << y(b)
+        << "' stroke='#2563eb' stroke-width='2' stroke-dasharray='2 3'/>\n";
   }
   for (int i = 0; i < map.node_count(); ++i) {
     const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(i).flight) - flights.begin();
@@ -232,7 +242,14 @@ std::string ToSvg(const TopoMap& map) {
     out << "<text x='10' y='" << 18 + 16 * f << "' font-size='12' fill='" << colours[f % 5] << "'>" << EscapeXml(flights[f])
         << "</text>\n";
   }
-  out << "<text x='10' y='" << 18 + 16 * flights.size() << "' font-size='12' fill='#16a34a'>loop closure</text>\n</svg>\n";
+  const std::size_t legend = 18 + 16 * flights.size();
+  out << "<text x='10' y='" << legend << "' font-size='12' fill='#16a34a'>" << (truth ? "correct loop closure" : "loop closure")
+      << "</text>\n";
+  if (truth != nullptr) {
+    out << "<text x='10' y='" << legend + 16 << "' font-size='12' fill='#dc2626'>false loop closure</text>\n"
+        << "<text x='10' y='" << legend + 32 << "' font-size='12' fill='#2563eb'>missed loop closure</text>\n";
+  }
+  out << "</svg>\n";
   return out.str();
 }
 

@@ -1,5 +1,6 @@
 // patrolmap export MAP --format graphml|dot|json [--out FILE]
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -7,7 +8,9 @@
 #include "common.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/export.h"
+#include "patrolmap/eval/loop_closure_score.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/io/readers.h"
 
 namespace patrolmap::tools {
 namespace {
@@ -16,7 +19,45 @@ struct ExportArguments {
   std::string map;
   std::string format = "graphml";
   std::string out;
+  std::vector<std::string> logs;  // simulated logs of the map's flights: SVG loop closures coloured by truth
 };
+
+// Scores the map's loop closures against the logs' ground-truth places (as `patrolmap eval`).
+Status SvgTruthFromLogs(const graph::TopoMap& map, const std::vector<std::string>& logs, graph::SvgTruth* truth) {
+  std::map<std::string, std::vector<eval::Place>> places;
+  for (const std::string& log : logs) {
+    std::unique_ptr<io::FrameSource> source;
+    PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, {}, &source));
+    PATROLMAP_RETURN_IF_ERROR(eval::ReadPlaces(log, &places[source->info().flight_id]));
+  }
+  std::vector<eval::NodeRecord> nodes;
+  std::vector<eval::Place> node_places;
+  for (int i = 0; i < map.node_count(); ++i) {
+    const graph::NodeData& node = map.node(i);
+    const auto flight = places.find(node.flight);
+    if (flight == places.end() || node.frame_index >= static_cast<std::int64_t>(flight->second.size())) {
+      return Status::InvalidArgument("no --log holds the places of node " + std::to_string(i) + " (flight '" +
+                                     node.flight + "')");
+    }
+    nodes.push_back({i, node.flight, node.timestamp_ns, node.frame_index});
+    node_places.push_back(flight->second[node.frame_index]);
+  }
+  std::vector<eval::LoopClosureRecord> closures;
+  for (const graph::TopoMap::Edge& edge : map.Edges()) {
+    if (edge.data.kind == graph::EdgeKind::kLoopClosure) closures.push_back({edge.a, edge.b});
+  }
+  const eval::LoopClosureScore score = eval::ScoreLoopClosures(nodes, node_places, closures);
+  truth->loop_closure_correct = score.correct;
+  truth->missed = score.missed;
+  return Status::Ok();
+}
+
+std::string Svg(const graph::TopoMap& map, const ExportArguments& arguments, Status* status) {
+  if (arguments.logs.empty()) return graph::ToSvg(map);
+  graph::SvgTruth truth;
+  *status = SvgTruthFromLogs(map, arguments.logs, &truth);
+  return status->ok() ? graph::ToSvg(map, &truth) : std::string();
+}
 
 int RunExport(const ExportArguments& arguments) {
   graph::TopoMap map;
@@ -30,8 +71,12 @@ int RunExport(const ExportArguments& arguments) {
                            : arguments.format == "geojson" ? graph::ToGeoJson(map)
                            : arguments.format == "kml"     ? graph::ToKml(map)
                            : arguments.format == "dot"   ? graph::ToDot(map)
-                           : arguments.format == "svg"   ? graph::ToSvg(map)
+                           : arguments.format == "svg"   ? Svg(map, arguments, &status)
                                                          : graph::ToJson(map);
+  if (!status.ok()) {
+    Fail(status);
+    return status.code() == StatusCode::kInvalidArgument ? 2 : 1;
+  }
   if (arguments.out.empty()) {
     std::fwrite(text.data(), 1, text.size(), stdout);
     return 0;
@@ -51,6 +96,9 @@ Command AddExportCommand(CLI::App* app) {
       ->check(CLI::IsMember({"graphml", "dot", "json", "svg", "geojson", "kml"}))
       ->capture_default_str();
   app->add_option("-o,--out", arguments->out, "file to write (default: standard output)");
+  app->add_option("--log", arguments->logs,
+                  "svg: simulated logs of the map's flights; loop closures are drawn correct (green), false (red) and "
+                  "missed (blue) against their ground truth");
   return [arguments] { return RunExport(*arguments); };
 }
 

@@ -53,6 +53,8 @@ struct LoopClosureScore {
   int true_positives = 0;
   int false_positives = 0;
   std::vector<bool> correct;  // per reported closure
+  // For each possible but not found query node: (its index in `nodes`, the earliest node of its place).
+  std::vector<std::pair<int, int>> missed;
   double precision() const { return reported > 0 ? static_cast<double>(true_positives) / reported : 1.0; }
   double recall() const { return possible > 0 ? static_cast<double>(found) / possible : 1.0; }
 };

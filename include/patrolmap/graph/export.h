@@ -17,9 +17,16 @@ namespace patrolmap::graph {
 std::string ToGraphML(const TopoMap& map);
 std::string ToDot(const TopoMap& map);
 std::string ToJson(const TopoMap& map);
+// Ground-truth verdicts for the SVG, as `patrolmap eval` decides them.
+struct SvgTruth {
+  std::vector<bool> loop_closure_correct;     // per loop-closure edge, in Edges() order
+  std::vector<std::pair<int, int>> missed;    // node pairs of the same place that no closure joins
+};
+
 // A picture like the paper's Fig. 5 from the layout: each flight's path in its
-// own colour, numbered nodes, loop closures as green dashed lines.
-std::string ToSvg(const TopoMap& map);
+// own colour, numbered nodes, loop closures dashed. Without truth they are
+// green; with it correct ones are green, false ones red and missed ones blue.
+std::string ToSvg(const TopoMap& map, const SvgTruth* truth = nullptr);
 // GeoJSON (RFC 7946: [longitude, latitude]) and KML of the nodes with GPS:
 // a point per node, a line per flight, a line per loop closure. Only for maps
 // whose nodes have GPS positions (HasGps).
