@@ -269,12 +269,14 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 }  // namespace patrolmap::pipeline
 
 #include "patrolmap/eval/loop_closure_score.h"
+#include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/map.h"
 
 namespace patrolmap::pipeline {
 namespace {
 
 // The same street flown twice under different lighting; every processed frame of both flights is a node.
+// Mapped together, and as a patrol against flight 1's saved map: the results must agree exactly.
 // Loop closures of the second flight against the first are scored against the simulator's places.
 TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   testing::TempDir dir;
@@ -332,6 +334,29 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   EXPECT_EQ(score.nodes, 68);
   EXPECT_EQ(score.possible, 34);
   EXPECT_GE(score.found, 32);  // measured: 34
+
+  // The same second flight as a patrol: flight 1's map saved, loaded, and flight 2 matched against the
+  // file alone gives the same nodes and loop closures.
+  MapResult first_only;
+  place::PlaceRecognizer first_recognizer(&vocabulary, config.place);
+  ASSERT_TRUE(RecognisePlaces(dir / "street-1", config, every, &first_recognizer, &first_only).ok());
+  ASSERT_TRUE(graph::SaveMap(BuildTopoMap(first_only, first_recognizer), dir / "first.pmap").ok());
+  graph::TopoMap prior;
+  ASSERT_TRUE(graph::LoadMap(dir / "first.pmap", &prior).ok());
+  place::PlaceRecognizer patrol_recognizer(&vocabulary, config.place);
+  SeedRecognizer(prior, &patrol_recognizer);
+  MapResult patrol;
+  ASSERT_TRUE(RecognisePlaces(dir / "street-2", config, every, &patrol_recognizer, &patrol).ok());
+  const graph::TopoMap extended = BuildTopoMap(patrol, patrol_recognizer, &prior);
+  EXPECT_EQ(extended.node_count(), map.node_count());
+  EXPECT_EQ(extended.loop_closure_count(), map.loop_closure_count());
+  const auto joint = map.Edges(), patrolled = extended.Edges();
+  ASSERT_EQ(joint.size(), patrolled.size());
+  for (std::size_t i = 0; i < joint.size(); ++i) {
+    EXPECT_EQ(joint[i].a, patrolled[i].a);
+    EXPECT_EQ(joint[i].b, patrolled[i].b);
+    EXPECT_EQ(joint[i].data.inliers, patrolled[i].data.inliers);
+  }
   EXPECT_EQ(score.false_positives, 0);
 }
 

@@ -93,6 +93,14 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
   return status.end_of_stream() ? Status::Ok() : status;
 }
 
+void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer) {
+  PATROLMAP_CHECK(recognizer->node_count() == 0);
+  for (int i = 0; i < prior.node_count(); ++i) {
+    const graph::NodeData& node = prior.node(i);
+    recognizer->AddDescribedNode({node.flight, node.timestamp_ns, node.keypoints, node.descriptors, node.bow});
+  }
+}
+
 graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
                             const graph::TopoMap* prior) {
   graph::TopoMap map;

@@ -52,14 +52,6 @@ void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& resu
               1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
 }
 
-// Puts a prior map's nodes into the recognizer, in order, so new key frames are matched against them.
-void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer) {
-  for (int i = 0; i < prior.node_count(); ++i) {
-    const graph::NodeData& node = prior.node(i);
-    recognizer->AddDescribedNode({node.flight, node.timestamp_ns, node.keypoints, node.descriptors, node.bow});
-  }
-}
-
 int RunMap(const MapArguments& arguments) {
   pipeline::Config config;
   vocab::Vocabulary vocabulary;
@@ -73,7 +65,7 @@ int RunMap(const MapArguments& arguments) {
   }
   if (!status.ok()) return Fail(status);
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
-  SeedRecognizer(prior, &recognizer);
+  pipeline::SeedRecognizer(prior, &recognizer);
   pipeline::MapResult result;
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = SelectKeyFrames(arguments, arguments.logs[i], config, &selection);

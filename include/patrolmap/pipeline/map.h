@@ -61,6 +61,10 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
 graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
                             const graph::TopoMap* prior = nullptr);
 
+// Puts a prior map's nodes (their stored features and BoW vectors) into an
+// empty recognizer, in order, so a later flight is matched against them.
+void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer);
+
 // Writes the whole map as DIR/nodes.csv (node,flight,timestamp_ns,frame_index,
 // features) and DIR/loop_closures.csv (query_node,matched_node,query_frame,
 // matched_frame,bow_score,matched_fraction,inliers), each atomically.
