@@ -95,6 +95,14 @@ expect "export kml" 0 "" -- "$bin" export "$work/map/map.pmap" --format kml --ou
 expect "kml parses" 0 "" -- xmllint --noout "$work/map.kml"
 "$bin" -q map "$work/second" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/nogps" >/dev/null
 expect "geojson without gps" 1 "no node has a GPS position" -- "$bin" export "$work/nogps/map.pmap" --format geojson
+# The HTML page in headless Chromium: it initialises without a script error and shows node 0's key frame.
+expect "export html" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format html --out "$work/map.html"
+chrome_profile=$(mktemp -d)
+expect "html in chromium" 0 'data-ready="6 nodes".*node 0 - street-1.*src="data:image/png;base64,' -- \
+  bash -c "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
+    --disable-background-networking --disable-component-update --disable-sync --user-data-dir=$chrome_profile \
+    --dump-dom file://$work/map.html 2>/dev/null | tr -d '\n'"
+rm -rf "$chrome_profile"
 expect "export bad format" 2 "format" -- "$bin" export "$work/patrol/map.pmap" --format pdf
 expect "foreign map" 1 "not a patrolmap map file" -- "$bin" info "$source_dir/README.md"
 expect "missing vocabulary" 1 "nothing.pmvoc: cannot read vocabulary" -- \

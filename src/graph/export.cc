@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 namespace patrolmap::graph {
 namespace {
@@ -235,7 +236,8 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
   }
   for (int i = 0; i < map.node_count(); ++i) {
     const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(i).flight) - flights.begin();
-    out << "<circle cx='" << x(i) << "' cy='" << y(i) << "' r='6' fill='" << colours[flight % 5] << "'/><text x='" << x(i)
+    out << "<circle class='node' data-node='" << i << "' cx='" << x(i) << "' cy='" << y(i) << "' r='6' fill='"
+        << colours[flight % 5] << "'/><text x='" << x(i)
         << "' y='" << y(i) << "' dx='8' dy='-8' font-size='11'>" << i << "</text>\n";
   }
   for (std::size_t f = 0; f < flights.size(); ++f) {
@@ -250,6 +252,91 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
         << "<text x='10' y='" << legend + 32 << "' font-size='12' fill='#2563eb'>missed loop closure</text>\n";
   }
   out << "</svg>\n";
+  return out.str();
+}
+
+namespace {
+
+std::string Base64(const std::vector<unsigned char>& bytes) {
+  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const unsigned value = (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) |
+                           (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+    out += kAlphabet[(value >> 18) & 63];
+    out += kAlphabet[(value >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(value >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kAlphabet[value & 63] : '=';
+  }
+  return out;
+}
+
+nlohmann::json NodeDetails(const TopoMap& map) {
+  nlohmann::json nodes = nlohmann::json::array();
+  for (int i = 0; i < map.node_count(); ++i) {
+    const NodeData& n = map.node(i);
+    std::vector<unsigned char> png;
+    if (!n.thumbnail.empty()) cv::imencode(".png", n.thumbnail, png);
+    nodes.push_back({{"flight", n.flight},
+                     {"time_s", NsToSeconds(n.timestamp_ns)},
+                     {"frame", n.frame_index},
+                     {"thumbnail", png.empty() ? "" : "data:image/png;base64," + Base64(png)},
+                     {"closures", nlohmann::json::array()}});
+  }
+  for (const TopoMap::Edge& e : map.Edges()) {
+    if (e.data.kind != EdgeKind::kLoopClosure) continue;
+    nodes[e.a]["closures"].push_back({{"node", e.b}, {"inliers", e.data.inliers}});
+    nodes[e.b]["closures"].push_back({{"node", e.a}, {"inliers", e.data.inliers}});
+  }
+  return nodes;
+}
+
+constexpr char kPageScript[] = R"(
+const nodes = JSON.parse(document.getElementById('nodes').textContent);
+const svg = document.querySelector('#map svg');
+let box = svg.viewBox.baseVal;
+let drag = null;
+svg.addEventListener('mousedown', e => { drag = {x: e.clientX, y: e.clientY}; });
+window.addEventListener('mouseup', () => { drag = null; });
+svg.addEventListener('mousemove', e => {
+  if (!drag) return;
+  const k = box.width / svg.clientWidth;
+  box.x -= (e.clientX - drag.x) * k; box.y -= (e.clientY - drag.y) * k;
+  drag = {x: e.clientX, y: e.clientY};
+});
+svg.addEventListener('wheel', e => {
+  e.preventDefault();
+  const f = e.deltaY > 0 ? 1.15 : 1 / 1.15;
+  box.x += box.width * (1 - f) / 2; box.y += box.height * (1 - f) / 2; box.width *= f; box.height *= f;
+});
+function show(i) {
+  const n = nodes[i];
+  document.getElementById('title').textContent = 'node ' + i + ' - ' + n.flight + ', ' + n.time_s.toFixed(1) + ' s, frame ' + n.frame;
+  document.getElementById('thumb').src = n.thumbnail;
+  document.getElementById('closures').textContent = n.closures.length ?
+      'loop closures: ' + n.closures.map(c => 'node ' + c.node + ' (' + c.inliers + ' inliers)').join(', ') : 'no loop closure';
+}
+document.querySelectorAll('#map .node').forEach(c => c.addEventListener('click', () => show(+c.dataset.node)));
+if (nodes.length) show(0);
+document.body.dataset.ready = nodes.length + ' nodes';
+)";
+
+}  // namespace
+
+std::string ToHtml(const TopoMap& map, const SvgTruth* truth) {
+  std::string svg = ToSvg(map, truth);
+  svg = svg.substr(svg.find("<svg"));
+  svg.replace(svg.find("<svg"), 4, "<svg viewBox='0 0 800 800'");
+  std::ostringstream out;
+  out << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>patrolmap map</title>\n<style>"
+      << "body{font-family:sans-serif;margin:0;display:flex;height:100vh}#map{flex:1;border-right:1px solid #ccc}"
+      << "#map svg{width:100%;height:100%;cursor:grab}#side{width:340px;padding:12px}#thumb{width:320px;"
+      << "image-rendering:pixelated;background:#eee;min-height:100px}.node{cursor:pointer}</style></head>\n<body>\n"
+      << "<div id='map'>" << svg << "</div>\n<div id='side'><h3>patrolmap</h3><p>" << map.node_count() << " nodes, "
+      << map.loop_closure_count() << " loop closures, " << map.Flights().size()
+      << " flight(s). Drag to pan, wheel to zoom, click a node.</p><p id='title'></p><img id='thumb' alt=''>"
+      << "<p id='closures'></p></div>\n<script type='application/json' id='nodes'>" << NodeDetails(map).dump()
+      << "</script>\n<script>" << kPageScript << "</script>\n</body></html>\n";
   return out.str();
 }
 

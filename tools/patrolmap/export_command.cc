@@ -52,11 +52,14 @@ Status SvgTruthFromLogs(const graph::TopoMap& map, const std::vector<std::string
   return Status::Ok();
 }
 
-std::string Svg(const graph::TopoMap& map, const ExportArguments& arguments, Status* status) {
-  if (arguments.logs.empty()) return graph::ToSvg(map);
+// SVG or HTML, with the loop closures judged when logs are given.
+std::string Picture(const graph::TopoMap& map, const ExportArguments& arguments, Status* status) {
+  const bool html = arguments.format == "html";
+  if (arguments.logs.empty()) return html ? graph::ToHtml(map) : graph::ToSvg(map);
   graph::SvgTruth truth;
   *status = SvgTruthFromLogs(map, arguments.logs, &truth);
-  return status->ok() ? graph::ToSvg(map, &truth) : std::string();
+  if (!status->ok()) return std::string();
+  return html ? graph::ToHtml(map, &truth) : graph::ToSvg(map, &truth);
 }
 
 int RunExport(const ExportArguments& arguments) {
@@ -71,7 +74,7 @@ int RunExport(const ExportArguments& arguments) {
                            : arguments.format == "geojson" ? graph::ToGeoJson(map)
                            : arguments.format == "kml"     ? graph::ToKml(map)
                            : arguments.format == "dot"   ? graph::ToDot(map)
-                           : arguments.format == "svg"   ? Svg(map, arguments, &status)
+                           : arguments.format == "svg" || arguments.format == "html" ? Picture(map, arguments, &status)
                                                          : graph::ToJson(map);
   if (!status.ok()) {
     Fail(status);
@@ -92,12 +95,12 @@ Command AddExportCommand(CLI::App* app) {
   app->add_option("map", arguments->map, "map file (map.pmap)")->required();
   app->add_option("-f,--format", arguments->format,
                   "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link), svg (the layout, like paper Fig. 5), "
-                  "geojson or kml (with GPS)")
-      ->check(CLI::IsMember({"graphml", "dot", "json", "svg", "geojson", "kml"}))
+                  "html (a self-contained page: pan, zoom, click a node for its key frame), geojson or kml (with GPS)")
+      ->check(CLI::IsMember({"graphml", "dot", "json", "svg", "html", "geojson", "kml"}))
       ->capture_default_str();
   app->add_option("-o,--out", arguments->out, "file to write (default: standard output)");
   app->add_option("--log", arguments->logs,
-                  "svg: simulated logs of the map's flights; loop closures are drawn correct (green), false (red) and "
+                  "svg, html: simulated logs of the map's flights; loop closures are drawn correct (green), false (red) and "
                   "missed (blue) against their ground truth");
   return [arguments] { return RunExport(*arguments); };
 }

@@ -31,6 +31,11 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth = nullptr);
 // a point per node, a line per flight, a line per loop closure. Only for maps
 // whose nodes have GPS positions (HasGps).
 bool HasGps(const TopoMap& map);
+// One self-contained HTML page (no network at view time): the layout picture,
+// pan by dragging and zoom with the wheel; clicking a node shows its key-frame
+// thumbnail (embedded as PNG), flight, time and loop closures; node 0 is shown
+// at first. When the page has initialised, <body> carries data-ready="N nodes".
+std::string ToHtml(const TopoMap& map, const SvgTruth* truth = nullptr);
 std::string ToGeoJson(const TopoMap& map);
 std::string ToKml(const TopoMap& map);
 
