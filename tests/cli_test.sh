@@ -81,6 +81,10 @@ import json, networkx as nx
 g = nx.read_graphml('$work/map.graphml')
 j = nx.node_link_graph(json.load(open('$work/map.json')))
 print('graphml', g.number_of_nodes(), g.number_of_edges(), 'json', j.number_of_nodes(), j.number_of_edges())"
+expect "json matches docs/map.schema.json" 0 "valid" -- /usr/bin/python3 -c "
+import json, jsonschema
+jsonschema.validate(json.load(open('$work/map.json')), json.load(open('$source_dir/docs/map.schema.json')))
+print('valid')"
 expect "export dot" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format dot --out "$work/map.dot"
 expect "dot renders" 0 "<svg" -- dot -Tsvg "$work/map.dot"
 expect "export json" 0 "patrolmap.map/1" -- "$bin" export "$work/patrol/map.pmap" --format json
