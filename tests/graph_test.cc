@@ -13,6 +13,13 @@
 namespace patrolmap::graph {
 namespace {
 
+// How often `what` occurs in `text`.
+std::size_t CountOf(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 // Flight a: nodes 0-1-2-3 in a row; flight b: 4-5-6. Loop closures 4~1 and 6~3, and 5~1 (same place as 4).
 TopoMap TwoFlights() {
   TopoMap map;
@@ -219,10 +226,7 @@ TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
   EXPECT_EQ(json["links"][5]["inliers"], 88);
   EXPECT_DOUBLE_EQ(json["nodes"][2]["gps"][0].get<double>(), 47.3572123456789);
   EXPECT_TRUE(json["nodes"][0]["gps"].is_null());
-  const std::string dot = ToDot(map);
-  std::size_t dashed = 0;
-  for (std::size_t at = dot.find("style=dashed"); at != std::string::npos; at = dot.find("style=dashed", at + 1)) ++dashed;
-  EXPECT_EQ(dashed, 3u);
+  EXPECT_EQ(CountOf(ToDot(map), "style=dashed"), 3u);
 }
 
 }  // namespace
@@ -299,14 +303,9 @@ TEST(Export, SvgColoursLoopClosuresByTruth) {
   truth.loop_closure_correct = {true, false, true};  // 4~1 correct, 6~3 false, 5~1 correct
   truth.missed = {{6, 2}};
   const std::string judged = ToSvg(map, &truth);
-  const auto count = [&judged](const std::string& what) {
-    std::size_t n = 0;
-    for (std::size_t at = judged.find(what); at != std::string::npos; at = judged.find(what, at + 1)) ++n;
-    return n;
-  };
-  EXPECT_EQ(count("stroke='#16a34a'"), 2u);  // correct closures
-  EXPECT_EQ(count("stroke='#dc2626'"), 1u);  // the false one
-  EXPECT_EQ(count("stroke='#2563eb'"), 1u);  // the missed pair
+  EXPECT_EQ(CountOf(judged, "stroke='#16a34a'"), 2u);  // correct closures
+  EXPECT_EQ(CountOf(judged, "stroke='#dc2626'"), 1u);  // the false one
+  EXPECT_EQ(CountOf(judged, "stroke='#2563eb'"), 1u);  // the missed pair
   EXPECT_NE(judged.find("missed loop closure"), std::string::npos);
 }
 
