@@ -16,6 +16,9 @@ std::string Precise(double value) {
   return buffer;
 }
 
+
+}  // namespace
+
 std::string EscapeXml(const std::string& text) {
   std::string out;
   for (char c : text) {
@@ -29,6 +32,28 @@ std::string EscapeXml(const std::string& text) {
   }
   return out;
 }
+
+std::string Base64(const std::vector<unsigned char>& bytes) {
+  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const unsigned value = (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) |
+                           (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+    out += kAlphabet[(value >> 18) & 63];
+    out += kAlphabet[(value >> 12) & 63];
+    out += i + 1 < bytes.size() ? kAlphabet[(value >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? kAlphabet[value & 63] : '=';
+  }
+  return out;
+}
+
+std::string PngDataUri(const cv::Mat& image) {
+  std::vector<unsigned char> png;
+  if (image.empty() || !cv::imencode(".png", image, png)) return "";
+  return "data:image/png;base64," + Base64(png);
+}
+
+namespace {
 
 std::string EscapeDot(const std::string& text) {
   std::string out;
@@ -257,30 +282,15 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
 
 namespace {
 
-std::string Base64(const std::vector<unsigned char>& bytes) {
-  static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const unsigned value = (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) |
-                           (i + 2 < bytes.size() ? bytes[i + 2] : 0);
-    out += kAlphabet[(value >> 18) & 63];
-    out += kAlphabet[(value >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(value >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[value & 63] : '=';
-  }
-  return out;
-}
 
 nlohmann::json NodeDetails(const TopoMap& map) {
   nlohmann::json nodes = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
     const NodeData& n = map.node(i);
-    std::vector<unsigned char> png;
-    if (!n.thumbnail.empty()) cv::imencode(".png", n.thumbnail, png);
     nodes.push_back({{"flight", n.flight},
                      {"time_s", NsToSeconds(n.timestamp_ns)},
                      {"frame", n.frame_index},
-                     {"thumbnail", png.empty() ? "" : "data:image/png;base64," + Base64(png)},
+                     {"thumbnail", PngDataUri(n.thumbnail)},
                      {"closures", nlohmann::json::array()}});
   }
   for (const TopoMap::Edge& e : map.Edges()) {

@@ -1,6 +1,8 @@
 #include "patrolmap/graph/map_file.h"
 
+#include <algorithm>
 #include <cstring>
+#include <tuple>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,7 +14,7 @@ namespace patrolmap::graph {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: PTRL section (patrol records)
 
 class Writer {
  public:
@@ -142,6 +144,56 @@ std::string FeatureSection(const TopoMap& map) {
   return std::move(w.bytes());
 }
 
+struct PoseRecord {
+  std::int64_t timestamp_ns;
+  double position[3];
+  double rotation[4];  // w, x, y, z
+};
+
+void WriteObject(const MapObject& o, Writer* w) {
+  w->Value<std::int32_t>(o.id);
+  w->String(o.label);
+  w->Value(o.confidence);
+  w->Value<std::int32_t>(o.detections);
+  for (const Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
+    for (int k = 0; k < 3; ++k) w->Value((*v)[k]);
+  }
+  w->Vector(o.points);
+  w->Vector(o.descriptor);
+  w->Value(static_cast<std::uint32_t>(o.labels.size()));
+  for (const MapObject::LabelEvidence& e : o.labels) {
+    w->String(e.label);
+    w->Value(e.confidence_sum);
+    w->Value<std::int32_t>(e.count);
+  }
+  w->Value(o.first_seen_ns);
+  w->Value(o.last_seen_ns);
+}
+
+std::string PatrolSection(const TopoMap& map) {
+  Writer w;
+  w.Value(static_cast<std::uint32_t>(map.patrols().size()));
+  for (const PatrolRecord& p : map.patrols()) {
+    w.String(p.flight);
+    for (double v : {p.camera.fx, p.camera.fy, p.camera.cx, p.camera.cy}) w.Value(v);
+    w.Value<std::int32_t>(p.camera.width);
+    w.Value<std::int32_t>(p.camera.height);
+    w.Value<std::int32_t>(p.feature_image_width);
+    std::vector<PoseRecord> views;
+    for (const CameraPoseSample& v : p.views) {
+      views.push_back({v.timestamp_ns, {v.position.x(), v.position.y(), v.position.z()},
+                       {v.rotation.w(), v.rotation.x(), v.rotation.y(), v.rotation.z()}});
+    }
+    w.Vector(views);
+    w.Value<std::uint8_t>(p.has_objects ? 1 : 0);
+    w.Value(static_cast<std::uint32_t>(p.objects.size()));
+    for (const MapObject& o : p.objects) WriteObject(o, &w);
+    w.Value(p.grid.voxel_size);
+    w.Vector(p.grid.voxels);
+  }
+  return std::move(w.bytes());
+}
+
 void AppendSection(const char (&tag)[5], const std::string& payload, std::string* file) {
   file->append(tag, 4);
   const std::uint64_t length = payload.size(), checksum = Checksum(payload.data(), payload.size());
@@ -211,6 +263,61 @@ Status ParseFeatures(const std::string& path, Reader* r, TopoMap* map) {
   return r->failed() || !r->done() ? Corrupt(path, "feature section") : Status::Ok();
 }
 
+MapObject ReadObject(Reader* r) {
+  MapObject o;
+  o.id = r->Value<std::int32_t>();
+  o.label = r->String();
+  o.confidence = r->Value<double>();
+  o.detections = r->Value<std::int32_t>();
+  for (Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
+    for (int k = 0; k < 3; ++k) (*v)[k] = r->Value<double>();
+  }
+  o.points = r->Vector<Eigen::Vector3f>();
+  o.descriptor = r->Vector<float>();
+  const std::uint32_t labels = r->Value<std::uint32_t>();
+  for (std::uint32_t i = 0; i < labels && !r->failed(); ++i) {
+    MapObject::LabelEvidence e;
+    e.label = r->String();
+    e.confidence_sum = r->Value<double>();
+    e.count = r->Value<std::int32_t>();
+    o.labels.push_back(e);
+  }
+  o.first_seen_ns = r->Value<TimestampNs>();
+  o.last_seen_ns = r->Value<TimestampNs>();
+  return o;
+}
+
+bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
+  return std::is_sorted(voxels.begin(), voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+}
+
+Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
+  const std::uint32_t count = r->Value<std::uint32_t>();
+  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
+    PatrolRecord p;
+    p.flight = r->String();
+    p.camera.fx = r->Value<double>(), p.camera.fy = r->Value<double>();
+    p.camera.cx = r->Value<double>(), p.camera.cy = r->Value<double>();
+    p.camera.width = r->Value<std::int32_t>(), p.camera.height = r->Value<std::int32_t>();
+    p.feature_image_width = r->Value<std::int32_t>();
+    for (const PoseRecord& v : r->Vector<PoseRecord>()) {
+      p.views.push_back({v.timestamp_ns, Eigen::Vector3d(v.position[0], v.position[1], v.position[2]),
+                         Eigen::Quaterniond(v.rotation[0], v.rotation[1], v.rotation[2], v.rotation[3])});
+    }
+    p.has_objects = r->Value<std::uint8_t>() != 0;
+    const std::uint32_t objects = r->Value<std::uint32_t>();
+    for (std::uint32_t k = 0; k < objects && !r->failed(); ++k) p.objects.push_back(ReadObject(r));
+    p.grid.voxel_size = r->Value<double>();
+    p.grid.voxels = r->Vector<VoxelEvidence>();
+    if (r->failed()) break;
+    if (!SortedVoxels(p.grid.voxels) || p.grid.voxel_size < 0.0) return Corrupt(path, "evidence grid of " + p.flight);
+    map->SetPatrol(std::move(p));
+  }
+  return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();
+}
+
 Status ParseSection(const std::string& path, const std::string& tag, const char* payload, std::size_t length,
                     TopoMap* map, bool* nodes, bool* edges) {
   Reader reader(payload, length);
@@ -223,6 +330,7 @@ Status ParseSection(const std::string& path, const std::string& tag, const char*
     return ParseEdges(path, &reader, map);
   }
   if (tag == "FEAT" && *nodes) return ParseFeatures(path, &reader, map);
+  if (tag == "PTRL") return ParsePatrols(path, &reader, map);
   return Corrupt(path, "unexpected section " + tag);
 }
 
@@ -230,11 +338,12 @@ Status ParseSection(const std::string& path, const std::string& tag, const char*
 
 Status SaveMap(const TopoMap& map, const std::string& path) {
   std::string file(kMagic, 8);
-  const std::uint32_t header[2] = {kVersion, 3};
+  const std::uint32_t header[2] = {kVersion, 4};
   file.append(reinterpret_cast<const char*>(header), sizeof(header));
   AppendSection("NODE", NodeSection(map), &file);
   AppendSection("EDGE", EdgeSection(map), &file);
   AppendSection("FEAT", FeatureSection(map), &file);
+  AppendSection("PTRL", PatrolSection(map), &file);
   return WriteFileAtomically(path, file);
 }
 

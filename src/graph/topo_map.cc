@@ -77,4 +77,18 @@ std::vector<std::string> TopoMap::Flights() const {
   return flights;
 }
 
+void TopoMap::SetPatrol(PatrolRecord record) {
+  for (PatrolRecord& existing : patrols_) {
+    if (existing.flight == record.flight) return void(existing = std::move(record));
+  }
+  patrols_.push_back(std::move(record));
+}
+
+const PatrolRecord* TopoMap::Patrol(const std::string& flight) const {
+  for (const PatrolRecord& record : patrols_) {
+    if (record.flight == flight) return &record;
+  }
+  return nullptr;
+}
+
 }  // namespace patrolmap::graph

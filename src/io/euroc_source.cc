@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <Eigen/Geometry>
 
+#include "euroc_tables.h"
 #include "image_list_source.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/io/readers.h"
@@ -13,48 +14,6 @@ namespace fs = std::filesystem;
 
 namespace patrolmap::io {
 namespace {
-
-Status CheckColumns(const CsvReader& csv, const std::vector<std::string_view>& fields,
-                    std::size_t minimum) {
-  if (fields.size() >= minimum) return Status::Ok();
-  return csv.Error("expected at least " + std::to_string(minimum) + " columns, found " +
-                   std::to_string(fields.size()));
-}
-
-Status CheckIncreasing(const CsvReader& csv, TimestampNs previous, TimestampNs current) {
-  if (current > previous) return Status::Ok();
-  return csv.Error("timestamp " + std::to_string(current) +
-                   " is not after the previous one (" + std::to_string(previous) + ")");
-}
-
-// Reads a table whose first column is a strictly increasing timestamp [ns];
-// `parse_row(csv, fields, &row)` fills the other columns of each row.
-template <typename Row, typename ParseRow>
-Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow parse_row, std::vector<Row>* rows) {
-  CsvReader csv;
-  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
-  std::vector<std::string_view> fields;
-  Status status;
-  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
-  while ((status = csv.NextRow(&fields)).ok()) {
-    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, columns));
-    Row row;
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &row.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, row.timestamp_ns));
-    PATROLMAP_RETURN_IF_ERROR(parse_row(csv, fields, &row));
-    previous = row.timestamp_ns;
-    rows->push_back(std::move(row));
-  }
-  return status.end_of_stream() ? Status::Ok() : status;
-}
-
-Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields,
-                   std::size_t first, const char* column, Eigen::Vector3d* vector) {
-  for (int axis = 0; axis < 3; ++axis) {
-    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + axis], column, &(*vector)[axis]));
-  }
-  return Status::Ok();
-}
 
 Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
   const std::string path = log + "/cam0/data.csv";
@@ -141,6 +100,7 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
   const bool has_camera_yaml = fs::exists(log + "/cam0/sensor.yaml");
   if (has_camera_yaml) {
     PATROLMAP_RETURN_IF_ERROR(ReadCameraSensor(log + "/cam0/sensor.yaml", info, &body_from_camera));
+    info->body_from_camera = body_from_camera;
   }
   if (fs::exists(log + "/meta.yaml")) PATROLMAP_RETURN_IF_ERROR(ReadMeta(log + "/meta.yaml", info));
   if (fs::exists(log + "/imu0/data.csv")) {

@@ -142,7 +142,7 @@ bool Config::IsValid(std::string* error) const {
     *error = "input.frame_rate_hz must be positive";
     return false;
   }
-  return flow.IsValid(error) && place.IsValid(error);
+  return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error);
 }
 
 Status LoadConfig(const std::string& path, Config* config) {

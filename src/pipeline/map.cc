@@ -49,7 +49,8 @@ void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, d
             const std::optional<Eigen::Vector3d>& gps, std::map<int, std::int64_t>* frame_of, MapResult* result) {
   result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
                            Thumbnail(key_frame.image), heading,
-                           gps ? std::optional<Eigen::Vector2d>(gps->head<2>()) : std::nullopt});
+                           gps ? std::optional<Eigen::Vector2d>(gps->head<2>()) : std::nullopt,
+                           key_frame.image.cols});
   (*frame_of)[place.node] = key_frame.frame_index;
   result->seconds_features += place.seconds_features;
   result->seconds_query += place.seconds_query;

@@ -19,5 +19,6 @@ Command AddVocabCommand(CLI::App* app);
 Command AddPatrolCommand(CLI::App* app);
 Command AddInfoCommand(CLI::App* app);
 Command AddExportCommand(CLI::App* app);
+Command AddDiffCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

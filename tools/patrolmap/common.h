@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "patrolmap/change/report.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/pipeline/config.h"
 
@@ -23,5 +24,8 @@ inline Status LoadCheckedConfig(const std::string& path, pipeline::Config* confi
   if (!config->IsValid(&error)) return Status::InvalidArgument(error);
   return Status::Ok();
 }
+
+// Prints one line on what changed between the report's flights (diff and patrol).
+void PrintChangeSummary(const change::ChangeReport& report, const std::string& out);
 
 }  // namespace patrolmap::tools

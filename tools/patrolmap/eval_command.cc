@@ -1,6 +1,7 @@
 // patrolmap eval RUN --log LOG [--log LOG ...] [--json] [--tolerance S] [--min-span S] [--radius M] ...
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <string>
@@ -9,7 +10,11 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "common.h"
+#include "patrolmap/eval/change_score.h"
 #include "patrolmap/eval/key_location_score.h"
+#include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/change.h"
 #include "patrolmap/eval/loop_closure_score.h"
 #include "patrolmap/io/readers.h"
 
@@ -23,6 +28,8 @@ struct EvalArguments {
   bool verbose = false;
   eval::KeyLocationScoreOptions key_locations;
   eval::LoopClosureScoreOptions loop_closures;
+  eval::ChangeScoreOptions changes;
+  std::string config;
 };
 
 // A simulated log: its flight id, frame count and ground-truth places.
@@ -98,6 +105,106 @@ Status EvaluateLoopClosures(const EvalArguments& arguments, const std::vector<Tr
   return Status::Ok();
 }
 
+nlohmann::json CountsJson(const eval::Counts& c) {
+  return {{"true_positives", c.true_positives}, {"false_positives", c.false_positives},
+          {"false_negatives", c.false_negatives}, {"precision", c.Precision()}, {"recall", c.Recall()}, {"f1", c.F1()}};
+}
+
+Status ReadReportedObjects(const std::string& path, const nlohmann::json& objects,
+                           std::vector<eval::ReportedObject>* reported) {
+  try {
+    for (const nlohmann::json& o : objects) {
+      eval::ReportedObject r{o.at("state").get<std::string>(), o.at("label").get<std::string>(), {}, {}};
+      for (const char* key : {"before", "after"}) {
+        if (o.at(key).is_null()) continue;
+        const Eigen::Vector3d p(o[key][0].get<double>(), o[key][1].get<double>(), o[key][2].get<double>());
+        (std::string(key) == "before" ? r.before : r.after) = p;
+      }
+      reported->push_back(r);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(path + ": malformed objects: " + e.what());
+  }
+  return Status::Ok();
+}
+
+// Changes of RUN (changes.json, and the grids in map.pmap) against the two flights' ground truth.
+Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLog>& logs, nlohmann::json* report) {
+  const std::string path = arguments.run + "/changes.json";
+  nlohmann::json changes;
+  try {
+    changes = nlohmann::json::parse(std::ifstream(path));
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(path + ": not JSON: " + e.what());
+  }
+  if (changes.value("format", "") != "patrolmap.changes") return Status::DataLoss(path + ": not a patrolmap change report");
+  const std::string prior = changes.value("prior_flight", ""), current = changes.value("current_flight", "");
+  const TruthLog *prior_log = nullptr, *current_log = nullptr;
+  for (const TruthLog& log : logs) {
+    if (log.info.flight_id == prior) prior_log = &log;
+    if (log.info.flight_id == current) current_log = &log;
+  }
+  if (prior_log == nullptr || current_log == nullptr) {
+    return Status::InvalidArgument(path + ": compares '" + prior + "' with '" + current + "': pass both logs with --log");
+  }
+  std::vector<eval::TruthObject> before, after;
+  PATROLMAP_RETURN_IF_ERROR(eval::ReadTruthObjects(prior_log->path, &before));
+  PATROLMAP_RETURN_IF_ERROR(eval::ReadTruthObjects(current_log->path, &after));
+  nlohmann::json result = {{"prior_flight", prior}, {"current_flight", current},
+                           {"distance_m", arguments.changes.distance_m},
+                           {"places_compared", changes["summary"].value("places_compared", 0)},
+                           {"places_changed", changes["summary"].value("places_changed", 0)}};
+  if (changes.contains("objects") && changes["objects"].is_array()) {
+    std::vector<eval::ReportedObject> reported;
+    PATROLMAP_RETURN_IF_ERROR(ReadReportedObjects(path, changes["objects"], &reported));
+    const eval::ObjectChangeScore score = eval::ScoreObjectChanges(reported, before, after, arguments.changes);
+    for (const auto& [state, counts] : score.by_state) result["objects"][state] = CountsJson(counts);
+    result["objects"]["unobserved_reported"] = score.unobserved;
+  }
+  if (!changes["geometry"].is_null() && std::filesystem::exists(arguments.run + "/map.pmap")) {
+    pipeline::Config config;
+    graph::TopoMap map;
+    change::ChangeReport recomputed;
+    PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(arguments.config, &config));
+    PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.run + "/map.pmap", &map));
+    PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, prior, current, config.change, &recomputed));
+    eval::ChangeScoreOptions options = arguments.changes;
+    options.min_observations = config.change.geometry.min_observations;
+    const eval::GeometryScore score = eval::ScoreGeometry(recomputed.geometry.changed_voxels, map.Patrol(prior)->grid,
+                                                          map.Patrol(current)->grid, before, after, options);
+    result["geometry"] = CountsJson(score.voxels);
+    result["geometry"]["iou"] = score.Iou();
+    result["geometry"]["observed_voxels"] = score.observed_voxels;
+    result["geometry"]["regions"] = recomputed.geometry.regions.size();
+  }
+  (*report)["changes"] = result;
+  return Status::Ok();
+}
+
+void PrintCounts(const char* name, const nlohmann::json& c) {
+  std::printf("%-12s %5d %6d %7d %10.2f %7.2f %6.2f\n", name, c["true_positives"].get<int>(),
+              c["false_positives"].get<int>(), c["false_negatives"].get<int>(), c["precision"].get<double>(),
+              c["recall"].get<double>(), c["f1"].get<double>());
+}
+
+void PrintChangeTable(const nlohmann::json& c) {
+  std::printf("changes %s -> %s: %d places compared, %d with appearance changes\n",
+              c["prior_flight"].get<std::string>().c_str(), c["current_flight"].get<std::string>().c_str(),
+              c["places_compared"].get<int>(), c["places_changed"].get<int>());
+  std::printf("%-12s %5s %6s %7s %10s %7s %6s\n", "", "true", "false", "missed", "precision", "recall", "F1");
+  if (c.contains("objects")) {
+    for (const char* state : {"new", "removed", "moved", "persistent"}) {
+      PrintCounts((std::string("objects ") + state).c_str(), c["objects"][state]);
+    }
+  }
+  if (c.contains("geometry")) {
+    PrintCounts("voxels", c["geometry"]);
+    std::printf("geometry: IoU %.2f over %lld voxels observed in both flights, %d regions\n",
+                c["geometry"]["iou"].get<double>(), c["geometry"]["observed_voxels"].get<long long>(),
+                c["geometry"]["regions"].get<int>());
+  }
+}
+
 void PrintTables(const nlohmann::json& report) {
   if (report.contains("key_locations")) {
     const nlohmann::json& k = report["key_locations"];
@@ -119,13 +226,15 @@ void PrintTables(const nlohmann::json& report) {
                 l["found"].get<int>(), l["reported"].get<int>(), l["false_positives"].get<int>(),
                 l["precision"].get<double>(), l["recall"].get<double>());
   }
+  if (report.contains("changes")) PrintChangeTable(report["changes"]);
 }
 
 Status Evaluate(const EvalArguments& arguments, nlohmann::json* report) {
   const bool has_key_locations = std::filesystem::exists(arguments.run + "/key_locations.csv");
   const bool has_loop_closures = std::filesystem::exists(arguments.run + "/loop_closures.csv");
-  if (!has_key_locations && !has_loop_closures) {
-    return Status::NotFound(arguments.run + ": holds neither key_locations.csv nor loop_closures.csv");
+  const bool has_changes = std::filesystem::exists(arguments.run + "/changes.json");
+  if (!has_key_locations && !has_loop_closures && !has_changes) {
+    return Status::NotFound(arguments.run + ": holds none of key_locations.csv, loop_closures.csv, changes.json");
   }
   std::vector<TruthLog> logs(arguments.logs.size());
   for (std::size_t i = 0; i < logs.size(); ++i) {
@@ -134,6 +243,7 @@ Status Evaluate(const EvalArguments& arguments, nlohmann::json* report) {
   *report = {{"schema", "patrolmap.eval/1"}, {"run", arguments.run}};
   if (has_key_locations) PATROLMAP_RETURN_IF_ERROR(EvaluateKeyLocations(arguments, logs.front(), report));
   if (has_loop_closures) PATROLMAP_RETURN_IF_ERROR(EvaluateLoopClosures(arguments, logs, report));
+  if (has_changes) PATROLMAP_RETURN_IF_ERROR(EvaluateChanges(arguments, logs, report));
   return Status::Ok();
 }
 
@@ -181,6 +291,14 @@ Command AddEvalCommand(CLI::App* app) {
                   "loop closures: nodes of one flight closer in time are neighbours [s]")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app->add_option("--change-distance", arguments->changes.distance_m,
+                  "changes: a reported object is a hit within this distance of a true one of its state and label [m]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app->add_option("--min-detections", arguments->changes.min_detections,
+                  "changes: true objects the detector reported fewer times in a flight do not count")
+      ->capture_default_str();
+  app->add_option("-c,--config", arguments->config, "the run's configuration (change.* keys), for the geometry score");
   return [arguments] { return RunEval(*arguments); };
 }
 

@@ -8,6 +8,7 @@
 #include "patrolmap/pipeline/detect.h"
 #include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/change.h"
 #include "patrolmap/pipeline/map.h"
 #include "progress.h"
 
@@ -52,6 +53,51 @@ void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& resu
               1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
 }
 
+// The width the flight's key-frame features were found at (from its first node), 0 when it has none.
+int FeatureWidth(const pipeline::MapResult& result, const std::string& flight) {
+  for (const pipeline::MapNode& node : result.nodes) {
+    if (node.flight == flight) return node.feature_width;
+  }
+  return 0;
+}
+
+// The patrol record of `log` (object map, evidence grid, views) for change detection.
+Status RecordPatrol(const std::string& log, const pipeline::Config& config, const pipeline::MapResult& result,
+                    graph::TopoMap* map) {
+  PatrolRecord record;
+  pipeline::PatrolRecordStats stats;
+  Progress progress("patrol record");
+  PATROLMAP_RETURN_IF_ERROR(pipeline::BuildPatrolRecord(
+      log, config, 0, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
+  record.feature_image_width = FeatureWidth(result, record.flight);
+  if (record.has_objects) {
+    spdlog::info("{}: {} objects from {} detections ({:.2f} ms per association)", record.flight, record.objects.size(),
+                 stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
+  }
+  if (record.grid.voxel_size > 0) {
+    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s", record.flight,
+                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds);
+    if (stats.dropped_voxel_updates > 0) {
+      spdlog::warn("{}: change.grid.max_voxels reached; {} voxel updates dropped", record.flight,
+                   stats.dropped_voxel_updates);
+    }
+  }
+  map->SetPatrol(std::move(record));
+  return Status::Ok();
+}
+
+// The change report between the prior map's last flight and the new one.
+Status ReportChanges(const graph::TopoMap& prior, const graph::TopoMap& map, const pipeline::Config& config,
+                     const std::string& out) {
+  const std::vector<std::string> before = prior.Flights(), after = map.Flights();
+  if (before.empty() || after.size() <= before.size()) return Status::Ok();
+  change::ChangeReport report;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, before.back(), after.back(), config.change, &report));
+  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(report, map, out));
+  PrintChangeSummary(report, out);
+  return Status::Ok();
+}
+
 int RunMap(const MapArguments& arguments) {
   pipeline::Config config;
   vocab::Vocabulary vocabulary;
@@ -76,11 +122,16 @@ int RunMap(const MapArguments& arguments) {
     }
   }
   graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
+    status = RecordPatrol(arguments.logs[i], config, result, &map);
+  }
   if (status.ok()) status = graph::LayoutMap(graph::LayoutInputOf(map), graph::LayoutOptions{}, &map);
   if (status.ok()) status = pipeline::WriteMapOutputs(map, arguments.out);
   if (status.ok()) status = graph::SaveMap(map, arguments.out + "/map.pmap");
   if (!status.ok()) return Fail(status);
   PrintSummary(arguments, result);
+  if (!arguments.prior_map.empty()) status = ReportChanges(prior, map, config, arguments.out);
+  if (!status.ok()) return Fail(status);
   return 0;
 }
 
@@ -95,7 +146,8 @@ Command AddPatrolCommand(CLI::App* app) {
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
   app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file")->capture_default_str();
   app->footer("Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
-              "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv.");
+              "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
+              "since the map's last flight to OUT/changes.json and OUT/changes.html (as patrolmap diff).");
   return [arguments] { return RunMap(*arguments); };
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "patrolmap/graph/topo_map.h"
 
@@ -38,5 +39,11 @@ bool HasGps(const TopoMap& map);
 std::string ToHtml(const TopoMap& map, const SvgTruth* truth = nullptr);
 std::string ToGeoJson(const TopoMap& map);
 std::string ToKml(const TopoMap& map);
+
+// Helpers the change report shares: XML/HTML escaping, Base64, an image as a
+// PNG data URI ("" for an empty image).
+std::string EscapeXml(const std::string& text);
+std::string Base64(const std::vector<unsigned char>& bytes);
+std::string PngDataUri(const cv::Mat& image);
 
 }  // namespace patrolmap::graph

@@ -9,6 +9,8 @@
 //            NODE: per node flight, time, frame, thumbnail, GPS, layout, heading
 //            EDGE: per edge the two nodes, kind and verification scores
 //            FEAT: per node keypoints, descriptors and BoW vector
+//            PTRL: per patrol its camera, views, object map and evidence grid
+//                  (format version 2; version 1 files have no PTRL and still load)
 // Saving is atomic (temporary file, fsync, rename): a crash never leaves a
 // half-written map. Loading a truncated, corrupt, foreign or newer file fails
 // with a message naming the file and the problem.

@@ -13,6 +13,7 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
+#include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/types.h"
 #include "patrolmap/vocab/bow.h"
 
@@ -66,9 +67,16 @@ class TopoMap {
   std::vector<int> Path(int from, int to) const;    // fewest edges, both ends included; empty when unreachable
   std::vector<std::string> Flights() const;         // in order of first node
 
+  // What each patrol keeps for change detection (object map, evidence grid,
+  // views); at most one record per flight, replaced when set again.
+  void SetPatrol(PatrolRecord record);
+  const PatrolRecord* Patrol(const std::string& flight) const;  // nullptr when the flight has none
+  const std::vector<PatrolRecord>& patrols() const { return patrols_; }
+
  private:
   Graph graph_;
   std::vector<Edge> edge_order_;
+  std::vector<PatrolRecord> patrols_;
 };
 
 }  // namespace patrolmap::graph

@@ -23,6 +23,9 @@ struct LogInfo {
   // Rotation taking IMU-frame vectors into the camera frame, when both
   // extrinsics are known (EuRoC T_BS of cam0 and imu0).
   std::optional<Eigen::Matrix3d> camera_from_imu;
+  // Rotation taking camera-frame vectors into the body (state estimate) frame:
+  // EuRoC T_BS of cam0, when cam0/sensor.yaml is present.
+  std::optional<Eigen::Matrix3d> body_from_camera;
   std::int64_t frame_count = -1;             // -1 when unknown (live or some videos)
   double frame_rate_hz = 0.0;                // nominal; 0 when unknown
   bool has_imu = false;

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "patrolmap/change/options.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/flow/options.h"
 #include "patrolmap/io/readers.h"
@@ -16,6 +17,7 @@ struct Config {
   io::ImageFolderOptions input;
   flow::KeyLocationOptions flow;
   place::PlaceOptions place;
+  ::patrolmap::change::ChangeOptions change;
 
   bool IsValid(std::string* error) const;
 };
@@ -68,6 +70,45 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);
   visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
+  auto& change = config->change;
+  visitor->Field("change.appearance.ratio", &change.appearance.ratio);
+  visitor->Field("change.appearance.inlier_threshold_px", &change.appearance.inlier_threshold_px);
+  visitor->Field("change.appearance.min_inliers", &change.appearance.min_inliers);
+  visitor->Field("change.appearance.blur_sigma_px", &change.appearance.blur_sigma_px);
+  visitor->Field("change.appearance.search_radius_px", &change.appearance.search_radius_px);
+  visitor->Field("change.appearance.min_difference", &change.appearance.min_difference);
+  visitor->Field("change.appearance.min_normalised_difference", &change.appearance.min_normalised_difference);
+  visitor->Field("change.appearance.local_window_px", &change.appearance.local_window_px);
+  visitor->Field("change.appearance.min_area_fraction", &change.appearance.min_area_fraction);
+  visitor->Field("change.object_map.centroid_gate_m", &change.object_map.centroid_gate_m);
+  visitor->Field("change.object_map.pair_distance_m", &change.object_map.pair_distance_m);
+  visitor->Field("change.object_map.min_pair_fraction", &change.object_map.min_pair_fraction);
+  visitor->Field("change.object_map.point_voxel_m", &change.object_map.point_voxel_m);
+  visitor->Field("change.object_map.segment_depth_m", &change.object_map.segment_depth_m);
+  visitor->Field("change.object_map.max_segment_samples", &change.object_map.max_segment_samples);
+  visitor->Field("change.object_map.min_box_iou", &change.object_map.min_box_iou);
+  visitor->Field("change.object_map.category_sigma_m", &change.object_map.category_sigma_m);
+  visitor->Field("change.object_map.vehicle_sigma_m", &change.object_map.vehicle_sigma_m);
+  visitor->Field("change.object_map.min_category_prior", &change.object_map.min_category_prior);
+  visitor->Field("change.object_map.min_detections", &change.object_map.min_detections);
+  visitor->Field("change.object_map.max_range_m", &change.object_map.max_range_m);
+  visitor->Field("change.objects.match_distance_m", &change.objects.match_distance_m);
+  visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
+  visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);
+  visitor->Field("change.objects.appearance_weight", &change.objects.appearance_weight);
+  visitor->Field("change.objects.max_weighted_distance", &change.objects.max_weighted_distance);
+  visitor->Field("change.objects.max_visible_range_m", &change.objects.max_visible_range_m);
+  visitor->Field("change.objects.image_margin_px", &change.objects.image_margin_px);
+  visitor->Field("change.objects.min_visible_views", &change.objects.min_visible_views);
+  visitor->Field("change.grid.voxel_size_m", &change.grid.voxel_size_m);
+  visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
+  visitor->Field("change.grid.pixel_step", &change.grid.pixel_step);
+  visitor->Field("change.grid.rate_hz", &change.grid.rate_hz);
+  visitor->Field("change.grid.max_voxels", &change.grid.max_voxels);
+  visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
+  visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);
+  visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
+  visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

@@ -22,6 +22,7 @@ struct MapNode {
   cv::Mat thumbnail;    // the key frame at kThumbnailWidth pixels wide
   double heading = 0;   // gyro yaw integrated since the start of the flight [rad]
   std::optional<Eigen::Vector2d> gps;  // latitude, longitude [deg] at the key frame, when the log has GPS
+  int feature_width = 0;  // width of the image its features were found in [pixels]
 };
 
 constexpr int kThumbnailWidth = 160;

@@ -1,0 +1,52 @@
+// Appearance change between the key frames of one place seen on two patrols:
+// the prior key frame is registered onto the current one by a homography
+// from matched features, the lighting difference is compensated twice (a
+// global gain and offset fitted over the overlap, and a local mean/contrast
+// normalisation), and pixels that differ under both, by more than their best
+// match within a small shift (parallax), form the changed regions:
+// connected, above a minimum size, each with a score and its box in both
+// images. A lighting-only change differs in the global but not in the local
+// comparison, so it yields no region.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include "patrolmap/change/options.h"
+
+namespace patrolmap::change {
+
+// One key frame: its image (grey) and features, whose coordinates are
+// `feature_scale` times the image's (e.g. features found at 188 px width on a
+// 160 px thumbnail: 188 / 160).
+struct KeyFrameView {
+  cv::Mat image;
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  // CV_32F or CV_8U rows (RootSIFT, 8-bit compact)
+  double feature_scale = 1.0;
+};
+
+struct AppearanceRegion {
+  cv::Rect current_box;   // in the current key frame
+  cv::Rect prior_box;     // the same region in the prior key frame
+  int area_px = 0;
+  double score = 0.0;     // mean local difference in the region [local sigmas]
+  int prior_features = 0;           // prior features that fall in the region
+  int unmatched_prior_features = 0; // ... of which no longer match (they support the change)
+};
+
+struct AppearanceChange {
+  bool registered = false;
+  int matches = 0, inliers = 0;
+  double gain = 1.0, offset = 0.0;  // current ~ gain * prior + offset over the overlap
+  double compared_fraction = 0.0;   // share of the current image the registered prior covers
+  cv::Mat homography;               // current_from_prior, image pixels (CV_64F 3x3)
+  std::vector<AppearanceRegion> regions;  // largest first
+};
+
+AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
+                                        const AppearanceOptions& options);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,75 @@
+// Evidence grid of one patrol (paper 004) and the geometry change between two.
+// Each depth ray adds a hit to the voxel it ends in and a pass to every voxel
+// it crosses before; a voxel's occupancy is hits / (hits + passes). A voxel
+// observed in both patrols whose occupancy differs by more than a threshold
+// has changed; changed voxels join the region whose centroid lies within a
+// distance (else start one), overlapping regions merge into the larger, and
+// small regions are dropped. Unobserved space is never a change.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/patrol_data.h"
+
+namespace patrolmap::change {
+
+class EvidenceGrid {
+ public:
+  explicit EvidenceGrid(const EvidenceGridOptions& options);
+
+  // Traces the rays of one depth image (metres along the optical axis, 0 = no
+  // return) seen from `pose`.
+  void Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose);
+  // Traces one ray from `origin` towards `end`; `hit` when it ends on a surface.
+  void TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit);
+
+  std::size_t voxel_count() const { return size_; }
+  long long dropped_updates() const { return dropped_; }  // updates lost to the memory bound
+  EvidenceGridData ToData() const;
+
+ private:
+  struct Slot {
+    std::uint64_t key = 0;  // 0 = empty
+    std::uint16_t hits = 0, passes = 0;
+  };
+  Slot* Find(std::uint64_t key);
+  void Grow();
+
+  EvidenceGridOptions options_;
+  std::vector<Slot> slots_;
+  std::size_t size_ = 0;
+  long long dropped_ = 0;
+};
+
+// Voxel key helpers (index = round(coordinate / voxel_size)).
+Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size);
+
+// The counts of voxel `index`, or nullptr (binary search in the sorted data).
+const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector3i& index);
+
+struct GeometryRegion {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  // voxel-centre extent
+  int voxels = 0;
+  int appeared = 0;   // voxels that became occupied
+  int vanished = 0;   // voxels that became free
+  double score = 0.0; // mean occupancy change
+};
+
+struct GeometryChange {
+  double voxel_size = 0.0;
+  long long compared_voxels = 0;                 // observed enough in both patrols
+  std::vector<Eigen::Vector3i> changed_voxels;   // of the reported regions
+  std::vector<GeometryRegion> regions;           // largest first
+};
+
+// Fails (returns false) when the grids have different voxel sizes or none.
+bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
+               GeometryChange* change);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,55 @@
+// The state of every object between two patrols (papers 000, 001, 003):
+//   persistent  a current object of the same label within the match distance
+//               of a prior one (and passing the point-pair test when both have points);
+//   moved       a prior object gone from its place paired with a new object of the
+//               same label by paper 003's weighted, min-max normalised physical and
+//               appearance distance; the rigid motion by SVD of the point covariances;
+//   removed     a prior object that enough current views covered (projected into the
+//               image, in range, not behind occupied voxels of the current evidence
+//               grid) but nothing matched;
+//   unobserved  a prior object too few current views covered: its state is unknown;
+//   new         a current object matching nothing of the prior patrol.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/patrol_data.h"
+
+namespace patrolmap::change {
+
+enum class ObjectState { kPersistent, kNew, kRemoved, kMoved, kUnobserved };
+const char* ToString(ObjectState state);
+bool ParseObjectState(const std::string& text, ObjectState* state);
+
+struct ObjectChange {
+  ObjectState state = ObjectState::kPersistent;
+  std::string label;
+  double confidence = 0.0;                 // in [0, 1]
+  int prior_id = -1, current_id = -1;      // object ids in the two patrols' object maps
+  std::optional<Eigen::Vector3d> before;   // prior position (not for new)
+  std::optional<Eigen::Vector3d> after;    // current position (not for removed or unobserved)
+  int covering_views = 0;                  // current views that covered the prior object
+  // moved: after ~ rotation * (before-point - before) + after, from the SVD registration.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  double weighted_distance = 0.0;          // moved: paper 003's delta
+};
+
+// How many of `views` cover `object`: in front, within range, the projected
+// centroid inside the image by the margin, and (with a grid) no occupied voxel
+// on the line of sight more than one metre before the object.
+int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options);
+
+std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
+                                      const ObjectDiffOptions& options);
+
+// Rotation taking `before` onto `after` (paper 003): centroids aligned, the
+// principal axes of the two covariances matched by SVD, each axis signed by
+// the skew of the points along it. Identity when either has fewer than 10 points.
+Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before, const std::vector<Eigen::Vector3f>& after);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,80 @@
+// The object map of one patrol (paper 000): each detection is associated with
+// an object already in the map or starts a new one. Association: map objects
+// whose centroid lies within a gate, then the point-pair test (at least half
+// of the nearest-neighbour pairs between the detection's points and the
+// object's points closer than a threshold; k-d tree by nanoflann) when the
+// detection has depth points, otherwise 2D box overlap of the object's
+// projection with a per-category prior on the centroid offset (paper 001).
+// Every object accumulates label-confidence and label-count pairs; Finish()
+// keeps objects with enough detections and gives each the label with the
+// highest accumulated confidence and that label's mean confidence.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/patrol_data.h"
+
+namespace patrolmap::change {
+
+class ObjectMapper {
+ public:
+  ObjectMapper(const ObjectMapOptions& options, const CameraIntrinsics& camera);
+
+  // Adds the detections of one frame seen from `pose`. `depth_m` (CV_32FC1,
+  // may be empty) gives each detection its points; `image` (CV_8UC1 at the
+  // camera's size, may be empty) its appearance descriptor. Detections
+  // without a 3D centroid take it from the depth; without either they are
+  // skipped (counted in skipped()).
+  void AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
+                const cv::Mat& depth_m, const cv::Mat& image);
+
+  // The objects seen at least min_detections times, with their final label and confidence.
+  std::vector<MapObject> Finish() const;
+
+  int associations() const { return associations_; }   // detections compared with the map
+  double association_seconds() const { return association_seconds_; }
+  int skipped() const { return skipped_; }
+
+ private:
+  struct Candidate;
+  struct Measured {
+    Eigen::Vector3d centroid;
+    std::vector<Eigen::Vector3f> points;  // world frame
+    Eigen::Vector2d size = Eigen::Vector2d::Zero();  // width, height [m]
+    std::vector<float> descriptor;
+  };
+  bool Measure(const ObjectObservation& detection, const CameraPoseSample& pose, const cv::Mat& depth_m,
+               const cv::Mat& image, Measured* measured) const;
+  int Associate(const ObjectObservation& detection, const Measured& measured, const CameraPoseSample& pose) const;
+  void Update(int object, const ObjectObservation& detection, Measured&& measured);
+
+  ObjectMapOptions options_;
+  CameraIntrinsics camera_;
+  std::vector<MapObject> objects_;
+  std::vector<Eigen::Vector2d> sizes_;  // running mean width, height of each object
+  int associations_ = 0;
+  double association_seconds_ = 0.0;
+  int skipped_ = 0;
+};
+
+// Shares of nearest-neighbour pairs closer than `distance`: for each point of
+// `query`, its nearest neighbour in `reference` (k-d tree). 0 when either is empty.
+double PairFraction(const std::vector<Eigen::Vector3f>& query, const std::vector<Eigen::Vector3f>& reference,
+                    double distance);
+
+// Keeps one point per voxel of side `voxel` (the first), in a stable order.
+void VoxelFilter(double voxel, std::vector<Eigen::Vector3f>* points);
+
+// Gradient-orientation histogram (8 bins, magnitude-weighted, L1-normalised)
+// of `box` in `image`: an appearance descriptor that ignores gain and offset.
+std::vector<float> OrientationHistogram(const cv::Mat& image, const cv::Rect& box);
+
+// The image box of an axis-aligned world box seen from `pose`; empty when
+// any corner lies behind the camera.
+cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,
+                      const Eigen::Vector3d& box_max);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,77 @@
+// Options of the change stage (DESIGN.md, change; papers 000, 001, 003, 004).
+// config/default.yaml mirrors these structs under `change:`.
+#pragma once
+
+#include <string>
+
+namespace patrolmap::change {
+
+// Appearance: changed regions between two registered key frames.
+struct AppearanceOptions {
+  double ratio = 0.8;                // descriptor ratio test for the registration matches
+  double inlier_threshold_px = 3.0;  // homography RANSAC threshold [key-frame pixels]
+  int min_inliers = 12;              // fewer: the pair is not registered and not compared
+  double blur_sigma_px = 1.0;        // Gaussian blur before differencing
+  int search_radius_px = 2;          // each pixel takes the best match within this shift (parallax)
+  double min_difference = 30.0;      // after global gain/offset compensation [grey levels]
+  double min_normalised_difference = 1.5;  // after local mean/contrast normalisation [local sigmas]
+  int local_window_px = 15;          // window of the local normalisation
+  double min_area_fraction = 0.01;   // regions smaller than this share of the compared area are dropped
+};
+
+// Object map of one patrol (paper 000, with the 2D fallback of paper 001).
+struct ObjectMapOptions {
+  double centroid_gate_m = 1.0;       // candidates: map objects whose centroid is this close
+  double pair_distance_m = 0.2;       // point-pair test: nearest-neighbour pairs closer than this agree
+  double min_pair_fraction = 0.5;     // ... and at least this share of pairs must agree
+  double point_voxel_m = 0.1;         // object points are kept one per voxel of this size
+  double segment_depth_m = 0.8;       // depth pixels within this of the centroid's depth belong to the object
+  int max_segment_samples = 400;      // depth pixels sampled per detection
+  double min_box_iou = 0.3;           // 2D test: predicted and detected box must overlap this much
+  double category_sigma_m = 0.5;      // 2D test: per-category prior, Gaussian on the centroid offset
+  double vehicle_sigma_m = 1.0;       // ... wider for vehicles (labels containing "vehicle", "car", "truck")
+  double min_category_prior = 0.1;    // 2D test: smallest prior probability accepted
+  int min_detections = 3;             // objects seen fewer times are dropped when the patrol ends
+  double max_range_m = 25.0;          // detections farther than this are ignored
+};
+
+// State of every object between two patrols (papers 000, 001, 003).
+struct ObjectDiffOptions {
+  double match_distance_m = 1.0;      // persistent: centroids this close (then the point-pair test)
+  double max_move_m = 12.0;           // moved: the two positions at most this far apart
+  double physical_weight = 0.6;       // alpha of paper 003's weighted normalised distance
+  double appearance_weight = 0.4;     // beta
+  double max_weighted_distance = 0.8; // pairs whose weighted distance is above this are not a move
+  double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
+  double image_margin_px = 4.0;       // visibility: its projected centroid must lie this far inside the image
+  int min_visible_views = 3;          // fewer covering views: unobserved instead of removed
+};
+
+// Evidence grid of one patrol (paper 004).
+struct EvidenceGridOptions {
+  double voxel_size_m = 0.2;
+  double max_range_m = 20.0;          // rays are traced this far; farther returns count as passes only
+  int pixel_step = 4;                 // every n-th depth pixel in both directions is a ray
+  double rate_hz = 5.0;               // depth frames integrated per second of flight
+  int max_voxels = 40000000;          // memory bound (16 bytes a voxel); further voxels are not created
+};
+
+// Geometry change between two evidence grids (paper 004).
+struct GeometryDiffOptions {
+  double min_occupancy_change = 0.5;  // |hits/(hits+passes) before - after| above this: changed
+  int min_observations = 3;           // rays per voxel in each patrol; fewer: unobserved, never a change
+  double join_distance_m = 1.0;       // a changed voxel joins a region whose centroid is this close
+  int min_region_voxels = 6;          // smaller regions are dropped as outliers
+};
+
+struct ChangeOptions {
+  AppearanceOptions appearance;
+  ObjectMapOptions object_map;
+  ObjectDiffOptions objects;
+  EvidenceGridOptions grid;
+  GeometryDiffOptions geometry;
+  // False with a message naming the first invalid option.
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace patrolmap::change

@@ -1,0 +1,86 @@
+// Value types of the change stage (DESIGN.md, change): what a log tells about
+// where the camera was and what it saw, and what one patrol keeps of it (its
+// object map, evidence grid and views) so that two patrols of a map can be
+// compared without their logs. World frame: the log's state estimate frame,
+// z up [m]. Camera frame: x right, y down, z forward.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core/types.hpp>
+
+#include "patrolmap/core/types.h"
+
+namespace patrolmap {
+
+// Where the camera was: world_from_camera = (rotation, position).
+struct CameraPoseSample {
+  TimestampNs timestamp_ns = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d ToWorld(const Eigen::Vector3d& in_camera) const { return rotation * in_camera + position; }
+  Eigen::Vector3d ToCamera(const Eigen::Vector3d& in_world) const {
+    return rotation.conjugate() * (in_world - position);
+  }
+};
+
+// One object detection of one frame (objects0/data.csv).
+struct ObjectObservation {
+  TimestampNs timestamp_ns = 0;
+  std::string label;
+  double confidence = 0.0;
+  cv::Rect2d box;                                   // in the image [pixels]
+  std::optional<Eigen::Vector3d> centroid_camera;   // 3D centroid in the camera frame, when the detector gives one
+};
+
+// One object of a patrol's object map (paper 000): detections associated
+// across frames, with the label-confidence and label-count accumulators.
+struct MapObject {
+  int id = 0;
+  std::string label;                 // the label with the highest accumulated confidence
+  double confidence = 0.0;           // mean confidence of the detections with that label
+  int detections = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // world frame [m]
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (or of its centroids)
+  Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3f> points;                 // segmented points (voxel-filtered); empty without depth
+  std::vector<float> descriptor;                       // appearance: gradient-orientation histogram of its views
+  struct LabelEvidence {
+    std::string label;
+    double confidence_sum = 0.0;
+    int count = 0;
+  };
+  std::vector<LabelEvidence> labels;
+  TimestampNs first_seen_ns = 0, last_seen_ns = 0;
+};
+
+// Hit and pass counts of one voxel of an evidence grid (paper 004).
+struct VoxelEvidence {
+  std::int32_t x = 0, y = 0, z = 0;  // voxel index: centre = index * voxel_size
+  std::uint16_t hits = 0;            // rays that ended in the voxel
+  std::uint16_t passes = 0;          // rays that passed through it
+};
+
+// An evidence grid as stored: its voxels in ascending (x, y, z) order.
+struct EvidenceGridData {
+  double voxel_size = 0.0;  // [m]; 0 when the patrol had no depth
+  std::vector<VoxelEvidence> voxels;
+};
+
+// What a patrol (one flight of a map) keeps for change detection.
+struct PatrolRecord {
+  std::string flight;
+  CameraIntrinsics camera;               // of the images the views and detections refer to
+  int feature_image_width = 0;           // width of the images its key-frame features were found in
+  std::vector<CameraPoseSample> views;   // camera poses sampled along the flight
+  bool has_objects = false;              // the log had detections
+  std::vector<MapObject> objects;
+  EvidenceGridData grid;                 // voxel_size 0 when the log had no depth
+};
+
+}  // namespace patrolmap

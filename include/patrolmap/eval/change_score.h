@@ -1,0 +1,79 @@
+// Scores a change report against a simulated patrol series' ground truth.
+//
+// Objects: each log's groundtruth/objects.csv lists its objects (id, label,
+// pose, size); an object keeps its id across flights, so the true state of
+// every object between two flights follows: in both at the same place
+// persistent, elsewhere moved, only in the earlier removed, only in the later
+// new. Only objects the detector reported at least `min_detections` times
+// (groundtruth/detections.csv) in the flight(s) that define the state count.
+// A reported object is a hit when a true object of the same state and label
+// lies within `distance_m` (moved: both its positions). Per state: precision,
+// recall and F1, one-to-one matching nearest first.
+//
+// Geometry (per voxel, as paper 003 scores per point): a voxel truly changed
+// when its centre, within half a voxel, lies inside an object box of exactly
+// one of the two flights, counted only where both evidence grids observed the
+// voxel at least `min_observations` times (unobservable space is no change).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "patrolmap/core/patrol_data.h"
+#include "patrolmap/core/status.h"
+
+namespace patrolmap::eval {
+
+struct TruthObject {
+  int id = 0;
+  std::string label;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double yaw = 0.0, length = 0.0, width = 0.0, height = 0.0;
+  int detections = 0;  // how often the flight's detector reported it
+  bool Contains(const Eigen::Vector3d& point, double margin) const;
+};
+
+// Reads groundtruth/objects.csv and counts groundtruth/detections.csv of a simulated log.
+Status ReadTruthObjects(const std::string& log, std::vector<TruthObject>* objects);
+
+struct ReportedObject {
+  std::string state;  // persistent, new, removed, moved, unobserved
+  std::string label;
+  std::optional<Eigen::Vector3d> before, after;
+};
+
+struct Counts {
+  int true_positives = 0, false_positives = 0, false_negatives = 0;
+  double Precision() const;
+  double Recall() const;
+  double F1() const;
+};
+
+struct ObjectChangeScore {
+  std::map<std::string, Counts> by_state;  // persistent, new, removed, moved
+  int unobserved = 0;                       // reported unobserved (not scored)
+};
+
+struct ChangeScoreOptions {
+  double distance_m = 1.0;
+  int min_detections = 3;
+  int min_observations = 3;
+};
+
+ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported, const std::vector<TruthObject>& before,
+                                     const std::vector<TruthObject>& after, const ChangeScoreOptions& options);
+
+struct GeometryScore {
+  Counts voxels;
+  long long observed_voxels = 0;  // observed in both grids
+  double Iou() const;
+};
+
+GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const EvidenceGridData& before_grid,
+                            const EvidenceGridData& after_grid, const std::vector<TruthObject>& before,
+                            const std::vector<TruthObject>& after, const ChangeScoreOptions& options);
+
+}  // namespace patrolmap::eval

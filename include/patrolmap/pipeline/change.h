@@ -1,0 +1,39 @@
+// Change detection for a patrol (DESIGN.md: prior map -> ChangeDetector ->
+// change report): what a log's poses, detections and depth give its patrol
+// record, and the comparison of two flights of a map.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "patrolmap/change/report.h"
+#include "patrolmap/core/status.h"
+#include "patrolmap/graph/topo_map.h"
+#include "patrolmap/pipeline/config.h"
+
+namespace patrolmap::pipeline {
+
+struct PatrolRecordStats {
+  int detections = 0, associations = 0, skipped_detections = 0;
+  double association_seconds = 0.0;
+  int depth_frames = 0;
+  double grid_seconds = 0.0;
+  long long dropped_voxel_updates = 0;
+};
+
+using ChangeProgress = std::function<void(std::int64_t, std::int64_t)>;
+
+// The patrol record of `log`: its camera, views sampled along the state
+// estimate, the object map (when it has objects0/) and the evidence grid
+// (when it has depth0/). Without poses only the camera is filled.
+// `feature_image_width` is the width its key-frame features were found at.
+Status BuildPatrolRecord(const std::string& log, const Config& config, int feature_image_width, PatrolRecord* record,
+                         PatrolRecordStats* stats = nullptr, const ChangeProgress& progress = {});
+
+// Compares flight `prior` with flight `current` of `map`: appearance at every
+// loop closure between their nodes, objects and geometry where both patrol
+// records have them. Fails naming a flight that is not in the map.
+Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const std::string& current,
+                      const change::ChangeOptions& options, change::ChangeReport* report);
+
+}  // namespace patrolmap::pipeline

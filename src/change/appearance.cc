@@ -1,0 +1,170 @@
+#include "patrolmap/change/appearance.h"
+
+#include <algorithm>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace patrolmap::change {
+namespace {
+
+cv::Mat AsFloat(const cv::Mat& descriptors) {
+  cv::Mat floats;
+  descriptors.convertTo(floats, CV_32F);
+  return floats;
+}
+
+// Ratio-test matches prior -> current (query = current).
+std::vector<cv::DMatch> Match(const KeyFrameView& prior, const KeyFrameView& current, double ratio) {
+  std::vector<cv::DMatch> good;
+  if (prior.descriptors.rows < 2 || current.descriptors.rows < 2) return good;
+  std::vector<std::vector<cv::DMatch>> knn;
+  cv::BFMatcher(cv::NORM_L2).knnMatch(AsFloat(current.descriptors), AsFloat(prior.descriptors), knn, 2);
+  for (const auto& pair : knn) {
+    if (pair.size() == 2 && pair[0].distance < ratio * pair[1].distance) good.push_back(pair[0]);
+  }
+  return good;
+}
+
+// current ~ gain * prior + offset, least squares over the overlap, refitted on the pixels within 2.5 sigma.
+void FitLighting(const cv::Mat& prior, const cv::Mat& current, const cv::Mat& mask, double* gain, double* offset) {
+  std::vector<cv::Point> points;
+  cv::findNonZero(mask, points);
+  std::vector<char> keep(points.size(), 1);
+  *gain = 1.0, *offset = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      const double x = prior.at<float>(points[i]), y = current.at<float>(points[i]);
+      n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    const double denominator = n * sxx - sx * sx;
+    if (n < 10 || denominator <= 1e-9) return;
+    *gain = (n * sxy - sx * sy) / denominator;
+    *offset = (sy - *gain * sx) / n;
+    double squared = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double r = current.at<float>(points[i]) - (*gain * prior.at<float>(points[i]) + *offset);
+      squared += r * r;
+    }
+    const double sigma = std::sqrt(squared / points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double r = current.at<float>(points[i]) - (*gain * prior.at<float>(points[i]) + *offset);
+      keep[i] = std::abs(r) < 2.5 * sigma;
+    }
+  }
+}
+
+// (image - local mean) / (local standard deviation + floor).
+cv::Mat LocallyNormalised(const cv::Mat& image, int window) {
+  cv::Mat mean, squared, variance;
+  const cv::Size size(window, window);
+  cv::blur(image, mean, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+  cv::blur(image.mul(image), squared, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+  cv::max(squared - mean.mul(mean), 0.0, variance);
+  cv::Mat sigma;
+  cv::sqrt(variance, sigma);
+  constexpr double kSigmaFloor = 6.0;  // grey levels: keeps flat areas from amplifying noise
+  return (image - mean) / (sigma + kSigmaFloor);
+}
+
+// Per pixel, the smallest |a - b(shifted)| over shifts of b within the radius.
+cv::Mat BestShiftDifference(const cv::Mat& a, const cv::Mat& b, int radius) {
+  cv::Mat best(a.size(), CV_32F, cv::Scalar(1e9)), shifted, difference;
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+      cv::warpAffine(b, shifted, m, b.size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+      cv::absdiff(a, shifted, difference);
+      best = cv::min(best, difference);
+    }
+  }
+  return best;
+}
+
+cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const cv::Size& prior_size) {
+  std::vector<cv::Point2f> corners = {box.tl(), {static_cast<float>(box.br().x), static_cast<float>(box.y)},
+                                      box.br(), {static_cast<float>(box.x), static_cast<float>(box.br().y)}};
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(corners, mapped, current_from_prior.inv());
+  return cv::boundingRect(mapped) & cv::Rect(0, 0, prior_size.width, prior_size.height);
+}
+
+}  // namespace
+
+AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
+                                        const AppearanceOptions& options) {
+  AppearanceChange result;
+  const std::vector<cv::DMatch> matches = Match(prior, current, options.ratio);
+  result.matches = static_cast<int>(matches.size());
+  if (result.matches < std::max(4, options.min_inliers)) return result;
+  std::vector<cv::Point2f> from, to;
+  for (const cv::DMatch& m : matches) {
+    from.push_back(prior.keypoints[m.trainIdx].pt / prior.feature_scale);
+    to.push_back(current.keypoints[m.queryIdx].pt / current.feature_scale);
+  }
+  std::vector<unsigned char> inlier;
+  cv::Mat h = cv::findHomography(from, to, cv::RANSAC, options.inlier_threshold_px, inlier, 2000, 0.999);
+  result.inliers = h.empty() ? 0 : cv::countNonZero(inlier);
+  if (result.inliers < options.min_inliers) return result;
+  result.registered = true;
+  result.homography = h;
+
+  cv::Mat prior_f, current_f, warped, mask;
+  prior.image.convertTo(prior_f, CV_32F);
+  current.image.convertTo(current_f, CV_32F);
+  if (options.blur_sigma_px > 0) {
+    cv::GaussianBlur(prior_f, prior_f, cv::Size(), options.blur_sigma_px);
+    cv::GaussianBlur(current_f, current_f, cv::Size(), options.blur_sigma_px);
+  }
+  cv::warpPerspective(prior_f, warped, h, current_f.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::warpPerspective(cv::Mat(prior_f.size(), CV_8U, cv::Scalar(255)), mask, h, current_f.size(), cv::INTER_NEAREST);
+  const int margin = options.search_radius_px + 2;
+  cv::erode(mask, mask, cv::Mat(), cv::Point(-1, -1), margin);
+  const int compared = cv::countNonZero(mask);
+  result.compared_fraction = static_cast<double>(compared) / mask.total();
+  if (compared == 0) return result;
+  FitLighting(warped, current_f, mask, &result.gain, &result.offset);
+
+  const cv::Mat global = BestShiftDifference(current_f, warped * result.gain + result.offset, options.search_radius_px);
+  const cv::Mat local = BestShiftDifference(LocallyNormalised(current_f, options.local_window_px),
+                                            LocallyNormalised(warped, options.local_window_px), options.search_radius_px);
+  cv::Mat changed = (global > options.min_difference) & (local > options.min_normalised_difference) & mask;
+  cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
+  cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), 2);
+  changed &= mask;
+
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8, CV_32S);
+  const int min_area = std::max(1, static_cast<int>(options.min_area_fraction * compared));
+  std::vector<bool> inlier_prior(prior.keypoints.size(), false);
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    if (inlier[i]) inlier_prior[matches[i].trainIdx] = true;
+  }
+  std::vector<cv::Point2f> prior_points, prior_in_current;
+  for (const cv::KeyPoint& k : prior.keypoints) prior_points.push_back(k.pt / prior.feature_scale);
+  if (!prior_points.empty()) cv::perspectiveTransform(prior_points, prior_in_current, h);
+  for (int label = 1; label < count; ++label) {
+    AppearanceRegion region;
+    region.area_px = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (region.area_px < min_area) continue;
+    region.current_box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+                                  stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    region.prior_box = PriorBox(region.current_box, h, prior.image.size());
+    region.score = cv::mean(local, labels == label)[0];
+    for (std::size_t k = 0; k < prior_in_current.size(); ++k) {
+      const cv::Point p(cvRound(prior_in_current[k].x), cvRound(prior_in_current[k].y));
+      if (!region.current_box.contains(p) || labels.at<int>(p) != label) continue;
+      ++region.prior_features;
+      if (!inlier_prior[k]) ++region.unmatched_prior_features;
+    }
+    result.regions.push_back(region);
+  }
+  std::sort(result.regions.begin(), result.regions.end(),
+            [](const AppearanceRegion& a, const AppearanceRegion& b) { return a.area_px > b.area_px; });
+  return result;
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,269 @@
+#include "patrolmap/change/evidence_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace patrolmap::change {
+namespace {
+
+constexpr int kBits = 21;
+constexpr std::int64_t kOffset = 1 << 20;
+constexpr std::uint64_t kUsed = 1ull << 63;
+
+std::uint64_t PackKey(const Eigen::Vector3i& v) {
+  const auto part = [](int value) { return static_cast<std::uint64_t>(value + kOffset) & ((1ull << kBits) - 1); };
+  return kUsed | part(v.x()) << (2 * kBits) | part(v.y()) << kBits | part(v.z());
+}
+
+Eigen::Vector3i UnpackKey(std::uint64_t key) {
+  const auto part = [key](int shift) {
+    return static_cast<int>(static_cast<std::int64_t>((key >> shift) & ((1ull << kBits) - 1)) - kOffset);
+  };
+  return {part(2 * kBits), part(kBits), part(0)};
+}
+
+bool Less(const VoxelEvidence& a, const Eigen::Vector3i& b) {
+  if (a.x != b.x()) return a.x < b.x();
+  if (a.y != b.y()) return a.y < b.y();
+  return a.z < b.z();
+}
+
+int Compare(const VoxelEvidence& a, const VoxelEvidence& b) {
+  if (a.x != b.x) return a.x < b.x ? -1 : 1;
+  if (a.y != b.y) return a.y < b.y ? -1 : 1;
+  if (a.z != b.z) return a.z < b.z ? -1 : 1;
+  return 0;
+}
+
+double Occupancy(const VoxelEvidence& v) { return static_cast<double>(v.hits) / (v.hits + v.passes); }
+
+struct Region {
+  GeometryRegion data;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double score_sum = 0.0;
+  std::vector<std::size_t> members;  // indices into the changed voxels
+  bool alive = true;
+};
+
+bool Overlap(const GeometryRegion& a, const GeometryRegion& b, double tolerance) {
+  for (int axis = 0; axis < 3; ++axis) {
+    if (a.box_max[axis] + tolerance < b.box_min[axis] || b.box_max[axis] + tolerance < a.box_min[axis]) return false;
+  }
+  return true;
+}
+
+void Absorb(Region* into, Region* from) {
+  into->data.voxels += from->data.voxels;
+  into->data.appeared += from->data.appeared;
+  into->data.vanished += from->data.vanished;
+  into->data.box_min = into->data.box_min.cwiseMin(from->data.box_min);
+  into->data.box_max = into->data.box_max.cwiseMax(from->data.box_max);
+  into->sum += from->sum;
+  into->score_sum += from->score_sum;
+  into->members.insert(into->members.end(), from->members.begin(), from->members.end());
+  into->data.centroid = into->sum / into->data.voxels;
+  from->alive = false;
+}
+
+// Paper 004's aggregation: nearest region centroid within the join distance, else a new region.
+std::vector<Region> Cluster(const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& changes,
+                            double join_distance) {
+  std::vector<Region> regions;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    Region* best = nullptr;
+    double best_distance = join_distance;
+    for (Region& region : regions) {
+      const double distance = (region.data.centroid - centres[i]).norm();
+      if (distance <= best_distance) best = &region, best_distance = distance;
+    }
+    if (best == nullptr) {
+      regions.emplace_back();
+      best = &regions.back();
+      best->data.box_min = best->data.box_max = centres[i];
+    }
+    Region single;
+    single.data.voxels = 1;
+    (changes[i] > 0 ? single.data.appeared : single.data.vanished) = 1;
+    single.data.box_min = single.data.box_max = centres[i];
+    single.sum = centres[i];
+    single.score_sum = std::abs(changes[i]);
+    single.members = {i};
+    Absorb(best, &single);
+  }
+  return regions;
+}
+
+// Cleanup: while two regions overlap, the smaller joins the larger.
+void MergeOverlapping(double tolerance, std::vector<Region>* regions) {
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t a = 0; a < regions->size(); ++a) {
+      for (std::size_t b = a + 1; b < regions->size(); ++b) {
+        Region& ra = (*regions)[a];
+        Region& rb = (*regions)[b];
+        if (!ra.alive || !rb.alive || !Overlap(ra.data, rb.data, tolerance)) continue;
+        if (ra.data.voxels >= rb.data.voxels) Absorb(&ra, &rb); else Absorb(&rb, &ra);
+        merged = true;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size) {
+  return (point / voxel_size).array().round().cast<int>();
+}
+
+const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector3i& index) {
+  const auto it = std::lower_bound(grid.voxels.begin(), grid.voxels.end(), index, Less);
+  if (it == grid.voxels.end() || it->x != index.x() || it->y != index.y() || it->z != index.z()) return nullptr;
+  return &*it;
+}
+
+EvidenceGrid::EvidenceGrid(const EvidenceGridOptions& options) : options_(options), slots_(1 << 16) {}
+
+EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
+  const int bits = __builtin_ctzll(slots_.size());
+  std::size_t i = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+  const std::size_t mask = slots_.size() - 1;
+  while (true) {
+    Slot& slot = slots_[i];
+    if (slot.key == key) return &slot;
+    if (slot.key == 0) {
+      if (static_cast<long long>(size_) >= options_.max_voxels) return nullptr;
+      if (2 * (size_ + 1) > slots_.size()) {
+        Grow();
+        return Find(key);
+      }
+      slot.key = key;
+      ++size_;
+      return &slot;
+    }
+    i = (i + 1) & mask;
+  }
+}
+
+void EvidenceGrid::Grow() {
+  std::vector<Slot> old(slots_.size() * 2);
+  old.swap(slots_);
+  size_ = 0;
+  for (const Slot& slot : old) {
+    if (slot.key == 0) continue;
+    Slot* moved = Find(slot.key);
+    moved->hits = slot.hits;
+    moved->passes = slot.passes;
+  }
+}
+
+void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit) {
+  const Eigen::Vector3d a = origin / options_.voxel_size_m + Eigen::Vector3d::Constant(0.5);
+  const Eigen::Vector3d b = end / options_.voxel_size_m + Eigen::Vector3d::Constant(0.5);
+  Eigen::Vector3i voxel = a.array().floor().cast<int>();
+  const Eigen::Vector3i last = b.array().floor().cast<int>();
+  const Eigen::Vector3d d = b - a;
+  int step[3];
+  double t_max[3], t_delta[3];
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (int axis = 0; axis < 3; ++axis) {
+    step[axis] = d[axis] > 0 ? 1 : (d[axis] < 0 ? -1 : 0);
+    if (step[axis] == 0) {
+      t_max[axis] = t_delta[axis] = kInf;
+      continue;
+    }
+    const double boundary = voxel[axis] + (step[axis] > 0 ? 1.0 : 0.0);
+    t_max[axis] = (boundary - a[axis]) / d[axis];
+    t_delta[axis] = std::abs(1.0 / d[axis]);
+  }
+  int remaining = (last - voxel).cwiseAbs().sum();
+  const auto count = [this](const Eigen::Vector3i& v, bool is_hit) {
+    Slot* slot = Find(PackKey(v));
+    if (slot == nullptr) return void(++dropped_);
+    std::uint16_t& counter = is_hit ? slot->hits : slot->passes;
+    if (counter < std::numeric_limits<std::uint16_t>::max()) ++counter;
+  };
+  while (remaining-- > 0) {
+    count(voxel, false);
+    const int axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    voxel[axis] += step[axis];
+    t_max[axis] += t_delta[axis];
+  }
+  count(last, hit);
+}
+
+void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose) {
+  constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
+  const int step = std::max(1, options_.pixel_step);
+  for (int y = step / 2; y < depth_m.rows; y += step) {
+    const float* row = depth_m.ptr<float>(y);
+    for (int x = step / 2; x < depth_m.cols; x += step) {
+      const double depth = row[x];
+      if (depth <= 0.0) continue;  // no return: unknown
+      const Eigen::Vector3d ray((x - camera.cx) / camera.fx, (y - camera.cy) / camera.fy, 1.0);
+      const double length = depth * ray.norm();
+      const bool hit = depth < kNoReturnBeyond && length <= options_.max_range_m;
+      const double traced = hit ? depth : options_.max_range_m / ray.norm();
+      TraceRay(pose.position, pose.ToWorld(traced * ray), hit);
+    }
+  }
+}
+
+EvidenceGridData EvidenceGrid::ToData() const {
+  EvidenceGridData data;
+  data.voxel_size = options_.voxel_size_m;
+  data.voxels.reserve(size_);
+  for (const Slot& slot : slots_) {
+    if (slot.key == 0) continue;
+    const Eigen::Vector3i v = UnpackKey(slot.key);
+    data.voxels.push_back({v.x(), v.y(), v.z(), slot.hits, slot.passes});
+  }
+  std::sort(data.voxels.begin(), data.voxels.end(),
+            [](const VoxelEvidence& a, const VoxelEvidence& b) { return Compare(a, b) < 0; });
+  return data;
+}
+
+bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
+               GeometryChange* change) {
+  *change = GeometryChange();
+  if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size) return false;
+  const double size = before.voxel_size;
+  change->voxel_size = size;
+  std::vector<Eigen::Vector3i> changed;
+  std::vector<Eigen::Vector3d> centres;
+  std::vector<double> deltas;
+  auto a = before.voxels.begin(), b = after.voxels.begin();
+  const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
+  while (a != before.voxels.end() && b != after.voxels.end()) {
+    const int order = Compare(*a, *b);
+    if (order < 0) { ++a; continue; }
+    if (order > 0) { ++b; continue; }
+    if (observed(*a) && observed(*b)) {
+      ++change->compared_voxels;
+      const double delta = Occupancy(*b) - Occupancy(*a);
+      if (std::abs(delta) > options.min_occupancy_change) {
+        changed.emplace_back(a->x, a->y, a->z);
+        centres.push_back(changed.back().cast<double>() * size);
+        deltas.push_back(delta);
+      }
+    }
+    ++a, ++b;
+  }
+  std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
+  MergeOverlapping(size / 2, &regions);
+  for (Region& region : regions) {
+    if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
+    region.data.score = region.score_sum / region.data.voxels;
+    change->regions.push_back(region.data);
+    for (std::size_t member : region.members) change->changed_voxels.push_back(changed[member]);
+  }
+  std::stable_sort(change->regions.begin(), change->regions.end(),
+                   [](const GeometryRegion& x, const GeometryRegion& y) { return x.voxels > y.voxels; });
+  std::sort(change->changed_voxels.begin(), change->changed_voxels.end(),
+            [](const Eigen::Vector3i& x, const Eigen::Vector3i& y) {
+              return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
+            });
+  return true;
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,237 @@
+#include "patrolmap/change/object_map.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_set>
+
+#include <nanoflann.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace patrolmap::change {
+namespace {
+
+struct PointCloud {
+  const std::vector<Eigen::Vector3f>* points;
+  std::size_t kdtree_get_point_count() const { return points->size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t axis) const { return (*points)[i][static_cast<int>(axis)]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const { return false; }
+};
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointCloud>, PointCloud, 3>;
+
+double Iou(const cv::Rect2d& a, const cv::Rect2d& b) {
+  const double overlap = (a & b).area();
+  const double total = a.area() + b.area() - overlap;
+  return total > 0.0 ? overlap / total : 0.0;
+}
+
+bool IsVehicle(const std::string& label) {
+  for (const char* word : {"vehicle", "car", "truck", "bus", "van"}) {
+    if (label.find(word) != std::string::npos) return true;
+  }
+  return false;
+}
+
+// The detection's depth: the median of the box's central third.
+float CentralDepth(const cv::Mat& depth_m, const cv::Rect& box) {
+  const cv::Rect centre(box.x + box.width / 3, box.y + box.height / 3, std::max(1, box.width / 3),
+                        std::max(1, box.height / 3));
+  std::vector<float> values;
+  for (int y = centre.y; y < centre.br().y; ++y) {
+    for (int x = centre.x; x < centre.br().x; ++x) {
+      const float d = depth_m.at<float>(y, x);
+      if (d > 0.0f) values.push_back(d);
+    }
+  }
+  if (values.empty()) return 0.0f;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+double PairFraction(const std::vector<Eigen::Vector3f>& query, const std::vector<Eigen::Vector3f>& reference,
+                    double distance) {
+  if (query.empty() || reference.empty()) return 0.0;
+  const PointCloud cloud{&reference};
+  const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  const float limit = static_cast<float>(distance * distance);
+  int close = 0;
+  for (const Eigen::Vector3f& point : query) {
+    std::uint32_t index = 0;
+    float squared = 0.0f;
+    if (tree.knnSearch(point.data(), 1, &index, &squared) == 1 && squared < limit) ++close;
+  }
+  return static_cast<double>(close) / static_cast<double>(query.size());
+}
+
+void VoxelFilter(double voxel, std::vector<Eigen::Vector3f>* points) {
+  std::unordered_set<std::uint64_t> occupied;
+  occupied.reserve(points->size());
+  const auto key = [voxel](const Eigen::Vector3f& p) {
+    const auto cell = [voxel](float v) { return static_cast<std::uint64_t>(std::floor(v / voxel) + (1 << 20)) & 0x1fffff; };
+    return cell(p.x()) << 42 | cell(p.y()) << 21 | cell(p.z());
+  };
+  const auto end = std::remove_if(points->begin(), points->end(),
+                                  [&](const Eigen::Vector3f& p) { return !occupied.insert(key(p)).second; });
+  points->erase(end, points->end());
+}
+
+std::vector<float> OrientationHistogram(const cv::Mat& image, const cv::Rect& box) {
+  std::vector<float> histogram(8, 0.0f);
+  const cv::Rect inside = box & cv::Rect(1, 1, image.cols - 2, image.rows - 2);
+  double total = 0.0;
+  for (int y = inside.y; y < inside.br().y; ++y) {
+    for (int x = inside.x; x < inside.br().x; ++x) {
+      const double gx = image.at<std::uint8_t>(y, x + 1) - image.at<std::uint8_t>(y, x - 1);
+      const double gy = image.at<std::uint8_t>(y + 1, x) - image.at<std::uint8_t>(y - 1, x);
+      const double magnitude = std::hypot(gx, gy);
+      if (magnitude < 1.0) continue;
+      const int bin = static_cast<int>(std::floor((std::atan2(gy, gx) + M_PI) / (2.0 * M_PI) * 8.0)) & 7;
+      histogram[bin] += static_cast<float>(magnitude);
+      total += magnitude;
+    }
+  }
+  if (total > 0.0) {
+    for (float& value : histogram) value = static_cast<float>(value / total);
+  }
+  return histogram;
+}
+
+cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,
+                      const Eigen::Vector3d& box_max) {
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d world((corner & 1) ? box_max.x() : box_min.x(), (corner & 2) ? box_max.y() : box_min.y(),
+                                (corner & 4) ? box_max.z() : box_min.z());
+    const Eigen::Vector3d c = pose.ToCamera(world);
+    if (c.z() < 0.1) return {};
+    const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
+    x0 = std::min(x0, u), y0 = std::min(y0, v), x1 = std::max(x1, u), y1 = std::max(y1, v);
+  }
+  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+}
+
+ObjectMapper::ObjectMapper(const ObjectMapOptions& options, const CameraIntrinsics& camera)
+    : options_(options), camera_(camera) {}
+
+bool ObjectMapper::Measure(const ObjectObservation& detection, const CameraPoseSample& pose, const cv::Mat& depth_m,
+                           const cv::Mat& image, Measured* measured) const {
+  const cv::Rect box = cv::Rect(detection.box) & cv::Rect(0, 0, camera_.width, camera_.height);
+  if (box.area() <= 0) return false;
+  const bool has_depth = !depth_m.empty() && depth_m.cols == camera_.width && depth_m.rows == camera_.height;
+  double z = detection.centroid_camera ? detection.centroid_camera->z() : 0.0;
+  if (!detection.centroid_camera && has_depth) z = CentralDepth(depth_m, box);
+  if (!(z > 0.0) || z > options_.max_range_m) return false;
+  const Eigen::Vector3d in_camera =
+      detection.centroid_camera ? *detection.centroid_camera
+                                : Eigen::Vector3d((box.x + box.width / 2.0 - camera_.cx) / camera_.fx * z,
+                                                  (box.y + box.height / 2.0 - camera_.cy) / camera_.fy * z, z);
+  measured->centroid = pose.ToWorld(in_camera);
+  measured->size = Eigen::Vector2d(box.width * z / camera_.fx, box.height * z / camera_.fy);
+  measured->points.clear();
+  if (has_depth) {
+    const int step = std::max(1, static_cast<int>(std::sqrt(box.area() / static_cast<double>(options_.max_segment_samples))));
+    for (int y = box.y; y < box.br().y; y += step) {
+      const float* row = depth_m.ptr<float>(y);
+      for (int x = box.x; x < box.br().x; x += step) {
+        const double d = row[x];
+        if (d <= 0.0 || std::abs(d - in_camera.z()) > options_.segment_depth_m) continue;
+        const Eigen::Vector3d p((x - camera_.cx) / camera_.fx * d, (y - camera_.cy) / camera_.fy * d, d);
+        measured->points.push_back(pose.ToWorld(p).cast<float>());
+      }
+    }
+    VoxelFilter(options_.point_voxel_m, &measured->points);
+  }
+  if (!image.empty()) measured->descriptor = OrientationHistogram(image, box);
+  return true;
+}
+
+int ObjectMapper::Associate(const ObjectObservation& detection, const Measured& measured,
+                            const CameraPoseSample& pose) const {
+  int best = -1;
+  double best_score = 0.0;
+  for (std::size_t i = 0; i < objects_.size(); ++i) {
+    const MapObject& object = objects_[i];
+    const double distance = (object.centroid - measured.centroid).norm();
+    if (distance > options_.centroid_gate_m) continue;
+    double score = 0.0;
+    if (!measured.points.empty() && !object.points.empty()) {
+      score = PairFraction(measured.points, object.points, options_.pair_distance_m);
+      if (score < options_.min_pair_fraction) continue;
+    } else {
+      const double sigma = IsVehicle(object.label) ? options_.vehicle_sigma_m : options_.category_sigma_m;
+      const double prior = std::exp(-0.5 * distance * distance / (sigma * sigma));
+      const double iou = Iou(ProjectBox(camera_, pose, object.box_min, object.box_max), detection.box);
+      if (prior < options_.min_category_prior || iou < options_.min_box_iou) continue;
+      score = prior * iou;
+    }
+    if (score > best_score) best = static_cast<int>(i), best_score = score;
+  }
+  return best;
+}
+
+void ObjectMapper::Update(int index, const ObjectObservation& detection, Measured&& measured) {
+  if (index < 0) {
+    MapObject object;
+    object.id = static_cast<int>(objects_.size());
+    object.first_seen_ns = detection.timestamp_ns;
+    object.descriptor.assign(measured.descriptor.size(), 0.0f);
+    objects_.push_back(std::move(object));
+    sizes_.push_back(Eigen::Vector2d::Zero());
+    index = static_cast<int>(objects_.size()) - 1;
+  }
+  MapObject& object = objects_[index];
+  const double n = ++object.detections;
+  object.centroid += (measured.centroid - object.centroid) / n;
+  sizes_[index] += (measured.size - sizes_[index]) / n;
+  if (object.descriptor.size() == measured.descriptor.size()) {
+    for (std::size_t b = 0; b < object.descriptor.size(); ++b) {
+      object.descriptor[b] += static_cast<float>((measured.descriptor[b] - object.descriptor[b]) / n);
+    }
+  }
+  object.points.insert(object.points.end(), measured.points.begin(), measured.points.end());
+  VoxelFilter(options_.point_voxel_m, &object.points);
+  const Eigen::Vector3d half(sizes_[index].x() / 2, sizes_[index].x() / 2, sizes_[index].y() / 2);
+  object.box_min = object.centroid - half;
+  object.box_max = object.centroid + half;
+  object.last_seen_ns = detection.timestamp_ns;
+  auto evidence = std::find_if(object.labels.begin(), object.labels.end(),
+                               [&](const MapObject::LabelEvidence& e) { return e.label == detection.label; });
+  if (evidence == object.labels.end()) evidence = object.labels.insert(object.labels.end(), {detection.label, 0.0, 0});
+  evidence->confidence_sum += detection.confidence;
+  ++evidence->count;
+  const auto top = std::max_element(object.labels.begin(), object.labels.end(),
+                                    [](const auto& a, const auto& b) { return a.confidence_sum < b.confidence_sum; });
+  object.label = top->label;
+  object.confidence = top->confidence_sum / top->count;
+}
+
+void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
+                            const cv::Mat& depth_m, const cv::Mat& image) {
+  Measured measured;
+  for (const ObjectObservation& detection : detections) {
+    if (!Measure(detection, pose, depth_m, image, &measured)) {
+      ++skipped_;
+      continue;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const int object = Associate(detection, measured, pose);
+    association_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++associations_;
+    Update(object, detection, std::move(measured));
+  }
+}
+
+std::vector<MapObject> ObjectMapper::Finish() const {
+  std::vector<MapObject> kept;
+  for (const MapObject& object : objects_) {
+    if (object.detections < options_.min_detections) continue;
+    kept.push_back(object);
+    kept.back().id = static_cast<int>(kept.size()) - 1;
+  }
+  return kept;
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,187 @@
+#include "patrolmap/eval/change_score.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "patrolmap/core/csv.h"
+
+namespace patrolmap::eval {
+namespace {
+
+constexpr double kSamePlace = 0.05;  // [m]: an object this close to where it was has not moved
+
+const TruthObject* FindId(const std::vector<TruthObject>& objects, int id) {
+  for (const TruthObject& o : objects) {
+    if (o.id == id) return &o;
+  }
+  return nullptr;
+}
+
+struct TruthChange {
+  std::string state, label;
+  std::optional<Eigen::Vector2d> before, after;
+};
+
+std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after,
+                                      int min_detections) {
+  std::vector<TruthChange> truth;
+  for (const TruthObject& b : before) {
+    const TruthObject* a = FindId(after, b.id);
+    if (a == nullptr) {
+      if (b.detections >= min_detections) truth.push_back({"removed", b.label, b.centre, std::nullopt});
+      continue;
+    }
+    if (b.detections < min_detections || a->detections < min_detections) continue;
+    const bool moved = (a->centre - b.centre).norm() > kSamePlace;
+    truth.push_back({moved ? "moved" : "persistent", b.label, b.centre, a->centre});
+  }
+  for (const TruthObject& a : after) {
+    if (FindId(before, a.id) == nullptr && a.detections >= min_detections) {
+      truth.push_back({"new", a.label, std::nullopt, a.centre});
+    }
+  }
+  return truth;
+}
+
+// Distance between a reported and a true change of the same state; infinity when they cannot match.
+double ChangeDistance(const ReportedObject& r, const TruthChange& t) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  if (r.label != t.label) return kInfinity;
+  double distance = 0.0;
+  if (t.before) {
+    if (!r.before) return kInfinity;
+    distance = std::max(distance, (r.before->head<2>() - *t.before).norm());
+  }
+  if (t.after) {
+    if (!r.after) return kInfinity;
+    distance = std::max(distance, (r.after->head<2>() - *t.after).norm());
+  }
+  return distance;
+}
+
+double Ratio(int numerator, int denominator) { return denominator > 0 ? static_cast<double>(numerator) / denominator : 0.0; }
+
+}  // namespace
+
+bool TruthObject::Contains(const Eigen::Vector3d& point, double margin) const {
+  const Eigen::Vector2d d = point.head<2>() - centre;
+  const double along = d.x() * std::cos(yaw) + d.y() * std::sin(yaw);
+  const double across = -d.x() * std::sin(yaw) + d.y() * std::cos(yaw);
+  return std::abs(along) <= length / 2 + margin && std::abs(across) <= width / 2 + margin && point.z() >= -margin &&
+         point.z() <= height + margin;
+}
+
+Status ReadTruthObjects(const std::string& log, std::vector<TruthObject>* objects) {
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& f, TruthObject* o) {
+    if (f.size() < 8) return csv.Error("expected 8 columns");
+    std::int64_t id = 0;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(f[0], "id", &id));
+    o->id = static_cast<int>(id);
+    o->label = std::string(f[1]);
+    double v[6];
+    for (int i = 0; i < 6; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(f[2 + i], "pose and size", &v[i]));
+    o->centre = Eigen::Vector2d(v[0], v[1]);
+    o->yaw = v[2], o->length = v[3], o->width = v[4], o->height = v[5];
+    return Status::Ok();
+  };
+  PATROLMAP_RETURN_IF_ERROR(ReadTable(log + "/groundtruth/objects.csv", nullptr, parse, objects));
+  struct Origin {
+    int id = -1;
+  };
+  const auto parse_origin = [](const CsvReader& csv, const std::vector<std::string_view>& f, Origin* o) {
+    if (f.size() < 3) return csv.Error("expected 3 columns");
+    std::int64_t id = 0;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(f[2], "object_id", &id));
+    o->id = static_cast<int>(id);
+    return Status::Ok();
+  };
+  std::vector<Origin> origins;
+  PATROLMAP_RETURN_IF_ERROR(ReadTable(log + "/groundtruth/detections.csv", nullptr, parse_origin, &origins));
+  std::unordered_map<int, int> counts;
+  for (const Origin& o : origins) ++counts[o.id];
+  for (TruthObject& o : *objects) o.detections = counts[o.id];
+  return Status::Ok();
+}
+
+double Counts::Precision() const { return Ratio(true_positives, true_positives + false_positives); }
+double Counts::Recall() const { return Ratio(true_positives, true_positives + false_negatives); }
+double Counts::F1() const {
+  const double p = Precision(), r = Recall();
+  return p + r > 0 ? 2 * p * r / (p + r) : 0.0;
+}
+double GeometryScore::Iou() const {
+  return Ratio(voxels.true_positives, voxels.true_positives + voxels.false_positives + voxels.false_negatives);
+}
+
+ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported, const std::vector<TruthObject>& before,
+                                     const std::vector<TruthObject>& after, const ChangeScoreOptions& options) {
+  ObjectChangeScore score;
+  const std::vector<TruthChange> truth = TruthChanges(before, after, options.min_detections);
+  for (const char* state : {"persistent", "new", "removed", "moved"}) {
+    struct Candidate {
+      double distance;
+      std::size_t r, t;
+    };
+    std::vector<Candidate> candidates;
+    int reported_count = 0, truth_count = 0;
+    for (std::size_t t = 0; t < truth.size(); ++t) truth_count += truth[t].state == state;
+    for (std::size_t r = 0; r < reported.size(); ++r) {
+      if (reported[r].state != state) continue;
+      ++reported_count;
+      for (std::size_t t = 0; t < truth.size(); ++t) {
+        if (truth[t].state != state) continue;
+        const double d = ChangeDistance(reported[r], truth[t]);
+        if (d <= options.distance_m) candidates.push_back({d, r, t});
+      }
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+    std::vector<bool> r_used(reported.size()), t_used(truth.size());
+    Counts& counts = score.by_state[state];
+    for (const Candidate& c : candidates) {
+      if (r_used[c.r] || t_used[c.t]) continue;
+      r_used[c.r] = t_used[c.t] = true;
+      ++counts.true_positives;
+    }
+    counts.false_positives = reported_count - counts.true_positives;
+    counts.false_negatives = truth_count - counts.true_positives;
+  }
+  for (const ReportedObject& r : reported) score.unobserved += r.state == "unobserved";
+  return score;
+}
+
+GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const EvidenceGridData& before_grid,
+                            const EvidenceGridData& after_grid, const std::vector<TruthObject>& before,
+                            const std::vector<TruthObject>& after, const ChangeScoreOptions& options) {
+  GeometryScore score;
+  const double size = before_grid.voxel_size;
+  const auto inside = [size](const std::vector<TruthObject>& objects, const Eigen::Vector3d& p) {
+    for (const TruthObject& o : objects) {
+      if (o.Contains(p, size / 2)) return true;
+    }
+    return false;
+  };
+  const auto key = [](int x, int y, int z) { return std::make_tuple(x, y, z); };
+  std::vector<std::tuple<int, int, int>> predicted;
+  for (const Eigen::Vector3i& v : changed) predicted.push_back(key(v.x(), v.y(), v.z()));
+  std::sort(predicted.begin(), predicted.end());
+  auto a = before_grid.voxels.begin(), b = after_grid.voxels.begin();
+  while (a != before_grid.voxels.end() && b != after_grid.voxels.end()) {
+    const auto ka = key(a->x, a->y, a->z), kb = key(b->x, b->y, b->z);
+    if (ka < kb) { ++a; continue; }
+    if (kb < ka) { ++b; continue; }
+    if (a->hits + a->passes >= options.min_observations && b->hits + b->passes >= options.min_observations) {
+      ++score.observed_voxels;
+      const Eigen::Vector3d centre = Eigen::Vector3d(a->x, a->y, a->z) * size;
+      const bool truly = inside(before, centre) != inside(after, centre);
+      const bool reported = std::binary_search(predicted.begin(), predicted.end(), ka);
+      if (truly && reported) ++score.voxels.true_positives;
+      if (!truly && reported) ++score.voxels.false_positives;
+      if (truly && !reported) ++score.voxels.false_negatives;
+    }
+    ++a, ++b;
+  }
+  return score;
+}
+
+}  // namespace patrolmap::eval

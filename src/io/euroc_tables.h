@@ -1,0 +1,60 @@
+// Internal: helpers for EuRoC-style tables whose first column is a timestamp.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "patrolmap/core/csv.h"
+#include "patrolmap/core/types.h"
+
+namespace patrolmap::io {
+
+inline Status CheckColumns(const CsvReader& csv, const std::vector<std::string_view>& fields,
+                    std::size_t minimum) {
+  if (fields.size() >= minimum) return Status::Ok();
+  return csv.Error("expected at least " + std::to_string(minimum) + " columns, found " +
+                   std::to_string(fields.size()));
+}
+
+inline Status CheckIncreasing(const CsvReader& csv, TimestampNs previous, TimestampNs current, bool strict = true) {
+  if (current > previous || (!strict && current == previous)) return Status::Ok();
+  return csv.Error("timestamp " + std::to_string(current) + (strict ? " is not after" : " is before") +
+                   " the previous one (" + std::to_string(previous) + ")");
+}
+
+// Reads a table whose first column is an increasing timestamp [ns] (strictly,
+// unless several rows may share a time); `parse_row(csv, fields, &row)` fills
+// the other columns of each row.
+template <typename Row, typename ParseRow>
+Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow parse_row, std::vector<Row>* rows,
+                      bool strict = true) {
+  CsvReader csv;
+  PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
+  std::vector<std::string_view> fields;
+  Status status;
+  TimestampNs previous = std::numeric_limits<TimestampNs>::min();
+  while ((status = csv.NextRow(&fields)).ok()) {
+    PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, columns));
+    Row row;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &row.timestamp_ns));
+    PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, row.timestamp_ns, strict));
+    PATROLMAP_RETURN_IF_ERROR(parse_row(csv, fields, &row));
+    previous = row.timestamp_ns;
+    rows->push_back(std::move(row));
+  }
+  return status.end_of_stream() ? Status::Ok() : status;
+}
+
+inline Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields,
+                   std::size_t first, const char* column, Eigen::Vector3d* vector) {
+  for (int axis = 0; axis < 3; ++axis) {
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + axis], column, &(*vector)[axis]));
+  }
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::io

@@ -1,0 +1,113 @@
+#include "patrolmap/io/patrol_sensors.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "euroc_tables.h"
+#include "patrolmap/io/readers.h"
+
+namespace fs = std::filesystem;
+
+namespace patrolmap::io {
+namespace {
+
+Status ReadPoseTable(const std::string& path, const Eigen::Matrix3d& body_from_camera,
+                     std::vector<CameraPoseSample>* poses) {
+  const Eigen::Quaterniond camera_rotation(body_from_camera);
+  const auto parse = [&camera_rotation](const CsvReader& csv, const std::vector<std::string_view>& fields,
+                                        CameraPoseSample* pose) {
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "p_RS_R [m]", &pose->position));
+    double q[4];
+    for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[4 + i], "q_RS", &q[i]));
+    const Eigen::Quaterniond body(q[0], q[1], q[2], q[3]);
+    if (std::abs(body.norm() - 1.0) > 1e-3) return csv.Error("q_RS is not a unit quaternion");
+    pose->rotation = (body.normalized() * camera_rotation).normalized();
+    return Status::Ok();
+  };
+  return ReadTimedTable(path, 8, parse, poses);
+}
+
+Status ReadDetectionTable(const std::string& path, std::vector<ObjectObservation>* detections) {
+  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, ObjectObservation* o) {
+    if (fields[1].empty()) return csv.Error("empty label");
+    o->label = std::string(fields[1]);
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[2], "confidence", &o->confidence));
+    if (!(o->confidence >= 0.0 && o->confidence <= 1.0)) return csv.Error("confidence must lie in [0, 1]");
+    double box[4];
+    for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3 + i], "box [px]", &box[i]));
+    if (!(box[2] > box[0] && box[3] > box[1])) return csv.Error("box must have x_max > x_min and y_max > y_min");
+    o->box = cv::Rect2d(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    if (fields.size() >= 10) {
+      Eigen::Vector3d centroid;
+      PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 7, "centroid [m]", &centroid));
+      o->centroid_camera = centroid;
+    }
+    return Status::Ok();
+  };
+  return ReadTimedTable(path, 7, parse, detections, /*strict=*/false);
+}
+
+Status ReadDepthTable(const std::string& log, std::vector<DepthEntry>* entries) {
+  const auto parse = [&log](const CsvReader& csv, const std::vector<std::string_view>& fields, DepthEntry* entry) {
+    if (fields[1].empty()) return csv.Error("empty file name");
+    entry->path = log + "/depth0/data/" + std::string(fields[1]);
+    return Status::Ok();
+  };
+  return ReadTimedTable(log + "/depth0/data.csv", 2, parse, entries);
+}
+
+}  // namespace
+
+Status ReadPatrolSensors(const std::string& log, PatrolSensors* sensors) {
+  *sensors = PatrolSensors();
+  std::unique_ptr<FrameSource> source;
+  PATROLMAP_RETURN_IF_ERROR(OpenLog(log, ImageFolderOptions{}, &source));
+  const LogInfo& info = source->info();
+  sensors->flight_id = info.flight_id;
+  sensors->camera = info.camera;
+  if (info.kind != "euroc") return Status::Ok();
+  std::string root = log;
+  if (!fs::exists(root + "/cam0/data.csv") && fs::exists(root + "/mav0/cam0/data.csv")) root += "/mav0";
+  const std::string state = root + "/state_groundtruth_estimate0/data.csv";
+  if (fs::exists(state)) {
+    PATROLMAP_RETURN_IF_ERROR(
+        ReadPoseTable(state, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), &sensors->poses));
+  }
+  if (fs::exists(root + "/objects0/data.csv")) {
+    PATROLMAP_RETURN_IF_ERROR(ReadDetectionTable(root + "/objects0/data.csv", &sensors->detections));
+  }
+  if (fs::exists(root + "/depth0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadDepthTable(root, &sensors->depth));
+  return Status::Ok();
+}
+
+std::optional<CameraPoseSample> PoseAt(const std::vector<CameraPoseSample>& poses, TimestampNs timestamp_ns,
+                                       TimestampNs max_gap_ns) {
+  const auto after = std::lower_bound(poses.begin(), poses.end(), timestamp_ns,
+                                      [](const CameraPoseSample& p, TimestampNs t) { return p.timestamp_ns < t; });
+  if (after == poses.end()) return std::nullopt;
+  if (after->timestamp_ns == timestamp_ns) return *after;
+  if (after == poses.begin()) return std::nullopt;
+  const CameraPoseSample& before = *(after - 1);
+  if (after->timestamp_ns - before.timestamp_ns > max_gap_ns) return std::nullopt;
+  const double s = static_cast<double>(timestamp_ns - before.timestamp_ns) /
+                   static_cast<double>(after->timestamp_ns - before.timestamp_ns);
+  CameraPoseSample pose;
+  pose.timestamp_ns = timestamp_ns;
+  pose.position = (1.0 - s) * before.position + s * after->position;
+  pose.rotation = before.rotation.slerp(s, after->rotation);
+  return pose;
+}
+
+Status ReadDepthImage(const std::string& path, cv::Mat* depth_m) {
+  if (!fs::exists(path)) return Status::NotFound(path + ": depth image missing");
+  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (raw.empty()) return Status::DataLoss(path + ": cannot decode depth image");
+  if (raw.type() != CV_16UC1) return Status::DataLoss(path + ": depth image must be 16-bit single-channel");
+  raw.convertTo(*depth_m, CV_32FC1, 1e-3);
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::io

@@ -1,0 +1,73 @@
+// patrolmap diff MAP.pmap [--from FLIGHT] [--to FLIGHT] --out DIR [--config FILE]
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "common.h"
+#include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/change.h"
+
+namespace patrolmap::tools {
+namespace {
+
+struct DiffArguments {
+  std::string map;
+  std::string from, to;  // default: the map's last two flights
+  std::string out = "patrolmap_diff";
+  std::string config;
+};
+
+int RunDiff(const DiffArguments& arguments) {
+  pipeline::Config config;
+  graph::TopoMap map;
+  Status status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok()) status = graph::LoadMap(arguments.map, &map);
+  if (!status.ok()) return Fail(status);
+  const std::vector<std::string> flights = map.Flights();
+  std::string from = arguments.from, to = arguments.to;
+  if (to.empty() && !flights.empty()) to = flights.back();
+  if (from.empty() && flights.size() >= 2) from = flights[flights.size() - 2];
+  if (from.empty() || to.empty()) return Fail(Status::InvalidArgument(arguments.map + ": needs two flights to compare"));
+  if (from == to) return Fail(Status::InvalidArgument("--from and --to name the same flight '" + from + "'"));
+  change::ChangeReport report;
+  status = pipeline::CompareFlights(map, from, to, config.change, &report);
+  if (!status.ok()) return Fail(Status::InvalidArgument(arguments.map + ": " + status.message()));
+  status = change::WriteChangeReport(report, map, arguments.out);
+  if (!status.ok()) return Fail(status);
+  PrintChangeSummary(report, arguments.out);
+  return 0;
+}
+
+}  // namespace
+
+void PrintChangeSummary(const change::ChangeReport& report, const std::string& out) {
+  std::printf("changes %s -> %s: %zu places compared, %d with appearance changes", report.prior_flight.c_str(),
+              report.current_flight.c_str(), report.places.size(), report.ChangedPlaces());
+  if (report.objects_compared) {
+    std::printf("; objects: %d new, %d removed, %d moved, %d persistent, %d unobserved",
+                report.ObjectsIn(change::ObjectState::kNew), report.ObjectsIn(change::ObjectState::kRemoved),
+                report.ObjectsIn(change::ObjectState::kMoved), report.ObjectsIn(change::ObjectState::kPersistent),
+                report.ObjectsIn(change::ObjectState::kUnobserved));
+  }
+  if (report.geometry_compared) {
+    std::printf("; geometry: %zu regions, %zu changed voxels", report.geometry.regions.size(),
+                report.geometry.changed_voxels.size());
+  }
+  std::printf("; report in %s/changes.json and changes.html\n", out.c_str());
+}
+
+Command AddDiffCommand(CLI::App* app) {
+  auto arguments = std::make_shared<DiffArguments>();
+  app->add_option("map", arguments->map, "map file (map.pmap) holding both flights")->required();
+  app->add_option("--from", arguments->from, "the earlier flight (default: the map's second-to-last flight)");
+  app->add_option("--to", arguments->to, "the later flight (default: the map's last flight)");
+  app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
+  app->add_option("-c,--config", arguments->config, "YAML configuration (change.* keys; see config/default.yaml)");
+  app->footer("Compares the two flights: appearance at every place both saw (their loop closures), objects when both "
+              "logs had detections, geometry when both had depth. Writes OUT/changes.json (format "
+              "patrolmap.changes/1, docs/changes.schema.json) and OUT/changes.html.");
+  return [arguments] { return RunDiff(*arguments); };
+}
+
+}  // namespace patrolmap::tools
