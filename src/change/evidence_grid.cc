@@ -241,7 +241,8 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
     if (observed(*a) && observed(*b)) {
       ++change->compared_voxels;
       const double delta = Occupancy(*b) - Occupancy(*a);
-      if (std::abs(delta) > options.min_occupancy_change) {
+      const bool one_free = std::min(Occupancy(*a), Occupancy(*b)) <= options.max_free_occupancy;
+      if (std::abs(delta) > options.min_occupancy_change && one_free) {
         changed.emplace_back(a->x, a->y, a->z);
         centres.push_back(changed.back().cast<double>() * size);
         deltas.push_back(delta);

@@ -131,13 +131,18 @@ bool ObjectMapper::Measure(const ObjectObservation& detection, const CameraPoseS
   measured->centroid = pose.ToWorld(in_camera);
   measured->size = Eigen::Vector2d(box.width * z / camera_.fx, box.height * z / camera_.fy);
   measured->points.clear();
-  if (has_depth) {
+  // The object's points: depth pixels within its half size of the 3D centroid's depth, or without a
+  // centroid within segment_depth_m of its visible surface (the box centre's median depth).
+  const double half_size = 0.5 * std::max(measured->size.x(), measured->size.y());
+  const double reach = detection.centroid_camera ? std::max(options_.segment_depth_m, half_size) : options_.segment_depth_m;
+  const double surface = detection.centroid_camera ? in_camera.z() : (has_depth ? CentralDepth(depth_m, box) : 0.0);
+  if (has_depth && surface > 0.0) {
     const int step = std::max(1, static_cast<int>(std::sqrt(box.area() / static_cast<double>(options_.max_segment_samples))));
     for (int y = box.y; y < box.br().y; y += step) {
       const float* row = depth_m.ptr<float>(y);
       for (int x = box.x; x < box.br().x; x += step) {
         const double d = row[x];
-        if (d <= 0.0 || std::abs(d - in_camera.z()) > options_.segment_depth_m) continue;
+        if (d <= 0.0 || std::abs(d - surface) > reach) continue;
         const Eigen::Vector3d p((x - camera_.cx) / camera_.fx * d, (y - camera_.cy) / camera_.fy * d, d);
         measured->points.push_back(pose.ToWorld(p).cast<float>());
       }
@@ -148,8 +153,26 @@ bool ObjectMapper::Measure(const ObjectObservation& detection, const CameraPoseS
   return true;
 }
 
+double ObjectMapper::SurfaceAgreement(const MapObject& object, const cv::Rect2d& box, const CameraPoseSample& pose,
+                                      const cv::Mat& depth_m) const {
+  if (depth_m.empty()) return 0.0;
+  int seen = 0, agree = 0;
+  for (const Eigen::Vector3f& point : object.points) {
+    const Eigen::Vector3d c = pose.ToCamera(point.cast<double>());
+    if (c.z() <= 0.1) continue;
+    const int u = static_cast<int>(std::lround(camera_.fx * c.x() / c.z() + camera_.cx));
+    const int v = static_cast<int>(std::lround(camera_.fy * c.y() / c.z() + camera_.cy));
+    if (!box.contains(cv::Point2d(u, v)) || u < 0 || v < 0 || u >= depth_m.cols || v >= depth_m.rows) continue;
+    const float d = depth_m.at<float>(v, u);
+    if (d <= 0.0f || c.z() > d + options_.pair_distance_m) continue;  // no return, or hidden behind the surface
+    ++seen;
+    if (d - c.z() < options_.pair_distance_m) ++agree;
+  }
+  return seen > 0 ? static_cast<double>(agree) / seen : 0.0;
+}
+
 int ObjectMapper::Associate(const ObjectObservation& detection, const Measured& measured,
-                            const CameraPoseSample& pose) const {
+                            const CameraPoseSample& pose, const cv::Mat& depth_m) const {
   int best = -1;
   double best_score = 0.0;
   for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -159,6 +182,10 @@ int ObjectMapper::Associate(const ObjectObservation& detection, const Measured& 
     double score = 0.0;
     if (!measured.points.empty() && !object.points.empty()) {
       score = PairFraction(measured.points, object.points, options_.pair_distance_m);
+      // A view that reveals a new side: most of the object's points this view sees lie on the depth surface.
+      if (score < options_.min_pair_fraction) {
+        score = SurfaceAgreement(object, detection.box, pose, depth_m);
+      }
       if (score < options_.min_pair_fraction) continue;
     } else {
       const double sigma = IsVehicle(object.label) ? options_.vehicle_sigma_m : options_.category_sigma_m;
@@ -217,7 +244,7 @@ void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, co
       continue;
     }
     const auto start = std::chrono::steady_clock::now();
-    const int object = Associate(detection, measured, pose);
+    const int object = Associate(detection, measured, pose, depth_m);
     association_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ++associations_;
     Update(object, detection, std::move(measured));

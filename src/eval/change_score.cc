@@ -155,11 +155,23 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
                             const std::vector<TruthObject>& after, const ChangeScoreOptions& options) {
   GeometryScore score;
   const double size = before_grid.voxel_size;
-  const auto inside = [size](const std::vector<TruthObject>& objects, const Eigen::Vector3d& p) {
+  const auto holds = [](const std::vector<TruthObject>& objects, const Eigen::Vector3d& p, double margin) {
     for (const TruthObject& o : objects) {
-      if (o.Contains(p, size / 2)) return true;
+      if (o.Contains(p, margin)) return true;
     }
     return false;
+  };
+  // Core: mostly inside a box of one flight (centre a quarter voxel inside it) and clear of the other
+  // flight's boxes, above the ground voxel. Band: touching a box of one flight but not the same box of the
+  // other (centre within half a voxel of it).
+  const auto core = [&](const Eigen::Vector3d& p) {
+    if (p.z() < size / 2) return false;
+    return (holds(before, p, -size / 4) && !holds(after, p, size / 2)) ||
+           (holds(after, p, -size / 4) && !holds(before, p, size / 2));
+  };
+  const auto band = [&](const Eigen::Vector3d& p) {
+    return holds(before, p, size / 2) != holds(after, p, size / 2) ||
+           holds(before, p, -size / 2) != holds(after, p, -size / 2) || holds(before, p, 0) != holds(after, p, 0);
   };
   const auto key = [](int x, int y, int z) { return std::make_tuple(x, y, z); };
   std::vector<std::tuple<int, int, int>> predicted;
@@ -173,11 +185,12 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     if (a->hits + a->passes >= options.min_observations && b->hits + b->passes >= options.min_observations) {
       ++score.observed_voxels;
       const Eigen::Vector3d centre = Eigen::Vector3d(a->x, a->y, a->z) * size;
-      const bool truly = inside(before, centre) != inside(after, centre);
+      const bool is_core = core(centre);
+      const bool in_band = is_core || band(centre);
       const bool reported = std::binary_search(predicted.begin(), predicted.end(), ka);
-      if (truly && reported) ++score.voxels.true_positives;
-      if (!truly && reported) ++score.voxels.false_positives;
-      if (truly && !reported) ++score.voxels.false_negatives;
+      if (reported && in_band) ++score.voxels.true_positives;
+      if (reported && !in_band) ++score.voxels.false_positives;
+      if (!reported && is_core) ++score.voxels.false_negatives;
     }
     ++a, ++b;
   }

@@ -11,7 +11,7 @@
 namespace patrolmap::tools {
 namespace {
 
-int RunInfo(const std::string& path) {
+int RunInfo(const std::string& path, bool verbose) {
   graph::TopoMap map;
   const Status status = graph::LoadMap(path, &map);
   if (!status.ok()) return Fail(status);
@@ -33,7 +33,19 @@ int RunInfo(const std::string& path) {
       if (nodes++ == 0) first = t;
       last = t;
     }
-    std::printf("  flight %-24s %4d nodes, %.1f-%.1f s\n", flight.c_str(), nodes, first, last);
+    std::printf("  flight %-24s %4d nodes, %.1f-%.1f s", flight.c_str(), nodes, first, last);
+    const PatrolRecord* record = map.Patrol(flight);
+    if (record != nullptr && record->has_objects) std::printf(", %zu objects", record->objects.size());
+    if (record != nullptr && record->grid.voxel_size > 0) {
+      std::printf(", evidence grid %zu voxels of %.2f m", record->grid.voxels.size(), record->grid.voxel_size);
+    }
+    std::printf("\n");
+    if (record == nullptr || !verbose) continue;
+    for (const MapObject& o : record->objects) {
+      std::printf("    object %3d %-10s confidence %.2f, %3d detections at (%.2f, %.2f, %.2f), %zu points\n", o.id,
+                  o.label.c_str(), o.confidence, o.detections, o.centroid.x(), o.centroid.y(), o.centroid.z(),
+                  o.points.size());
+    }
   }
   return 0;
 }
@@ -42,8 +54,10 @@ int RunInfo(const std::string& path) {
 
 Command AddInfoCommand(CLI::App* app) {
   auto path = std::make_shared<std::string>();
+  auto verbose = std::make_shared<bool>(false);
   app->add_option("map", *path, "map file (map.pmap)")->required();
-  return [path] { return RunInfo(*path); };
+  app->add_flag("-v,--verbose", *verbose, "list every flight's objects");
+  return [path, verbose] { return RunInfo(*path, *verbose); };
 }
 
 }  // namespace patrolmap::tools

@@ -5,6 +5,8 @@
 // object's points closer than a threshold; k-d tree by nanoflann) when the
 // detection has depth points, otherwise 2D box overlap of the object's
 // projection with a per-category prior on the centroid offset (paper 001).
+// A view that shows a new side of an object passes the point-pair test when
+// at least half of the object's points it sees lie on its depth surface.
 // Every object accumulates label-confidence and label-count pairs; Finish()
 // keeps objects with enough detections and gives each the label with the
 // highest accumulated confidence and that label's mean confidence.
@@ -48,7 +50,12 @@ class ObjectMapper {
   };
   bool Measure(const ObjectObservation& detection, const CameraPoseSample& pose, const cv::Mat& depth_m,
                const cv::Mat& image, Measured* measured) const;
-  int Associate(const ObjectObservation& detection, const Measured& measured, const CameraPoseSample& pose) const;
+  int Associate(const ObjectObservation& detection, const Measured& measured, const CameraPoseSample& pose,
+                const cv::Mat& depth_m) const;
+  // Share of the object's points inside `box` and not hidden behind the depth surface that lie on it
+  // (within pair_distance_m): the point-pair test against the full depth image, for views showing a new side.
+  double SurfaceAgreement(const MapObject& object, const cv::Rect2d& box, const CameraPoseSample& pose,
+                          const cv::Mat& depth_m) const;
   void Update(int object, const ObjectObservation& detection, Measured&& measured);
 
   ObjectMapOptions options_;

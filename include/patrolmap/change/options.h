@@ -59,6 +59,8 @@ struct EvidenceGridOptions {
 // Geometry change between two evidence grids (paper 004).
 struct GeometryDiffOptions {
   double min_occupancy_change = 0.5;  // |hits/(hits+passes) before - after| above this: changed
+  double max_free_occupancy = 0.1;    // ... and in one patrol it must be free (a surface cut by the voxel's
+                                      // edge fills it partly, by a share that changes with the view)
   int min_observations = 3;           // rays per voxel in each patrol; fewer: unobserved, never a change
   double join_distance_m = 1.0;       // a changed voxel joins a region whose centroid is this close
   int min_region_voxels = 6;          // smaller regions are dropped as outliers

@@ -10,10 +10,14 @@
 // lies within `distance_m` (moved: both its positions). Per state: precision,
 // recall and F1, one-to-one matching nearest first.
 //
-// Geometry (per voxel, as paper 003 scores per point): a voxel truly changed
-// when its centre, within half a voxel, lies inside an object box of exactly
-// one of the two flights, counted only where both evidence grids observed the
-// voxel at least `min_observations` times (unobservable space is no change).
+// Geometry (per voxel, as paper 003 scores per point), only over voxels both
+// evidence grids observed at least `min_observations` times (unobservable
+// space is no change). A voxel truly changed (core) when it lies mostly in an
+// object box of one flight (its centre a quarter voxel inside) and clear of
+// the other flight's boxes, above the ground voxel; a voxel that touches a box
+// of one flight only partly (centre within half a voxel of its faces) is a
+// tolerance band, where reporting is a hit and not reporting no miss.
+// Precision = hits / reported, recall = core voxels reported / core voxels.
 #pragma once
 
 #include <map>

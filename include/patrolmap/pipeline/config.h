@@ -106,6 +106,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.grid.rate_hz", &change.grid.rate_hz);
   visitor->Field("change.grid.max_voxels", &change.grid.max_voxels);
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
+  visitor->Field("change.geometry.max_free_occupancy", &change.geometry.max_free_occupancy);
   visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
