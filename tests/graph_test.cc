@@ -44,6 +44,28 @@ TopoMap TwoFlights() {
   map.AddEdge(4, 1, {EdgeKind::kLoopClosure, 0.41, 0.62, 88});
   map.AddEdge(6, 3, {EdgeKind::kLoopClosure, 0.33, 0.51, 71});
   map.AddEdge(5, 1, {EdgeKind::kLoopClosure, 0.21, 0.35, 55});
+  PatrolRecord record;
+  record.flight = "b";
+  record.camera = {180.5, 181.5, 94.0, 60.0, 188, 120};
+  record.feature_image_width = 188;
+  record.views.push_back({123, Eigen::Vector3d(1.5, -2.25, 3.0), Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5)});
+  record.has_objects = true;
+  MapObject object;
+  object.id = 3;
+  object.label = "crate";
+  object.confidence = 0.71;
+  object.detections = 12;
+  object.centroid = Eigen::Vector3d(10.125, -3.5, 0.5);
+  object.box_min = object.centroid - Eigen::Vector3d::Constant(0.5);
+  object.box_max = object.centroid + Eigen::Vector3d::Constant(0.5);
+  object.points = {Eigen::Vector3f(10.0f, -3.0f, 0.25f), Eigen::Vector3f(10.5f, -3.5f, 0.75f)};
+  object.descriptor = {0.5f, 0.25f, 0.25f};
+  object.labels = {{"crate", 7.5, 10}, {"barrel", 1.0, 2}};
+  object.first_seen_ns = 5, object.last_seen_ns = 99;
+  record.objects.push_back(object);
+  record.grid.voxel_size = 0.2;
+  record.grid.voxels = {{-3, 0, 1, 2, 7}, {-3, 1, 0, 0, 4}, {5, -2, 2, 9, 1}};
+  map.SetPatrol(record);
   return map;
 }
 
@@ -101,6 +123,28 @@ TEST(MapFile, RoundTripKeepsEverything) {
     EXPECT_EQ(a[i].data.inliers, b[i].data.inliers);
     EXPECT_EQ(a[i].data.bow_score, b[i].data.bow_score);
   }
+  ASSERT_EQ(loaded.patrols().size(), 1u);
+  const PatrolRecord& p = *loaded.Patrol("b");
+  const PatrolRecord& q = *map.Patrol("b");
+  EXPECT_EQ(loaded.Patrol("a"), nullptr);
+  EXPECT_EQ(p.camera.fx, q.camera.fx);
+  EXPECT_EQ(p.camera.height, q.camera.height);
+  EXPECT_EQ(p.feature_image_width, 188);
+  ASSERT_EQ(p.views.size(), 1u);
+  EXPECT_EQ(p.views[0].position, q.views[0].position);
+  EXPECT_EQ(p.views[0].rotation.coeffs(), q.views[0].rotation.coeffs());
+  ASSERT_EQ(p.objects.size(), 1u);
+  EXPECT_EQ(p.objects[0].label, "crate");
+  EXPECT_EQ(p.objects[0].centroid, q.objects[0].centroid);
+  EXPECT_EQ(p.objects[0].points, q.objects[0].points);
+  EXPECT_EQ(p.objects[0].descriptor, q.objects[0].descriptor);
+  ASSERT_EQ(p.objects[0].labels.size(), 2u);
+  EXPECT_EQ(p.objects[0].labels[1].label, "barrel");
+  EXPECT_EQ(p.objects[0].labels[1].count, 2);
+  EXPECT_EQ(p.objects[0].last_seen_ns, 99);
+  ASSERT_EQ(p.grid.voxels.size(), 3u);
+  EXPECT_EQ(p.grid.voxels[2].hits, 9);
+  EXPECT_EQ(p.grid.voxels[0].passes, 7);
   // Saving again gives the same bytes.
   ASSERT_TRUE(SaveMap(loaded, dir / "again.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "m.pmap"), testing::ReadText(dir / "again.pmap"));
@@ -133,8 +177,33 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   std::memcpy(newer.data() + 8, &version, 4);
   EXPECT_NE(LoadBytes(newer).find("version 9 is newer"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
+  // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
+  TopoMap unsorted = TwoFlights();
+  PatrolRecord record = *unsorted.Patrol("b");
+  std::swap(record.grid.voxels[0], record.grid.voxels[2]);
+  unsorted.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(unsorted, dir_ / "unsorted.pmap").ok());
+  EXPECT_NE(LoadBytes(testing::ReadText(dir_ / "unsorted.pmap")).find("corrupt map (evidence grid of b)"),
+            std::string::npos);
   TopoMap map;
   EXPECT_EQ(LoadMap(dir_ / "missing.pmap", &map).code(), StatusCode::kNotFound);
+}
+
+// A version 1 file (before patrol records): header version 1, three sections, no PTRL.
+TEST(MapFile, VersionOneFilesStillLoad) {
+  testing::TempDir dir;
+  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
+  std::string bytes = testing::ReadText(dir / "m.pmap");
+  const std::size_t ptrl = bytes.rfind("PTRL");
+  ASSERT_NE(ptrl, std::string::npos);
+  bytes.resize(ptrl);
+  const std::uint32_t header[2] = {1, 3};
+  std::memcpy(bytes.data() + 8, header, sizeof(header));
+  std::ofstream(dir / "v1.pmap", std::ios::binary) << bytes;
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v1.pmap", &map).ok()) << LoadMap(dir / "v1.pmap", &map).message();
+  EXPECT_EQ(map.node_count(), 7);
+  EXPECT_TRUE(map.patrols().empty());
 }
 
 TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {

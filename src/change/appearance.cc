@@ -57,28 +57,34 @@ void FitLighting(const cv::Mat& prior, const cv::Mat& current, const cv::Mat& ma
   }
 }
 
-// (image - local mean) / (local standard deviation + floor).
-cv::Mat LocallyNormalised(const cv::Mat& image, int window) {
-  cv::Mat mean, squared, variance;
-  const cv::Size size(window, window);
-  cv::blur(image, mean, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-  cv::blur(image.mul(image), squared, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-  cv::max(squared - mean.mul(mean), 0.0, variance);
-  cv::Mat sigma;
-  cv::sqrt(variance, sigma);
-  constexpr double kSigmaFloor = 6.0;  // grey levels: keeps flat areas from amplifying noise
-  return (image - mean) / (sigma + kSigmaFloor);
+// The contrast-structure term of SSIM over a Gaussian window: 1 where the two images have the same local
+// pattern whatever their local gain and offset, near 0 or below where they differ.
+cv::Mat ContrastStructure(const cv::Mat& a, const cv::Mat& b, double sigma) {
+  constexpr double kC2 = (0.03 * 255) * (0.03 * 255);  // SSIM's stabiliser: flat pairs count as alike
+  cv::Mat ma, mb, aa, bb, ab;
+  cv::GaussianBlur(a, ma, cv::Size(), sigma);
+  cv::GaussianBlur(b, mb, cv::Size(), sigma);
+  cv::GaussianBlur(a.mul(a), aa, cv::Size(), sigma);
+  cv::GaussianBlur(b.mul(b), bb, cv::Size(), sigma);
+  cv::GaussianBlur(a.mul(b), ab, cv::Size(), sigma);
+  cv::Mat va = cv::max(aa - ma.mul(ma), 0.0), vb = cv::max(bb - mb.mul(mb), 0.0), cov = ab - ma.mul(mb);
+  cv::Mat denominator;
+  cv::sqrt((va + kC2 / 2).mul(vb + kC2 / 2), denominator);
+  return (cov + kC2 / 2) / denominator;
 }
 
-// Per pixel, the smallest |a - b(shifted)| over shifts of b within the radius.
-cv::Mat BestShiftDifference(const cv::Mat& a, const cv::Mat& b, int radius) {
-  cv::Mat best(a.size(), CV_32F, cv::Scalar(1e9)), shifted, difference;
+// Per pixel, the best of `measure(a, b shifted)` over shifts of b within the radius (parallax), where
+// `larger_is_better` says whether to keep the largest or the smallest value.
+template <typename Measure>
+cv::Mat BestOverShifts(const cv::Mat& a, const cv::Mat& b, int radius, bool larger_is_better, Measure measure) {
+  cv::Mat best, shifted;
   for (int dy = -radius; dy <= radius; ++dy) {
     for (int dx = -radius; dx <= radius; ++dx) {
       const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
       cv::warpAffine(b, shifted, m, b.size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
-      cv::absdiff(a, shifted, difference);
-      best = cv::min(best, difference);
+      const cv::Mat value = measure(a, shifted);
+      if (best.empty()) best = value.clone();
+      else best = larger_is_better ? cv::max(best, value) : cv::min(best, value);
     }
   }
   return best;
@@ -128,12 +134,15 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
   if (compared == 0) return result;
   FitLighting(warped, current_f, mask, &result.gain, &result.offset);
 
-  const cv::Mat global = BestShiftDifference(current_f, warped * result.gain + result.offset, options.search_radius_px);
-  const cv::Mat local = BestShiftDifference(LocallyNormalised(current_f, options.local_window_px),
-                                            LocallyNormalised(warped, options.local_window_px), options.search_radius_px);
-  cv::Mat changed = (global > options.min_difference) & (local > options.min_normalised_difference) & mask;
-  cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
+  const int r = options.search_radius_px;
+  const cv::Mat global = BestOverShifts(current_f, warped * result.gain + result.offset, r, false,
+                                        [](const cv::Mat& a, const cv::Mat& b) { return cv::Mat(cv::abs(a - b)); });
+  const cv::Mat local = 1.0 - BestOverShifts(current_f, warped, r, true, [&](const cv::Mat& a, const cv::Mat& b) {
+                          return ContrastStructure(a, b, options.structure_sigma_px);
+                        });
+  cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
   cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), 2);
+  cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
   changed &= mask;
 
   cv::Mat labels, stats, centroids;

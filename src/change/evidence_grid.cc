@@ -194,7 +194,7 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
 
 void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose) {
   constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
-  const int step = std::max(1, options_.pixel_step);
+  const int step = std::max(1, static_cast<int>(std::lround(static_cast<double>(depth_m.cols) / options_.rays_per_row)));
   for (int y = step / 2; y < depth_m.rows; y += step) {
     const float* row = depth_m.ptr<float>(y);
     for (int x = step / 2; x < depth_m.cols; x += step) {
@@ -251,7 +251,7 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
     ++a, ++b;
   }
   std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
-  MergeOverlapping(size / 2, &regions);
+  MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
   for (Region& region : regions) {
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
     region.data.score = region.score_sum / region.data.voxels;

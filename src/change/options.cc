@@ -14,7 +14,7 @@ bool ChangeOptions::IsValid(std::string* error) const {
   return Check(appearance.ratio > 0 && appearance.ratio <= 1, "change.appearance.ratio must lie in (0, 1]", error) &&
          Check(appearance.min_inliers >= 4, "change.appearance.min_inliers must be at least 4", error) &&
          Check(appearance.search_radius_px >= 0, "change.appearance.search_radius_px must not be negative", error) &&
-         Check(appearance.local_window_px >= 3, "change.appearance.local_window_px must be at least 3", error) &&
+         Check(appearance.structure_sigma_px > 0, "change.appearance.structure_sigma_px must be positive", error) &&
          Check(object_map.centroid_gate_m > 0, "change.object_map.centroid_gate_m must be positive", error) &&
          Check(object_map.point_voxel_m > 0, "change.object_map.point_voxel_m must be positive", error) &&
          Check(object_map.min_pair_fraction >= 0 && object_map.min_pair_fraction <= 1,
@@ -26,7 +26,7 @@ bool ChangeOptions::IsValid(std::string* error) const {
          Check(grid.voxel_size_m >= 0.02, "change.grid.voxel_size_m must be at least 0.02", error) &&
          Check(grid.max_range_m > 0 && grid.max_range_m / grid.voxel_size_m < 1e5,
                "change.grid.max_range_m must be positive and under 100000 voxels", error) &&
-         Check(grid.pixel_step >= 1, "change.grid.pixel_step must be at least 1", error) &&
+         Check(grid.rays_per_row >= 1, "change.grid.rays_per_row must be at least 1", error) &&
          Check(grid.rate_hz > 0, "change.grid.rate_hz must be positive", error) &&
          Check(grid.max_voxels > 0, "change.grid.max_voxels must be positive", error) &&
          Check(geometry.min_occupancy_change > 0 && geometry.min_occupancy_change < 1,

@@ -32,7 +32,7 @@ struct AppearanceRegion {
   cv::Rect current_box;   // in the current key frame
   cv::Rect prior_box;     // the same region in the prior key frame
   int area_px = 0;
-  double score = 0.0;     // mean local difference in the region [local sigmas]
+  double score = 0.0;     // mean structure change in the region (1 - contrast-structure term)
   int prior_features = 0;           // prior features that fall in the region
   int unmatched_prior_features = 0; // ... of which no longer match (they support the change)
 };

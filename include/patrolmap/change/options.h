@@ -13,9 +13,9 @@ struct AppearanceOptions {
   int min_inliers = 12;              // fewer: the pair is not registered and not compared
   double blur_sigma_px = 1.0;        // Gaussian blur before differencing
   int search_radius_px = 2;          // each pixel takes the best match within this shift (parallax)
-  double min_difference = 30.0;      // after global gain/offset compensation [grey levels]
-  double min_normalised_difference = 1.5;  // after local mean/contrast normalisation [local sigmas]
-  int local_window_px = 15;          // window of the local normalisation
+  double min_difference = 30.0;      // after global gain/offset compensation [grey levels], and ...
+  double min_structure_change = 0.5; // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
+  double structure_sigma_px = 1.5;   // Gaussian window of that term
   double min_area_fraction = 0.01;   // regions smaller than this share of the compared area are dropped
 };
 
@@ -51,7 +51,8 @@ struct ObjectDiffOptions {
 struct EvidenceGridOptions {
   double voxel_size_m = 0.2;
   double max_range_m = 20.0;          // rays are traced this far; farther returns count as passes only
-  int pixel_step = 4;                 // every n-th depth pixel in both directions is a ray
+  int rays_per_row = 94;              // depth pixels traced per image row (every width/94-th pixel, and
+                                      // every as many rows): 94 is every 8th pixel at 752 px
   double rate_hz = 5.0;               // depth frames integrated per second of flight
   int max_voxels = 40000000;          // memory bound (16 bytes a voxel); further voxels are not created
 };

@@ -77,8 +77,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.appearance.blur_sigma_px", &change.appearance.blur_sigma_px);
   visitor->Field("change.appearance.search_radius_px", &change.appearance.search_radius_px);
   visitor->Field("change.appearance.min_difference", &change.appearance.min_difference);
-  visitor->Field("change.appearance.min_normalised_difference", &change.appearance.min_normalised_difference);
-  visitor->Field("change.appearance.local_window_px", &change.appearance.local_window_px);
+  visitor->Field("change.appearance.min_structure_change", &change.appearance.min_structure_change);
+  visitor->Field("change.appearance.structure_sigma_px", &change.appearance.structure_sigma_px);
   visitor->Field("change.appearance.min_area_fraction", &change.appearance.min_area_fraction);
   visitor->Field("change.object_map.centroid_gate_m", &change.object_map.centroid_gate_m);
   visitor->Field("change.object_map.pair_distance_m", &change.object_map.pair_distance_m);
@@ -102,7 +102,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.objects.min_visible_views", &change.objects.min_visible_views);
   visitor->Field("change.grid.voxel_size_m", &change.grid.voxel_size_m);
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
-  visitor->Field("change.grid.pixel_step", &change.grid.pixel_step);
+  visitor->Field("change.grid.rays_per_row", &change.grid.rays_per_row);
   visitor->Field("change.grid.rate_hz", &change.grid.rate_hz);
   visitor->Field("change.grid.max_voxels", &change.grid.max_voxels);
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);

@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Change detection on simulated patrol series (BENCHMARKS.md, "Change detection"): for each route and seed,
+# flies a series of 3 flights with objects added, removed and moved between them (and one series that changes
+# only the lighting), maps flight 1, adds flights 2 and 3 with `patrol`, and scores every change report with
+# `eval`. Prints one line per patrol and writes OUT/summary.json.
+# Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-out/change_study}
+pm=${2:-build/tools/patrolmap}
+routes=${ROUTES:-"inner-loop l-shape"}
+seeds=${SEEDS:-"1 2"}
+objects=${OBJECTS:-30}
+mkdir -p "$out"
+: > "$out/lines.jsonl"
+# Logs at 376x240 processed at full scale: the same images the default 752x480 log gives the flow and place
+# stages after their 0.5 downscale, at a quarter of the rendering time.
+config="$out/study.yaml"
+printf 'flow:\n  frames:\n    scale: 1.0\n' > "$config"
+run_series() {  # name route seed extra-simulate-options...
+  local name=$1 route=$2 seed=$3
+  shift 3
+  local dir="$out/$name"
+  rm -rf "$dir"
+  "$pm" simulate --route "$route" --seed "$seed" --flights 3 --objects "$objects" --detections --depth \
+    --resolution 376x240 "$@" --out "$dir/logs" >/dev/null 2>&1
+  "$pm" map "$dir/logs/flight_1" --out "$dir/run_1" -c "$config" >/dev/null 2>&1
+  for n in 2 3; do
+    "$pm" patrol "$dir/logs/flight_$n" --map "$dir/run_$((n - 1))/map.pmap" --out "$dir/run_$n" -c "$config" \
+      2>/dev/null | tail -1
+    local logs=(--log "$dir/logs/flight_$n" --log "$dir/logs/flight_$((n - 1))")
+    [ "$n" = 3 ] && logs+=(--log "$dir/logs/flight_1")
+    "$pm" eval "$dir/run_$n" "${logs[@]}" -c "$config" --json |
+      /usr/bin/python3 -c "import json,sys; r=json.load(sys.stdin); r['series']='$name'; r['patrol']=$n; print(json.dumps(r))" \
+      >> "$out/lines.jsonl"
+  done
+}
+for route in $routes; do
+  for seed in $seeds; do
+    run_series "$route-$seed" "$route" "$seed"
+  done
+done
+run_series "lighting-only" inner-loop 1 --remove-fraction 0 --move-fraction 0 --added 0
+/usr/bin/python3 - "$out" <<'PY'
+import json, sys
+out = sys.argv[1]
+lines = [json.loads(l) for l in open(out + "/lines.jsonl")]
+total = {}
+geo = [0, 0, 0]
+for r in lines:
+    c = r["changes"]
+    states = c.get("objects", {})
+    row = [f"{r['series']:16s} patrol {r['patrol']}"]
+    for s in ("new", "removed", "moved", "persistent"):
+        k = states.get(s, {})
+        t = total.setdefault(s, [0, 0, 0])
+        t[0] += k.get("true_positives", 0); t[1] += k.get("false_positives", 0); t[2] += k.get("false_negatives", 0)
+        row.append(f"{s} {k.get('true_positives',0)}/{k.get('false_positives',0)}/{k.get('false_negatives',0)}")
+    g = c.get("geometry", {})
+    if g:
+        geo[0] += g["true_positives"]; geo[1] += g["false_positives"]; geo[2] += g["false_negatives"]
+        row.append(f"voxels P {g['precision']:.2f} R {g['recall']:.2f} IoU {g['iou']:.2f} ({g['regions']} regions)")
+    row.append(f"places {c['places_changed']}/{c['places_compared']} changed")
+    print("  ".join(row))
+def prf(tp, fp, fn):
+    p = tp / (tp + fp) if tp + fp else 0.0
+    r = tp / (tp + fn) if tp + fn else 0.0
+    return p, r, (2 * p * r / (p + r) if p + r else 0.0)
+summary = {}
+print("totals (true/false/missed, precision, recall, F1):")
+for s, (tp, fp, fn) in total.items():
+    p, r, f = prf(tp, fp, fn)
+    summary[s] = {"tp": tp, "fp": fp, "fn": fn, "precision": p, "recall": r, "f1": f}
+    print(f"  {s:10s} {tp}/{fp}/{fn}  P {p:.2f} R {r:.2f} F1 {f:.2f}")
+p, r, f = prf(*geo)
+iou = geo[0] / sum(geo) if sum(geo) else 0.0
+summary["voxels"] = {"tp": geo[0], "fp": geo[1], "fn": geo[2], "precision": p, "recall": r, "f1": f, "iou": iou}
+print(f"  voxels     {geo[0]}/{geo[1]}/{geo[2]}  P {p:.2f} R {r:.2f} F1 {f:.2f} IoU {iou:.2f}")
+json.dump(summary, open(out + "/summary.json", "w"), indent=1)
+PY
