@@ -4,6 +4,7 @@
 # only the lighting), maps flight 1, adds flights 2 and 3 with `patrol`, and scores every change report with
 # `eval`. Prints one line per patrol and writes OUT/summary.json.
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
+# Environment: ROUTES, SEEDS, OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/change_study}
@@ -21,9 +22,11 @@ run_series() {  # name route seed extra-simulate-options...
   local name=$1 route=$2 seed=$3
   shift 3
   local dir="$out/$name"
-  rm -rf "$dir"
-  "$pm" simulate --route "$route" --seed "$seed" --flights 3 --objects "$objects" --detections --depth \
-    --resolution 376x240 "$@" --out "$dir/logs" >/dev/null 2>&1
+  if [ -z "${REUSE_LOGS:-}" ] || [ ! -d "$dir/logs/flight_3" ]; then  # REUSE_LOGS=1: keep logs of an earlier run
+    rm -rf "$dir"
+    "$pm" simulate --route "$route" --seed "$seed" --flights 3 --objects "$objects" --detections --depth \
+      --resolution 376x240 "$@" --out "$dir/logs" >/dev/null 2>&1
+  fi
   "$pm" map "$dir/logs/flight_1" --out "$dir/run_1" -c "$config" >/dev/null 2>&1
   for n in 2 3; do
     "$pm" patrol "$dir/logs/flight_$n" --map "$dir/run_$((n - 1))/map.pmap" --out "$dir/run_$n" -c "$config" \

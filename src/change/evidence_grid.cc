@@ -223,6 +223,22 @@ EvidenceGridData EvidenceGrid::ToData() const {
   return data;
 }
 
+// True when a voxel next to `index` is occupied in `grid`, the patrol where `index` is free: the same
+// surface seen a voxel off (an edge or a corner from a slightly different view) explains the change.
+// With `vertical` false only the horizontal neighbours count.
+bool OccupiedNeighbour(const EvidenceGridData& grid, const Eigen::Vector3i& index, int reach, bool vertical) {
+  for (int dz = vertical ? -reach : 0; dz <= (vertical ? reach : 0); ++dz) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        if (dx == 0 && dy == 0 && dz == 0) continue;
+        const VoxelEvidence* v = FindVoxel(grid, index + Eigen::Vector3i(dx, dy, dz));
+        if (v != nullptr && v->hits >= 2 && v->hits > v->passes) return true;
+      }
+    }
+  }
+  return false;
+}
+
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change) {
   *change = GeometryChange();
@@ -242,7 +258,11 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
       ++change->compared_voxels;
       const double delta = Occupancy(*b) - Occupancy(*a);
       const bool one_free = std::min(Occupancy(*a), Occupancy(*b)) <= options.max_free_occupancy;
-      if (std::abs(delta) > options.min_occupancy_change && one_free) {
+      const Eigen::Vector3i index(a->x, a->y, a->z);
+      if (std::abs(delta) > options.min_occupancy_change && one_free &&
+          (options.surface_tolerance_voxels == 0 ||
+           !OccupiedNeighbour(delta > 0 ? before : after, index, options.surface_tolerance_voxels,
+                              options.vertical_tolerance))) {
         changed.emplace_back(a->x, a->y, a->z);
         centres.push_back(changed.back().cast<double>() * size);
         deltas.push_back(delta);
@@ -254,6 +274,8 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
   MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
   for (Region& region : regions) {
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
+    const Eigen::Vector3d extent = region.data.box_max - region.data.box_min + Eigen::Vector3d::Constant(size);
+    if (std::max(extent.x(), extent.y()) < options.min_region_width_m - 1e-9) continue;
     region.data.score = region.score_sum / region.data.voxels;
     change->regions.push_back(region.data);
     for (std::size_t member : region.members) change->changed_voxels.push_back(changed[member]);

@@ -49,6 +49,42 @@ float CentralDepth(const cv::Mat& depth_m, const cv::Rect& box) {
   return values[values.size() / 2];
 }
 
+// Paper 000's final label: the one with the highest accumulated confidence, with its mean confidence.
+void AssignFinalLabel(MapObject* object) {
+  const auto top = std::max_element(object->labels.begin(), object->labels.end(),
+                                    [](const auto& a, const auto& b) { return a.confidence_sum < b.confidence_sum; });
+  object->label = top->label;
+  object->confidence = top->confidence_sum / top->count;
+}
+
+// Folds `from` into `into`: detections, centroid and descriptor weighted by detections, points, labels.
+void Absorb(double point_voxel, MapObject* into, const MapObject& from) {
+  const double n = into->detections + from.detections, w = from.detections / n;
+  into->centroid += w * (from.centroid - into->centroid);
+  if (into->descriptor.size() == from.descriptor.size()) {
+    for (std::size_t b = 0; b < into->descriptor.size(); ++b) {
+      into->descriptor[b] += static_cast<float>(w * (from.descriptor[b] - into->descriptor[b]));
+    }
+  }
+  into->box_min = into->box_min.cwiseMin(from.box_min);
+  into->box_max = into->box_max.cwiseMax(from.box_max);
+  into->points.insert(into->points.end(), from.points.begin(), from.points.end());
+  VoxelFilter(point_voxel, &into->points);
+  for (const MapObject::LabelEvidence& e : from.labels) {
+    auto it = std::find_if(into->labels.begin(), into->labels.end(), [&](const auto& x) { return x.label == e.label; });
+    if (it == into->labels.end()) {
+      into->labels.push_back(e);
+    } else {
+      it->confidence_sum += e.confidence_sum;
+      it->count += e.count;
+    }
+  }
+  into->detections = static_cast<int>(n);
+  into->first_seen_ns = std::min(into->first_seen_ns, from.first_seen_ns);
+  into->last_seen_ns = std::max(into->last_seen_ns, from.last_seen_ns);
+  AssignFinalLabel(into);
+}
+
 }  // namespace
 
 double PairFraction(const std::vector<Eigen::Vector3f>& query, const std::vector<Eigen::Vector3f>& reference,
@@ -229,10 +265,7 @@ void ObjectMapper::Update(int index, const ObjectObservation& detection, Measure
   if (evidence == object.labels.end()) evidence = object.labels.insert(object.labels.end(), {detection.label, 0.0, 0});
   evidence->confidence_sum += detection.confidence;
   ++evidence->count;
-  const auto top = std::max_element(object.labels.begin(), object.labels.end(),
-                                    [](const auto& a, const auto& b) { return a.confidence_sum < b.confidence_sum; });
-  object.label = top->label;
-  object.confidence = top->confidence_sum / top->count;
+  AssignFinalLabel(&object);
 }
 
 void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
@@ -252,10 +285,22 @@ void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, co
 }
 
 std::vector<MapObject> ObjectMapper::Finish() const {
+  // Objects whose mean centroids ended up this close are one object split by a failed association
+  // (two solid objects cannot stand there): merged, the one seen more often absorbing the other.
+  std::vector<MapObject> merged = objects_;
+  std::vector<bool> alive(merged.size(), true);
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    for (std::size_t j = i + 1; j < merged.size() && alive[i]; ++j) {
+      if (!alive[j] || (merged[i].centroid - merged[j].centroid).norm() > options_.merge_distance_m) continue;
+      const std::size_t into = merged[i].detections >= merged[j].detections ? i : j, from = i + j - into;
+      Absorb(options_.point_voxel_m, &merged[into], merged[from]);
+      alive[from] = false;
+    }
+  }
   std::vector<MapObject> kept;
-  for (const MapObject& object : objects_) {
-    if (object.detections < options_.min_detections) continue;
-    kept.push_back(object);
+  for (std::size_t i = 0; i < merged.size(); ++i) {
+    if (!alive[i] || merged[i].detections < options_.min_detections) continue;
+    kept.push_back(std::move(merged[i]));
     kept.back().id = static_cast<int>(kept.size()) - 1;
   }
   return kept;

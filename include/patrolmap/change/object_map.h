@@ -8,8 +8,10 @@
 // A view that shows a new side of an object passes the point-pair test when
 // at least half of the object's points it sees lie on its depth surface.
 // Every object accumulates label-confidence and label-count pairs; Finish()
-// keeps objects with enough detections and gives each the label with the
-// highest accumulated confidence and that label's mean confidence.
+// merges objects whose centroids ended up within merge_distance_m (one object
+// split by a failed association), keeps objects with enough detections and
+// gives each the label with the highest accumulated confidence and that
+// label's mean confidence.
 #pragma once
 
 #include <vector>

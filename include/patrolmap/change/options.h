@@ -31,6 +31,7 @@ struct ObjectMapOptions {
   double category_sigma_m = 0.5;      // 2D test: per-category prior, Gaussian on the centroid offset
   double vehicle_sigma_m = 1.0;       // ... wider for vehicles (labels containing "vehicle", "car", "truck")
   double min_category_prior = 0.1;    // 2D test: smallest prior probability accepted
+  double merge_distance_m = 0.5;      // when the patrol ends, objects whose centroids are this close merge
   int min_detections = 3;             // objects seen fewer times are dropped when the patrol ends
   double max_range_m = 25.0;          // detections farther than this are ignored
 };
@@ -59,12 +60,16 @@ struct EvidenceGridOptions {
 
 // Geometry change between two evidence grids (paper 004).
 struct GeometryDiffOptions {
-  double min_occupancy_change = 0.5;  // |hits/(hits+passes) before - after| above this: changed
+  double min_occupancy_change = 0.45; // |hits/(hits+passes) before - after| above this: changed
   double max_free_occupancy = 0.1;    // ... and in one patrol it must be free (a surface cut by the voxel's
                                       // edge fills it partly, by a share that changes with the view)
   int min_observations = 3;           // rays per voxel in each patrol; fewer: unobserved, never a change
+  int surface_tolerance_voxels = 1;   // no change where the free patrol has an occupied voxel this near
+                                      // (a surface seen a voxel off: edges, corners); 0 = off
+  bool vertical_tolerance = false;    // ... counting voxels above and below too (not only beside)
   double join_distance_m = 1.0;       // a changed voxel joins a region whose centroid is this close
-  int min_region_voxels = 6;          // smaller regions are dropped as outliers
+  int min_region_voxels = 10;         // smaller regions are dropped as outliers, ...
+  double min_region_width_m = 0.4;    // ... and so are narrower ones (a lone column of voxels at an edge)
 };
 
 struct ChangeOptions {

@@ -90,6 +90,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.object_map.category_sigma_m", &change.object_map.category_sigma_m);
   visitor->Field("change.object_map.vehicle_sigma_m", &change.object_map.vehicle_sigma_m);
   visitor->Field("change.object_map.min_category_prior", &change.object_map.min_category_prior);
+  visitor->Field("change.object_map.merge_distance_m", &change.object_map.merge_distance_m);
   visitor->Field("change.object_map.min_detections", &change.object_map.min_detections);
   visitor->Field("change.object_map.max_range_m", &change.object_map.max_range_m);
   visitor->Field("change.objects.match_distance_m", &change.objects.match_distance_m);
@@ -108,8 +109,11 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
   visitor->Field("change.geometry.max_free_occupancy", &change.geometry.max_free_occupancy);
   visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);
+  visitor->Field("change.geometry.surface_tolerance_voxels", &change.geometry.surface_tolerance_voxels);
+  visitor->Field("change.geometry.vertical_tolerance", &change.geometry.vertical_tolerance);
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
+  visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep
