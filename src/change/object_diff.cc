@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kPairDistance = 0.25;      // point-pair test between patrols [m]
 constexpr double kMinPairFraction = 0.5;
-constexpr double kOcclusionClearance = 1.0; // voxels this close to the object do not hide it [m]
+constexpr double kMinClearance = 1.0;       // voxels this close to an object do not hide it, nor within its half size [m]
 
 // A voxel counts as occupied when most rays ended in it and at least two did.
 bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
@@ -22,8 +22,10 @@ bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
   return v != nullptr && v->hits >= 2 && v->hits > v->passes;
 }
 
-bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-  const double length = (to - from).norm() - kOcclusionClearance;
+// Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands
+// where the object stood (another object, the object moved by a little) does not hide its place.
+bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eigen::Vector3d& to, double clearance) {
+  const double length = (to - from).norm() - clearance;
   const Eigen::Vector3d direction = (to - from).normalized();
   for (double s = grid.voxel_size; s < length; s += grid.voxel_size) {
     if (Occupied(grid, from + s * direction)) return true;
@@ -31,15 +33,33 @@ bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eig
   return false;
 }
 
-double AppearanceDistance(const MapObject& a, const MapObject& b) {
-  double histogram = 0.0;
-  if (a.descriptor.size() == b.descriptor.size()) {
-    for (std::size_t i = 0; i < a.descriptor.size(); ++i) histogram += std::abs(a.descriptor[i] - b.descriptor[i]);
+}  // namespace
+
+AppearanceTerms CompareAppearance(const MapObject& a, const MapObject& b) {
+  AppearanceTerms terms;
+  constexpr std::size_t kBins = 8;
+  if (a.descriptor.size() >= kBins && b.descriptor.size() >= kBins) {
+    double l1 = 0.0;
+    for (std::size_t i = 0; i < kBins; ++i) l1 += std::abs(a.descriptor[i] - b.descriptor[i]);
+    terms.texture = 0.5 * l1;
   }
-  const Eigen::Vector3d sa = a.box_max - a.box_min, sb = b.box_max - b.box_min;
-  const double size = (sa - sb).norm() / std::max(1e-6, 0.5 * (sa.norm() + sb.norm()));
-  return 0.5 * histogram + size;
+  if (a.descriptor.size() > kBins && b.descriptor.size() > kBins) {
+    terms.brightness = std::abs(a.descriptor[kBins] - b.descriptor[kBins]);
+  }
+  if (a.height > 0.0 && b.height > 0.0) terms.height = std::abs(a.height - b.height) / std::max(a.height, b.height);
+  return terms;
 }
+
+double AppearanceTerms::Distance() const {
+  double sum = 0.0;
+  int count = 0;
+  for (const std::optional<double>& term : {texture, brightness, height}) {
+    if (term) sum += *term, ++count;
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+namespace {
 
 Eigen::Vector3d MeanOf(const std::vector<Eigen::Vector3f>& points) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -113,6 +133,7 @@ Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before, con
 int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options) {
   const CameraIntrinsics& camera = current.camera;
   const bool grid = current.grid.voxel_size > 0.0 && !current.grid.voxels.empty();
+  const double clearance = std::max(kMinClearance, 0.5 * (object.box_max - object.box_min).norm());
   int views = 0;
   for (const CameraPoseSample& view : current.views) {
     const Eigen::Vector3d c = view.ToCamera(object.centroid);
@@ -120,7 +141,7 @@ int CoveringViews(const MapObject& object, const PatrolRecord& current, const Ob
     const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
     const double m = options.image_margin_px;
     if (u < m || v < m || u > camera.width - 1 - m || v > camera.height - 1 - m) continue;
-    if (grid && Hidden(current.grid, view.position, object.centroid)) continue;
+    if (grid && Hidden(current.grid, view.position, object.centroid, clearance)) continue;
     ++views;
   }
   return views;
@@ -185,7 +206,8 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
       if (distance > options.max_move_m) continue;
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
       physical.push_back(distance);
-      appearance.push_back(AppearanceDistance(p[i], c[j]));
+      const AppearanceTerms terms = CompareAppearance(p[i], c[j]);
+      appearance.push_back(terms.Distance());
     }
   }
   const auto normalise = [](const std::vector<double>& values, std::size_t k) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
 #include <unordered_set>
 
 #include <nanoflann.hpp>
@@ -135,6 +136,45 @@ std::vector<float> OrientationHistogram(const cv::Mat& image, const cv::Rect& bo
   return histogram;
 }
 
+void CumulativeHistogram(const cv::Mat& image, std::array<float, 256>* cdf) {
+  std::array<double, 256> counts{};
+  for (int y = 0; y < image.rows; ++y) {
+    const std::uint8_t* row = image.ptr<std::uint8_t>(y);
+    for (int x = 0; x < image.cols; ++x) ++counts[row[x]];
+  }
+  double sum = 0.0;
+  for (int v = 0; v < 256; ++v) {
+    sum += counts[v];
+    (*cdf)[v] = static_cast<float>(sum / static_cast<double>(image.total()));
+  }
+}
+
+float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array<float, 256>& cdf) {
+  const cv::Rect centre =
+      cv::Rect(box.x + box.width / 4, box.y + box.height / 4, std::max(1, box.width / 2), std::max(1, box.height / 2)) &
+      cv::Rect(0, 0, image.cols, image.rows);
+  if (centre.area() == 0) return 0.5f;
+  std::vector<std::uint8_t> values;
+  for (int y = centre.y; y < centre.br().y; ++y) {
+    const std::uint8_t* row = image.ptr<std::uint8_t>(y);
+    values.insert(values.end(), row + centre.x, row + centre.br().x);
+  }
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return cdf[values[values.size() / 2]];
+}
+
+double PointHeight(const std::vector<Eigen::Vector3f>& points) {
+  if (points.size() < 10) return 0.0;
+  std::vector<float> z;
+  for (const Eigen::Vector3f& p : points) z.push_back(p.z());
+  const auto at = [&z](double q) {
+    const auto k = z.begin() + static_cast<std::ptrdiff_t>(q * (z.size() - 1));
+    std::nth_element(z.begin(), k, z.end());
+    return *k;
+  };
+  return at(0.95) - at(0.05);
+}
+
 cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,
                       const Eigen::Vector3d& box_max) {
   double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
@@ -185,7 +225,10 @@ bool ObjectMapper::Measure(const ObjectObservation& detection, const CameraPoseS
     }
     VoxelFilter(options_.point_voxel_m, &measured->points);
   }
-  if (!image.empty()) measured->descriptor = OrientationHistogram(image, box);
+  if (!image.empty()) {
+    measured->descriptor = OrientationHistogram(image, box);
+    measured->descriptor.push_back(BrightnessRank(image, box, brightness_cdf_));
+  }
   return true;
 }
 
@@ -271,6 +314,7 @@ void ObjectMapper::Update(int index, const ObjectObservation& detection, Measure
 void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
                             const cv::Mat& depth_m, const cv::Mat& image) {
   Measured measured;
+  if (!image.empty() && !detections.empty()) CumulativeHistogram(image, &brightness_cdf_);
   for (const ObjectObservation& detection : detections) {
     if (!Measure(detection, pose, depth_m, image, &measured)) {
       ++skipped_;
@@ -302,6 +346,7 @@ std::vector<MapObject> ObjectMapper::Finish() const {
     if (!alive[i] || merged[i].detections < options_.min_detections) continue;
     kept.push_back(std::move(merged[i]));
     kept.back().id = static_cast<int>(kept.size()) - 1;
+    kept.back().height = PointHeight(kept.back().points);
   }
   return kept;
 }

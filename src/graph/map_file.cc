@@ -74,7 +74,7 @@ class Reader {
     const std::uint32_t count = Value<std::uint32_t>();
     if (!Take(static_cast<std::size_t>(count) * sizeof(T))) return {};
     std::vector<T> values(count);
-    std::memcpy(values.data(), data_ + position_ - count * sizeof(T), count * sizeof(T));
+    std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
     return values;
   }
   bool failed() const { return failed_; }
@@ -160,6 +160,7 @@ void WriteObject(const MapObject& o, Writer* w) {
   }
   w->Vector(o.points);
   w->Vector(o.descriptor);
+  w->Value(o.height);
   w->Value(static_cast<std::uint32_t>(o.labels.size()));
   for (const MapObject::LabelEvidence& e : o.labels) {
     w->String(e.label);
@@ -274,6 +275,7 @@ MapObject ReadObject(Reader* r) {
   }
   o.points = r->Vector<Eigen::Vector3f>();
   o.descriptor = r->Vector<float>();
+  o.height = r->Value<double>();
   const std::uint32_t labels = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < labels && !r->failed(); ++i) {
     MapObject::LabelEvidence e;

@@ -89,16 +89,20 @@ cv::Mat ObjectTexture(const WorldObject& object) {
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-// True when a wall at least as tall as the camera crosses the ground segment from the camera to `target`.
-bool HiddenByBuilding(const Scene& scene, const Eigen::Vector3d& camera, const Eigen::Vector2d& target) {
-  const Eigen::Vector2d origin = camera.head<2>(), ray = target - origin;
+// True when a wall (of a building or of another object) crosses the line of sight from the camera to the
+// object's centre below the line's height there. The object's own sides do not count.
+bool Hidden(const Scene& scene, const Eigen::Vector3d& camera, const WorldObject& object) {
+  const Eigen::Vector3d target(object.centre.x(), object.centre.y(), object.height / 2);
+  const Eigen::Vector2d origin = camera.head<2>(), ray = target.head<2>() - origin;
+  const double own = 0.5 * std::hypot(object.length, object.width) + 1e-6;
   for (const Wall& wall : scene.walls) {
-    if (wall.height < camera.z()) continue;
+    if ((0.5 * (wall.start + wall.end) - object.centre).norm() <= own) continue;
     const Eigen::Vector2d along = wall.end - wall.start, offset = wall.start - origin;
     const double denominator = Cross(ray, along);
     if (std::abs(denominator) < 1e-12) continue;
     const double t = Cross(offset, along) / denominator, u = Cross(offset, ray) / denominator;
-    if (t > 0.0 && t < 0.97 && u >= 0.0 && u <= 1.0) return true;
+    if (t <= 0.0 || t >= 1.0 || u < 0.0 || u > 1.0) continue;
+    if (camera.z() + t * (target.z() - camera.z()) <= wall.height) return true;
   }
   return false;
 }
@@ -215,7 +219,7 @@ std::vector<Detection> DetectObjects(const std::vector<WorldObject>& objects, co
     Detection detection;
     if (in_camera.z() < 0.3 || in_camera.norm() > options.max_range_m) continue;
     if (!ProjectBox(object, camera, pose, &detection.box)) continue;
-    if (HiddenByBuilding(scene, pose.position, object.centre)) continue;
+    if (Hidden(scene, pose.position, object)) continue;
     if (rng.uniform(0.0, 1.0) < options.miss_rate) continue;
     detection.label = object.label;
     detection.confidence = rng.uniform(0.55, 0.95);

@@ -39,9 +39,18 @@ struct ObjectChange {
   double weighted_distance = 0.0;          // moved: paper 003's delta
 };
 
+// The appearance terms between two objects, each in [0, 1] and present when both have it: texture (half
+// the L1 distance of the gradient-orientation histograms), brightness (difference of the brightness
+// ranks) and height (difference relative to the taller).
+struct AppearanceTerms {
+  std::optional<double> texture, brightness, height;
+  double Distance() const;  // mean of the present terms; 0 when none
+};
+AppearanceTerms CompareAppearance(const MapObject& a, const MapObject& b);
+
 // How many of `views` cover `object`: in front, within range, the projected
 // centroid inside the image by the margin, and (with a grid) no occupied voxel
-// on the line of sight more than one metre before the object.
+// on the line of sight short of the object's half size (at least 1 m) before it.
 int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options);
 
 std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,

@@ -14,6 +14,7 @@
 // label's mean confidence.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -64,6 +65,7 @@ class ObjectMapper {
   CameraIntrinsics camera_;
   std::vector<MapObject> objects_;
   std::vector<Eigen::Vector2d> sizes_;  // running mean width, height of each object
+  std::array<float, 256> brightness_cdf_{};  // of the current frame's image
   int associations_ = 0;
   double association_seconds_ = 0.0;
   int skipped_ = 0;
@@ -80,6 +82,16 @@ void VoxelFilter(double voxel, std::vector<Eigen::Vector3f>* points);
 // Gradient-orientation histogram (8 bins, magnitude-weighted, L1-normalised)
 // of `box` in `image`: an appearance descriptor that ignores gain and offset.
 std::vector<float> OrientationHistogram(const cv::Mat& image, const cv::Rect& box);
+
+// The image's cumulative grey-level distribution (share of pixels at or below each level).
+void CumulativeHistogram(const cv::Mat& image, std::array<float, 256>* cdf);
+
+// Brightness rank of `box`: the share of the image's pixels at or below the median grey level of the
+// box's central half. Unchanged by any monotonic change of the lighting (gain, offset, gamma).
+float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array<float, 256>& cdf);
+
+// Vertical extent of points (5th to 95th percentile of z) [m]; 0 with fewer than 10 points.
+double PointHeight(const std::vector<Eigen::Vector3f>& points);
 
 // The image box of an axis-aligned world box seen from `pose`; empty when
 // any corner lies behind the camera.

@@ -49,7 +49,9 @@ struct MapObject {
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (or of its centroids)
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3f> points;                 // segmented points (voxel-filtered); empty without depth
-  std::vector<float> descriptor;                       // appearance: gradient-orientation histogram of its views
+  std::vector<float> descriptor;  // appearance, mean over its views: 8-bin gradient-orientation histogram, then
+                                  // the brightness rank (share of the frame's pixels darker than it)
+  double height = 0.0;            // vertical extent of its points [m]; 0 without points
   struct LabelEvidence {
     std::string label;
     double confidence_sum = 0.0;

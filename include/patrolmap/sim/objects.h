@@ -73,7 +73,8 @@ struct DetectorOptions {
 };
 
 // Simulated detections of `objects` seen from `pose` (visibility: in front,
-// in range, at least 8x8 pixels in the image, centre not hidden by a wall).
+// in range, at least 8x8 pixels in the image, centre not hidden by a wall of
+// a building or of another object).
 // `frame` seeds the noise.
 std::vector<Detection> DetectObjects(const std::vector<WorldObject>& objects, const Scene& scene,
                                      const CameraIntrinsics& camera, const CameraPose& pose,

@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# Change detection end to end on simulated patrol series (issue 6):
+#  - two L-shaped flights with objects added, removed and moved between them, object detections and depth:
+#    `map`, then `patrol` writes changes.json and changes.html; `eval` scores them against the ground truth;
+#  - `diff` on the patrol's map repeats the patrol's report;
+#  - the report follows docs/changes.schema.json and the page holds both key frames of changed places;
+#  - a series that changes only the lighting reports no change at all;
+#  - bad requests fail with a message.
+# Usage: change_series_test.sh PATROLMAP_BINARY SOURCE_DIR
+set -euo pipefail
+bin=$1
+source_dir=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+py=/usr/bin/python3
+failures=0
+check() {  # check NAME PYTHON-EXPRESSION-ON-r (r: the eval JSON's "changes")
+  if $py -c "import json,sys; r=json.load(open('$3'))['changes']; sys.exit(0 if ($2) else 1)"; then
+    echo "ok   $1"
+  else
+    echo "FAIL $1: $2"
+    $py -c "import json; print(json.dumps(json.load(open('$3'))['changes'], indent=1))"
+    failures=$((failures + 1))
+  fi
+}
+
+# Logs at 376x240 processed at full scale (what a 752x480 log gives the stages after their 0.5 downscale).
+config="$work/study.yaml"
+printf 'flow:\n  frames:\n    scale: 1.0\n' > "$config"
+
+series() {  # series NAME EXTRA-SIMULATE-OPTIONS...
+  local name=$1
+  shift
+  "$bin" simulate --route l-shape --seed 1 --flights 2 --objects 20 --detections --depth --resolution 376x240 \
+    "$@" --out "$work/$name" >/dev/null
+  "$bin" map "$work/$name/flight_1" -c "$config" --out "$work/$name-1" >/dev/null
+  "$bin" patrol "$work/$name/flight_2" --map "$work/$name-1/map.pmap" -c "$config" --out "$work/$name-2" |
+    tail -1
+  "$bin" eval "$work/$name-2" --log "$work/$name/flight_2" --log "$work/$name/flight_1" -c "$config" --json \
+    > "$work/$name.json"
+  $py -c "
+import json
+r = json.load(open('$work/$name.json'))['changes']
+print('  ' + ', '.join('%s %d/%d/%d' % (s, c['true_positives'], c['false_positives'], c['false_negatives'])
+                       for s, c in r['objects'].items() if isinstance(c, dict)) + ' (true/false/missed)')
+g = r['geometry']
+print('  voxels: precision %.3f recall %.3f IoU %.3f, %d regions' % (g['precision'], g['recall'], g['iou'], g['regions']))"
+}
+
+series changed
+json="$work/changed.json"
+# Measured on this series: every object state and the geometry come out at or near 1.0 (BENCHMARKS.md);
+# the bounds leave room for one object more or less.
+check "new objects F1" "r['objects']['new']['f1'] >= 0.66" "$json"
+check "removed objects F1" "r['objects']['removed']['f1'] >= 0.8" "$json"
+check "moved objects F1" "r['objects']['moved']['f1'] >= 0.8" "$json"
+check "persistent objects F1" "r['objects']['persistent']['f1'] >= 0.9" "$json"
+check "geometry precision" "r['geometry']['precision'] >= 0.9" "$json"
+check "geometry recall" "r['geometry']['recall'] >= 0.8" "$json"
+
+if $py -c "
+import json, sys, jsonschema
+schema = json.load(open('$source_dir/docs/changes.schema.json'))
+report = json.load(open('$work/changed-2/changes.json'))
+jsonschema.validate(report, schema)
+assert report['prior_flight'] == 'l-shape-1-f1' and report['current_flight'] == 'l-shape-1-f2'
+page = open('$work/changed-2/changes.html').read()
+assert '<h2>Objects</h2>' in page and '<svg' in page
+changed = sum(1 for p in report['places'] if p['regions'])
+assert page.count('<img alt=') == 2 * changed, (page.count('<img alt='), changed)
+"; then echo "ok   report follows the schema; the page shows both key frames per changed place"; else
+  echo "FAIL report schema or page"; failures=$((failures + 1)); fi
+
+"$bin" diff "$work/changed-2/map.pmap" --from l-shape-1-f1 --to l-shape-1-f2 --out "$work/diff" >/dev/null
+if $py -c "
+import json
+a = json.load(open('$work/changed-2/changes.json')); b = json.load(open('$work/diff/changes.json'))
+a.pop('timing_s'); b.pop('timing_s')
+assert a == b
+"; then echo "ok   diff repeats the patrol's report"; else echo "FAIL diff differs from patrol"; failures=$((failures + 1)); fi
+
+expect_fail() {  # expect_fail NAME PATTERN -- COMMAND...
+  local name=$1 pattern=$2
+  shift 3
+  local output code=0
+  output=$("$@" 2>&1) || code=$?
+  if [ "$code" = 1 ] && grep -qE -- "$pattern" <<< "$output"; then echo "ok   $name"; else
+    echo "FAIL $name: exit $code, output: $output"; failures=$((failures + 1)); fi
+}
+expect_fail "diff: unknown flight" "flight 'nope' is not in the map" -- \
+  "$bin" diff "$work/changed-2/map.pmap" --from nope --out "$work/d2"
+expect_fail "diff: one flight" "needs two flights" -- "$bin" diff "$work/changed-1/map.pmap" --out "$work/d3"
+expect_fail "diff: same flight" "name the same flight" -- \
+  "$bin" diff "$work/changed-2/map.pmap" --from l-shape-1-f2 --to l-shape-1-f2 --out "$work/d4"
+expect_fail "diff: missing map" "nothing.pmap: cannot read map" -- "$bin" diff "$work/nothing.pmap" --out "$work/d5"
+
+series lighting --remove-fraction 0 --move-fraction 0 --added 0
+json="$work/lighting.json"
+check "lighting only: no object changed" \
+  "all(r['objects'][s]['false_positives'] == 0 for s in ('new', 'removed', 'moved'))" "$json"
+check "lighting only: no geometry region" "r['geometry']['regions'] == 0" "$json"
+check "lighting only: no appearance region" "r['places_changed'] == 0" "$json"
+
+if [ "$failures" != 0 ]; then
+  echo "$failures check(s) failed"
+  exit 1
+fi
+echo "all change checks passed"
