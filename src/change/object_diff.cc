@@ -24,11 +24,21 @@ bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
 
 // Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands
 // where the object stood (another object, the object moved by a little) does not hide its place.
-bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eigen::Vector3d& to, double clearance) {
+// Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands
+// where the object stood (another object, the object moved by a little) does not hide its place, nor do
+// voxels inside `see_through` (the boxes of current objects that may be this one, moved).
+bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eigen::Vector3d& to, double clearance,
+            const std::vector<const MapObject*>& see_through) {
+  static constexpr double kBoxMargin = 0.3;  // [m]
   const double length = (to - from).norm() - clearance;
   const Eigen::Vector3d direction = (to - from).normalized();
   for (double s = grid.voxel_size; s < length; s += grid.voxel_size) {
-    if (Occupied(grid, from + s * direction)) return true;
+    const Eigen::Vector3d point = from + s * direction;
+    if (!Occupied(grid, point)) continue;
+    const bool inside = std::any_of(see_through.begin(), see_through.end(), [&point](const MapObject* o) {
+      return (point.array() >= o->box_min.array() - kBoxMargin).all() && (point.array() <= o->box_max.array() + kBoxMargin).all();
+    });
+    if (!inside) return true;
   }
   return false;
 }
@@ -130,7 +140,8 @@ Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before, con
   return rotation;
 }
 
-int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options) {
+int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options,
+                  const std::vector<const MapObject*>& see_through) {
   const CameraIntrinsics& camera = current.camera;
   const bool grid = current.grid.voxel_size > 0.0 && !current.grid.voxels.empty();
   const double clearance = std::max(kMinClearance, 0.5 * (object.box_max - object.box_min).norm());
@@ -141,7 +152,7 @@ int CoveringViews(const MapObject& object, const PatrolRecord& current, const Ob
     const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
     const double m = options.image_margin_px;
     if (u < m || v < m || u > camera.width - 1 - m || v > camera.height - 1 - m) continue;
-    if (grid && Hidden(current.grid, view.position, object.centroid, clearance)) continue;
+    if (grid && Hidden(current.grid, view.position, object.centroid, clearance, see_through)) continue;
     ++views;
   }
   return views;
@@ -183,7 +194,13 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
   std::vector<int> views(p.size(), 0);
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (prior_used[i]) continue;
-    views[i] = CoveringViews(p[i], current, options);
+    std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved
+    for (std::size_t j = 0; j < c.size(); ++j) {
+      if (!current_used[j] && c[j].label == p[i].label && (c[j].centroid - p[i].centroid).norm() <= options.max_move_m) {
+        candidates.push_back(&c[j]);
+      }
+    }
+    views[i] = CoveringViews(p[i], current, options, candidates);
     if (views[i] >= options.min_visible_views) continue;
     prior_used[i] = true;
     ObjectChange change;

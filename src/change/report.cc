@@ -206,6 +206,9 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
          << PlanSvg(report, map);
   }
   html << "<h2>Places with appearance changes</h2>\n";
+  if (report.ChangedPlaces() == 0) {
+    html << "<p>None of the " << report.places.size() << " places both patrols saw changed in appearance.</p>\n";
+  }
   for (const PlaceChange& place : report.places) {
     if (place.appearance.regions.empty()) continue;
     std::vector<cv::Rect> prior_boxes, current_boxes;

@@ -178,12 +178,25 @@ std::vector<WorldObject> ChangeObjects(const std::vector<WorldObject>& previous,
       continue;
     }
     WorldObject moved = object;
-    const bool move = rng.uniform(0.0, 1.0) < spec.move_fraction;
+    bool move = rng.uniform(0.0, 1.0) < spec.move_fraction;
     if (move) {
-      // Along the street the object stands in: in x beside the south and north sides, else in y.
+      // Along the street the object stands in: in x beside the south and north sides, else in y; the other
+      // way when that spot is taken, and not at all when both are (objects never overlap).
       const bool along_x = object.centre.y() < 0.0 || object.centre.y() > 30.0;
       const double shift = rng.uniform(2.0, 6.0) * (rng.uniform(0, 2) == 0 ? -1.0 : 1.0);
-      moved.centre += shift * (along_x ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1));
+      std::vector<WorldObject> others = next;
+      for (const WorldObject& other : previous) {
+        if (other.id != object.id) others.push_back(other);
+      }
+      move = false;
+      for (const double sign : {1.0, -1.0}) {
+        moved.centre = object.centre + sign * shift * (along_x ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 1));
+        if (!Overlaps(moved, others)) {
+          move = true;
+          break;
+        }
+      }
+      if (!move) moved.centre = object.centre;
     }
     changes->push_back({object.id, move ? ChangeState::kMoved : ChangeState::kPersistent, object.label, object.centre,
                         moved.centre});

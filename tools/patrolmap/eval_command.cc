@@ -182,7 +182,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
 }
 
 void PrintCounts(const char* name, const nlohmann::json& c) {
-  std::printf("%-12s %5d %6d %7d %10.2f %7.2f %6.2f\n", name, c["true_positives"].get<int>(),
+  std::printf("%-18s %5d %6d %7d %10.2f %7.2f %6.2f\n", name, c["true_positives"].get<int>(),
               c["false_positives"].get<int>(), c["false_negatives"].get<int>(), c["precision"].get<double>(),
               c["recall"].get<double>(), c["f1"].get<double>());
 }
@@ -191,7 +191,7 @@ void PrintChangeTable(const nlohmann::json& c) {
   std::printf("changes %s -> %s: %d places compared, %d with appearance changes\n",
               c["prior_flight"].get<std::string>().c_str(), c["current_flight"].get<std::string>().c_str(),
               c["places_compared"].get<int>(), c["places_changed"].get<int>());
-  std::printf("%-12s %5s %6s %7s %10s %7s %6s\n", "", "true", "false", "missed", "precision", "recall", "F1");
+  std::printf("%-18s %5s %6s %7s %10s %7s %6s\n", "", "true", "false", "missed", "precision", "recall", "F1");
   if (c.contains("objects")) {
     for (const char* state : {"new", "removed", "moved", "persistent"}) {
       PrintCounts((std::string("objects ") + state).c_str(), c["objects"][state]);

@@ -6,7 +6,8 @@
 //               appearance distance; the rigid motion by SVD of the point covariances;
 //   removed     a prior object that enough current views covered (projected into the
 //               image, in range, not behind occupied voxels of the current evidence
-//               grid) but nothing matched;
+//               grid other than those of a current object that may be it, moved) but
+//               nothing matched;
 //   unobserved  a prior object too few current views covered: its state is unknown;
 //   new         a current object matching nothing of the prior patrol.
 #pragma once
@@ -51,7 +52,9 @@ AppearanceTerms CompareAppearance(const MapObject& a, const MapObject& b);
 // How many of `views` cover `object`: in front, within range, the projected
 // centroid inside the image by the margin, and (with a grid) no occupied voxel
 // on the line of sight short of the object's half size (at least 1 m) before it.
-int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options);
+// Voxels inside `see_through` (current objects that may be this one, moved) do not hide it.
+int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options,
+                  const std::vector<const MapObject*>& see_through = {});
 
 std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
                                       const ObjectDiffOptions& options);
