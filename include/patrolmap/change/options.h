@@ -39,7 +39,7 @@ struct ObjectMapOptions {
 // State of every object between two patrols (papers 000, 001, 003).
 struct ObjectDiffOptions {
   double match_distance_m = 1.0;      // persistent: centroids this close (then the point-pair test)
-  double max_move_m = 12.0;           // moved: the two positions at most this far apart
+  double max_move_m = 8.0;            // moved: the two positions at most this far apart (farther: removed + new)
   double physical_weight = 0.6;       // alpha of paper 003's weighted normalised distance
   double appearance_weight = 0.4;     // beta
   double max_weighted_distance = 0.8; // pairs whose weighted distance is above this are not a move
