@@ -215,7 +215,7 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
 
   // Moved (paper 003): weighted, min-max normalised physical and appearance distances.
   std::vector<Pair> candidates;
-  std::vector<double> physical, appearance;
+  std::vector<double> physical, appearance, textures;
   for (std::size_t i = 0; i < p.size(); ++i) {
     for (std::size_t j = 0; j < c.size(); ++j) {
       if (prior_used[i] || current_used[j] || p[i].label != c[j].label) continue;
@@ -224,6 +224,7 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
       physical.push_back(distance);
       const AppearanceTerms terms = CompareAppearance(p[i], c[j]);
+      textures.push_back(terms.texture.value_or(0.0));
       appearance.push_back(terms.Distance());
     }
   }
@@ -231,12 +232,16 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
     const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
     return *hi - *lo > 1e-12 ? (values[k] - *lo) / (*hi - *lo) : 0.0;
   };
+  // Paper 003's weighted normalised distance orders the candidates; the gates are absolute (min-max
+  // normalised values cannot reject anything: the worst candidate is always 1).
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     candidates[k].cost = options.physical_weight * normalise(physical, k) + options.appearance_weight * normalise(appearance, k);
   }
-  candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
-                                  [&](const Pair& pair) { return pair.cost > options.max_weighted_distance; }),
-                   candidates.end());
+  std::vector<Pair> gated;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (textures[k] <= options.max_texture_distance) gated.push_back(candidates[k]);
+  }
+  candidates.swap(gated);
   std::vector<Pair> moved;
   AssignGreedy(candidates, &prior_used, &current_used, &moved);
   for (const Pair& pair : moved) {

@@ -23,18 +23,28 @@ struct TruthChange {
   std::optional<Eigen::Vector2d> before, after;
 };
 
+// The true changes as a patrolling robot can know them: an object that moved counts as moved when the
+// detector reported it often enough in both flights, as removed when only in the earlier one and as new
+// when only in the later one; an object that stayed counts only when seen in both.
 std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after,
                                       int min_detections) {
   std::vector<TruthChange> truth;
   for (const TruthObject& b : before) {
     const TruthObject* a = FindId(after, b.id);
+    const bool seen_before = b.detections >= min_detections;
     if (a == nullptr) {
-      if (b.detections >= min_detections) truth.push_back({"removed", b.label, b.centre, std::nullopt});
+      if (seen_before) truth.push_back({"removed", b.label, b.centre, std::nullopt});
       continue;
     }
-    if (b.detections < min_detections || a->detections < min_detections) continue;
+    const bool seen_after = a->detections >= min_detections;
     const bool moved = (a->centre - b.centre).norm() > kSamePlace;
-    truth.push_back({moved ? "moved" : "persistent", b.label, b.centre, a->centre});
+    if (seen_before && seen_after) {
+      truth.push_back({moved ? "moved" : "persistent", b.label, b.centre, a->centre});
+    } else if (moved && seen_before) {
+      truth.push_back({"removed", b.label, b.centre, std::nullopt});
+    } else if (moved && seen_after) {
+      truth.push_back({"new", a->label, std::nullopt, a->centre});
+    }
   }
   for (const TruthObject& a : after) {
     if (FindId(before, a.id) == nullptr && a.detections >= min_detections) {

@@ -42,10 +42,11 @@ struct ObjectDiffOptions {
   double max_move_m = 8.0;            // moved: the two positions at most this far apart (farther: removed + new)
   double physical_weight = 0.6;       // alpha of paper 003's weighted normalised distance
   double appearance_weight = 0.4;     // beta
-  double max_weighted_distance = 0.8; // pairs whose weighted distance is above this are not a move
+  double max_texture_distance = 0.15; // pairs whose gradient-orientation histograms differ more (half their
+                                      // L1 distance) are not a move
   double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
   double image_margin_px = 4.0;       // visibility: its projected centroid must lie this far inside the image
-  int min_visible_views = 3;          // fewer covering views: unobserved instead of removed
+  int min_visible_views = 8;          // fewer covering views (sampled at 5 Hz): unobserved instead of removed
 };
 
 // Evidence grid of one patrol (paper 004).

@@ -4,8 +4,11 @@
 // pose, size); an object keeps its id across flights, so the true state of
 // every object between two flights follows: in both at the same place
 // persistent, elsewhere moved, only in the earlier removed, only in the later
-// new. Only objects the detector reported at least `min_detections` times
-// (groundtruth/detections.csv) in the flight(s) that define the state count.
+// new — as far as a patrol can know it: an object counts as seen in a flight
+// when the detector reported it at least `min_detections` times there
+// (groundtruth/detections.csv); a moved object seen in both flights is moved,
+// seen only before removed, seen only after new; an object that stayed counts
+// (as persistent) only when seen in both.
 // A reported object is a hit when a true object of the same state and label
 // lies within `distance_m` (moved: both its positions). Per state: precision,
 // recall and F1, one-to-one matching nearest first.

@@ -97,7 +97,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
   visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);
   visitor->Field("change.objects.appearance_weight", &change.objects.appearance_weight);
-  visitor->Field("change.objects.max_weighted_distance", &change.objects.max_weighted_distance);
+  visitor->Field("change.objects.max_texture_distance", &change.objects.max_texture_distance);
   visitor->Field("change.objects.max_visible_range_m", &change.objects.max_visible_range_m);
   visitor->Field("change.objects.image_margin_px", &change.objects.image_margin_px);
   visitor->Field("change.objects.min_visible_views", &change.objects.min_visible_views);
