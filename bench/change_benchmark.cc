@@ -53,6 +53,18 @@ View Render(double x, const std::vector<sim::WorldObject>& objects, const sim::L
   return view;
 }
 
+// Index of the object on the south street nearest to x = 20 m.
+std::size_t SouthObject(const std::vector<sim::WorldObject>& objects) {
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (objects[i].centre.y() < 0.0 &&
+        (objects[best].centre.y() >= 0.0 || std::abs(objects[i].centre.x() - 20) < std::abs(objects[best].centre.x() - 20))) {
+      best = i;
+    }
+  }
+  return best;
+}
+
 const View& Village() {
   static const View view = Render(20.0, sim::PlaceObjects(30, 1), {});
   return view;
@@ -80,10 +92,11 @@ void BM_EvidenceGridIntegrateFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_EvidenceGridIntegrateFrame)->Unit(benchmark::kMillisecond);
 
-// Two grids along 40 m of street (a depth frame every 0.26 m, as at 5 Hz and 1.3 m/s), one with a crate removed.
+// Two grids along 40 m of street (a depth frame every 0.26 m, as at 5 Hz and 1.3 m/s), one with an object removed.
 void BM_DiffGridsFortyMetres(benchmark::State& state) {
   std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
-  const std::vector<sim::WorldObject> fewer(objects.begin() + 1, objects.end());
+  std::vector<sim::WorldObject> fewer = objects;
+  fewer.erase(fewer.begin() + static_cast<std::ptrdiff_t>(SouthObject(objects)));
   EvidenceGridData grids[2];
   for (int g = 0; g < 2; ++g) {
     change::EvidenceGrid grid(change::EvidenceGridOptions{});
@@ -112,9 +125,12 @@ change::KeyFrameView Describe(const cv::Mat& image) {
 
 void BM_AppearanceChangePerPlace(benchmark::State& state) {
   std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
-  const change::KeyFrameView prior = Describe(Render(20.0, objects, sim::DrawLighting(1, 1)).image);
-  objects.erase(objects.begin() + 3);
-  const change::KeyFrameView current = Describe(Render(20.3, objects, sim::DrawLighting(1, 2)).image);
+  const std::size_t removed = SouthObject(objects);
+  const double x = objects[removed].centre.x();
+  const change::KeyFrameView prior = Describe(Render(x, objects, sim::DrawLighting(1, 1)).image);
+  objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(removed));
+  const change::KeyFrameView current = Describe(Render(x + 0.3, objects, sim::DrawLighting(1, 2)).image);
+  state.counters["object_x"] = x;
   change::AppearanceChange change;
   for (auto _ : state) change = change::DetectAppearanceChange(prior, current, change::AppearanceOptions{});
   state.counters["inliers"] = change.inliers;
