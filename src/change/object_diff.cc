@@ -97,6 +97,19 @@ struct Pair {
   double cost;
 };
 
+// A change that involves a prior object (`prior` may be null for new ones) and a current one (may be null).
+ObjectChange MakeChange(ObjectState state, const MapObject* prior, const MapObject* current, double confidence,
+                        int covering_views = 0) {
+  ObjectChange change;
+  change.state = state;
+  change.label = prior != nullptr ? prior->label : current->label;
+  change.confidence = confidence;
+  change.covering_views = covering_views;
+  if (prior != nullptr) change.prior_id = prior->id, change.before = prior->centroid;
+  if (current != nullptr) change.current_id = current->id, change.after = current->centroid;
+  return change;
+}
+
 // Greedy assignment in ascending cost.
 void AssignGreedy(std::vector<Pair> pairs, std::vector<bool>* prior_used, std::vector<bool>* current_used,
                   std::vector<Pair>* chosen) {
@@ -158,73 +171,72 @@ int CoveringViews(const MapObject& object, const PatrolRecord& current, const Ob
   return views;
 }
 
-std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
-                                      const ObjectDiffOptions& options) {
-  const std::vector<MapObject>& p = prior.objects;
-  const std::vector<MapObject>& c = current.objects;
-  std::vector<bool> prior_used(p.size(), false), current_used(c.size(), false);
-  std::vector<ObjectChange> changes;
+namespace {
 
-  // Persistent: same label, close, and (with points) passing the point-pair test.
+// The two object maps being compared and which of their objects a state has taken.
+struct Matching {
+  const std::vector<MapObject>& p;
+  const std::vector<MapObject>& c;
+  std::vector<bool> prior_used, current_used;
+  std::vector<int> views;  // covering views of each prior object (those not persistent)
+};
+
+// Persistent: same label, close, and (with points) passing the point-pair test; nearest first.
+void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<ObjectChange>* changes) {
   std::vector<Pair> close, persistent;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (std::size_t j = 0; j < c.size(); ++j) {
-      const double distance = (p[i].centroid - c[j].centroid).norm();
-      if (p[i].label != c[j].label || distance > options.match_distance_m) continue;
-      if (!p[i].points.empty() && !c[j].points.empty() &&
-          PairFraction(c[j].points, p[i].points, kPairDistance) < kMinPairFraction) {
+  for (std::size_t i = 0; i < m->p.size(); ++i) {
+    for (std::size_t j = 0; j < m->c.size(); ++j) {
+      const MapObject &a = m->p[i], &b = m->c[j];
+      const double distance = (a.centroid - b.centroid).norm();
+      if (a.label != b.label || distance > options.match_distance_m) continue;
+      if (!a.points.empty() && !b.points.empty() && PairFraction(b.points, a.points, kPairDistance) < kMinPairFraction) {
         continue;
       }
       close.push_back({static_cast<int>(i), static_cast<int>(j), distance});
     }
   }
-  AssignGreedy(close, &prior_used, &current_used, &persistent);
+  AssignGreedy(close, &m->prior_used, &m->current_used, &persistent);
   for (const Pair& pair : persistent) {
-    ObjectChange change;
-    change.state = ObjectState::kPersistent;
-    change.label = p[pair.prior].label;
-    change.prior_id = p[pair.prior].id, change.current_id = c[pair.current].id;
-    change.before = p[pair.prior].centroid, change.after = c[pair.current].centroid;
-    change.confidence = std::min(p[pair.prior].confidence, c[pair.current].confidence) *
-                        (1.0 - pair.cost / (2.0 * options.match_distance_m));
-    changes.push_back(change);
+    const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
+    const double confidence = std::min(a.confidence, b.confidence) * (1.0 - pair.cost / (2.0 * options.match_distance_m));
+    changes->push_back(MakeChange(ObjectState::kPersistent, &a, &b, confidence));
   }
+}
 
-  // Unmatched prior objects: removed candidates when covered, else unobserved.
-  std::vector<int> views(p.size(), 0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (prior_used[i]) continue;
+// Unmatched prior objects too few current views covered are unobserved; the others may be removed or moved.
+void MarkUnobserved(const PatrolRecord& current, const ObjectDiffOptions& options, Matching* m,
+                    std::vector<ObjectChange>* changes) {
+  m->views.assign(m->p.size(), 0);
+  for (std::size_t i = 0; i < m->p.size(); ++i) {
+    if (m->prior_used[i]) continue;
     std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved
-    for (std::size_t j = 0; j < c.size(); ++j) {
-      if (!current_used[j] && c[j].label == p[i].label && (c[j].centroid - p[i].centroid).norm() <= options.max_move_m) {
-        candidates.push_back(&c[j]);
+    for (std::size_t j = 0; j < m->c.size(); ++j) {
+      if (!m->current_used[j] && m->c[j].label == m->p[i].label &&
+          (m->c[j].centroid - m->p[i].centroid).norm() <= options.max_move_m) {
+        candidates.push_back(&m->c[j]);
       }
     }
-    views[i] = CoveringViews(p[i], current, options, candidates);
-    if (views[i] >= options.min_visible_views) continue;
-    prior_used[i] = true;
-    ObjectChange change;
-    change.state = ObjectState::kUnobserved;
-    change.label = p[i].label;
-    change.prior_id = p[i].id;
-    change.before = p[i].centroid;
-    change.covering_views = views[i];
-    change.confidence = p[i].confidence;
-    changes.push_back(change);
+    m->views[i] = CoveringViews(m->p[i], current, options, candidates);
+    if (m->views[i] >= options.min_visible_views) continue;
+    m->prior_used[i] = true;
+    changes->push_back(MakeChange(ObjectState::kUnobserved, &m->p[i], nullptr, m->p[i].confidence, m->views[i]));
   }
+}
 
-  // Moved (paper 003): weighted, min-max normalised physical and appearance distances.
+// Move candidates (paper 003): same label within max_move_m and alike in texture, ordered by the weighted,
+// min-max normalised physical and appearance distances. The normalised distance only orders them: the
+// worst candidate always scores 1, so the gates are absolute.
+std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matching& m) {
   std::vector<Pair> candidates;
-  std::vector<double> physical, appearance, textures;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    for (std::size_t j = 0; j < c.size(); ++j) {
-      if (prior_used[i] || current_used[j] || p[i].label != c[j].label) continue;
-      const double distance = (p[i].centroid - c[j].centroid).norm();
-      if (distance > options.max_move_m) continue;
+  std::vector<double> physical, appearance;
+  for (std::size_t i = 0; i < m.p.size(); ++i) {
+    for (std::size_t j = 0; j < m.c.size(); ++j) {
+      if (m.prior_used[i] || m.current_used[j] || m.p[i].label != m.c[j].label) continue;
+      const double distance = (m.p[i].centroid - m.c[j].centroid).norm();
+      const AppearanceTerms terms = CompareAppearance(m.p[i], m.c[j]);
+      if (distance > options.max_move_m || terms.texture.value_or(0.0) > options.max_texture_distance) continue;
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
       physical.push_back(distance);
-      const AppearanceTerms terms = CompareAppearance(p[i], c[j]);
-      textures.push_back(terms.texture.value_or(0.0));
       appearance.push_back(terms.Distance());
     }
   }
@@ -232,51 +244,44 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
     const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
     return *hi - *lo > 1e-12 ? (values[k] - *lo) / (*hi - *lo) : 0.0;
   };
-  // Paper 003's weighted normalised distance orders the candidates; the gates are absolute (min-max
-  // normalised values cannot reject anything: the worst candidate is always 1).
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     candidates[k].cost = options.physical_weight * normalise(physical, k) + options.appearance_weight * normalise(appearance, k);
   }
-  std::vector<Pair> gated;
-  for (std::size_t k = 0; k < candidates.size(); ++k) {
-    if (textures[k] <= options.max_texture_distance) gated.push_back(candidates[k]);
-  }
-  candidates.swap(gated);
-  std::vector<Pair> moved;
-  AssignGreedy(candidates, &prior_used, &current_used, &moved);
-  for (const Pair& pair : moved) {
-    ObjectChange change;
-    change.state = ObjectState::kMoved;
-    change.label = p[pair.prior].label;
-    change.prior_id = p[pair.prior].id, change.current_id = c[pair.current].id;
-    change.before = p[pair.prior].centroid, change.after = c[pair.current].centroid;
-    change.covering_views = views[pair.prior];
-    change.weighted_distance = pair.cost;
-    change.rotation = RegisterRotation(p[pair.prior].points, c[pair.current].points);
-    change.confidence = std::min(p[pair.prior].confidence, c[pair.current].confidence) * (1.0 - 0.5 * pair.cost);
-    changes.push_back(change);
-  }
+  return candidates;
+}
 
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (prior_used[i]) continue;
-    ObjectChange change;
-    change.state = ObjectState::kRemoved;
-    change.label = p[i].label;
-    change.prior_id = p[i].id;
-    change.before = p[i].centroid;
-    change.covering_views = views[i];
-    change.confidence = p[i].confidence * std::min(1.0, views[i] / (2.0 * options.min_visible_views));
-    changes.push_back(change);
+void MatchMoved(const ObjectDiffOptions& options, Matching* m, std::vector<ObjectChange>* changes) {
+  std::vector<Pair> moved;
+  AssignGreedy(MoveCandidates(options, *m), &m->prior_used, &m->current_used, &moved);
+  for (const Pair& pair : moved) {
+    const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
+    ObjectChange change = MakeChange(ObjectState::kMoved, &a, &b, std::min(a.confidence, b.confidence) * (1.0 - 0.5 * pair.cost),
+                                     m->views[pair.prior]);
+    change.weighted_distance = pair.cost;
+    change.rotation = RegisterRotation(a.points, b.points);
+    changes->push_back(change);
   }
-  for (std::size_t j = 0; j < c.size(); ++j) {
-    if (current_used[j]) continue;
-    ObjectChange change;
-    change.state = ObjectState::kNew;
-    change.label = c[j].label;
-    change.current_id = c[j].id;
-    change.after = c[j].centroid;
-    change.confidence = c[j].confidence * std::min(1.0, c[j].detections / 10.0);
-    changes.push_back(change);
+}
+
+}  // namespace
+
+std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
+                                      const ObjectDiffOptions& options) {
+  Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
+             std::vector<bool>(current.objects.size(), false), {}};
+  std::vector<ObjectChange> changes;
+  MatchPersistent(options, &m, &changes);
+  MarkUnobserved(current, options, &m, &changes);
+  MatchMoved(options, &m, &changes);
+  for (std::size_t i = 0; i < m.p.size(); ++i) {
+    if (m.prior_used[i]) continue;
+    const double confidence = m.p[i].confidence * std::min(1.0, m.views[i] / (2.0 * options.min_visible_views));
+    changes.push_back(MakeChange(ObjectState::kRemoved, &m.p[i], nullptr, confidence, m.views[i]));
+  }
+  for (std::size_t j = 0; j < m.c.size(); ++j) {
+    if (m.current_used[j]) continue;
+    const double confidence = m.c[j].confidence * std::min(1.0, m.c[j].detections / 10.0);
+    changes.push_back(MakeChange(ObjectState::kNew, nullptr, &m.c[j], confidence));
   }
   return changes;
 }
