@@ -49,7 +49,7 @@ print('  voxels: precision %.3f recall %.3f IoU %.3f, %d regions' % (g['precisio
 
 series changed
 json="$work/changed.json"
-# Measured on this series: every object state and the geometry come out at or near 1.0 (BENCHMARKS.md);
+# Measured on this series: every object state F1 1.0, voxels precision 0.999 and recall 0.949;
 # the bounds leave room for one object more or less.
 check "new objects F1" "r['objects']['new']['f1'] >= 0.66" "$json"
 check "removed objects F1" "r['objects']['removed']['f1'] >= 0.8" "$json"

@@ -232,7 +232,10 @@ TEST(ObjectMap, DetectionsBecomeObjectsWithAccumulatedLabels) {
     mapper.AddFrame(detections, pose, cv::Mat(), cv::Mat());
   }
   const std::vector<MapObject> objects = mapper.Finish();
-  ASSERT_EQ(objects.size(), 2u);  // the single false detection is below min_detections
+  ASSERT_EQ(objects.size(), 3u);
+  EXPECT_TRUE(objects[0].confirmed && objects[1].confirmed);
+  EXPECT_FALSE(objects[2].confirmed);  // the single false detection is below min_detections
+  EXPECT_EQ(objects[2].detections, 1);
   EXPECT_EQ(objects[0].label, "crate");
   EXPECT_NEAR(objects[0].confidence, 0.8, 1e-9);
   EXPECT_EQ(objects[0].detections, 12);
@@ -315,6 +318,18 @@ TEST(ObjectStates, PersistentMovedRemovedNewAndUnobserved) {
     EXPECT_GE(c.confidence, 0.0);
     EXPECT_LE(c.confidence, 1.0);
   }
+}
+
+TEST(ObjectStates, UnconfirmedObjectsAreNeverReportedButExplainLaterSightings) {
+  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}, {"barrel", {12, 2, 0.5}}});
+  prior.objects[0].confirmed = false;  // seen once in the prior patrol
+  prior.objects[1].confirmed = false;
+  PatrolRecord current = Patrol({{"crate", {10.1, 0, 0.5}}, {"vehicle", {14, -2, 0.75}}});
+  current.objects[1].confirmed = false;
+  const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 1u);  // no removed barrel, no new vehicle
+  EXPECT_EQ(changes[0].state, ObjectState::kPersistent);
+  EXPECT_EQ(changes[0].label, "crate");
 }
 
 TEST(ObjectStates, AnOccupiedWallHidesAPriorObject) {

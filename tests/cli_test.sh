@@ -55,7 +55,7 @@ expect "malformed csv" 1 "cam0/data.csv:7: column 'timestamp \[ns\]': not an int
 expect "sample detect" 0 "421 frames, 85 processed, 3 key locations" -- \
   "$bin" detect "$source_dir/flight_logs/sample" --out "$work/sample"
 expect "sample eval" 0 "street-1 +421 +3 +3 +3 +0 +0" -- "$bin" eval "$work/sample" --log "$source_dir/flight_logs/sample"
-expect "eval without outputs" 1 "holds neither key_locations.csv nor loop_closures.csv" -- \
+expect "eval without outputs" 1 "holds none of key_locations.csv, loop_closures.csv, changes.json" -- \
   "$bin" eval "$work/empty" --log "$source_dir/flight_logs/sample"
 expect "unknown route" 2 "unknown route 'zigzag'" -- "$bin" simulate --route zigzag --out "$work/z"
 

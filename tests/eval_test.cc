@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "patrolmap/eval/change_score.h"
 #include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/eval/loop_closure_score.h"
 #include "test_util.h"
@@ -165,6 +166,71 @@ TEST(ReadFiles, NodesClosuresAndPlaces) {
   testing::WriteText(dir / "nodes.csv", "id,flight\n");
   EXPECT_NE(ReadNodesCsv(dir / "nodes.csv", &nodes).message().find("nodes.csv:1: header must start with 'node'"),
             std::string::npos);
+}
+
+
+TruthObject Truth(int id, const char* label, double x, double y, int detections) {
+  TruthObject o;
+  o.id = id, o.label = label, o.centre = Eigen::Vector2d(x, y);
+  o.length = o.width = o.height = 1.0;
+  o.detections = detections;
+  return o;
+}
+
+TEST(ChangeScore, ObjectStatesPerStateWithOptionalSightings) {
+  const std::vector<TruthObject> before = {Truth(1, "crate", 0, 0, 10), Truth(2, "crate", 5, 0, 10),
+                                           Truth(3, "barrel", 9, 0, 10), Truth(4, "crate", 20, 0, 1),
+                                           Truth(6, "vehicle", 30, 0, 9)};
+  const std::vector<TruthObject> after = {Truth(1, "crate", 0, 0, 10), Truth(2, "crate", 8, 0, 10),
+                                          Truth(4, "crate", 20, 0, 12), Truth(5, "crate", 12, 0, 10),
+                                          Truth(6, "vehicle", 34, 0, 1)};
+  // 1 persistent, 2 moved, 3 removed, 4 stayed but seen once before (optional), 5 new, 6 moved out of sight
+  // after (removed as a patrol can know it).
+  const auto at = [](double x) { return Eigen::Vector3d(x, 0.1, 0.5); };
+  const std::vector<ReportedObject> reported = {
+      {"persistent", "crate", at(0), at(0)},  {"moved", "crate", at(5), at(8.3)}, {"removed", "barrel", at(9), {}},
+      {"new", "crate", {}, at(20.2)},          {"new", "crate", {}, at(12)},      {"removed", "vehicle", at(30), {}},
+      {"new", "barrel", {}, at(40)},           {"unobserved", "crate", at(50), {}}};
+  const ObjectChangeScore score = ScoreObjectChanges(reported, before, after, ChangeScoreOptions{});
+  EXPECT_EQ(score.by_state.at("persistent").true_positives, 1);
+  EXPECT_EQ(score.by_state.at("moved").true_positives, 1);
+  EXPECT_EQ(score.by_state.at("removed").true_positives, 2);
+  EXPECT_EQ(score.by_state.at("removed").false_negatives, 0);
+  const Counts& fresh = score.by_state.at("new");
+  EXPECT_EQ(fresh.true_positives, 1);   // object 5
+  EXPECT_EQ(fresh.false_positives, 1);  // the barrel at 40 m; object 4 reported new is optional, no error
+  EXPECT_EQ(fresh.false_negatives, 0);
+  EXPECT_DOUBLE_EQ(fresh.Precision(), 0.5);
+  EXPECT_NEAR(fresh.F1(), 2.0 / 3.0, 1e-12);
+  EXPECT_EQ(score.unobserved, 1);
+  // A label that disagrees or a position 1 m off is no hit.
+  const ObjectChangeScore wrong = ScoreObjectChanges({{"removed", "crate", at(9), {}}, {"new", "crate", {}, at(13.2)}},
+                                                     before, after, ChangeScoreOptions{});
+  EXPECT_EQ(wrong.by_state.at("removed").true_positives, 0);
+  EXPECT_EQ(wrong.by_state.at("new").false_positives, 1);
+}
+
+TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
+  // One 1 m crate (centre (1, 1), z 0..1) removed between the flights; 0.2 m voxels.
+  const std::vector<TruthObject> before = {Truth(1, "crate", 1.0, 1.0, 10)};
+  const std::vector<TruthObject> after;
+  EvidenceGridData a, b;
+  a.voxel_size = b.voxel_size = 0.2;
+  const auto add = [](EvidenceGridData* g, int x, int y, int z, int hits, int passes) {
+    g->voxels.push_back({x, y, z, static_cast<std::uint16_t>(hits), static_cast<std::uint16_t>(passes)});
+  };
+  add(&a, 4, 5, 2, 9, 0), add(&b, 4, 5, 2, 0, 9);    // inside the crate's face: core, reported
+  add(&a, 5, 5, 2, 9, 0), add(&b, 5, 5, 2, 0, 9);    // core, missed
+  add(&a, 7, 5, 2, 5, 5), add(&b, 7, 5, 2, 0, 9);    // centre 1.4: 0.1 m outside the face, band, reported
+  add(&a, 9, 5, 2, 0, 9), add(&b, 9, 5, 2, 0, 9);    // free in both, reported: false
+  add(&a, 12, 5, 2, 9, 0);                            // not observed in the second flight: never counted
+  const std::vector<Eigen::Vector3i> changed = {{4, 5, 2}, {7, 5, 2}, {9, 5, 2}, {12, 5, 2}};
+  const GeometryScore score = ScoreGeometry(changed, a, b, before, after, ChangeScoreOptions{});
+  EXPECT_EQ(score.observed_voxels, 4);
+  EXPECT_EQ(score.voxels.true_positives, 2);
+  EXPECT_EQ(score.voxels.false_positives, 1);
+  EXPECT_EQ(score.voxels.false_negatives, 1);
+  EXPECT_DOUBLE_EQ(score.Iou(), 0.5);
 }
 
 }  // namespace

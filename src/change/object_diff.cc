@@ -198,6 +198,7 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
   AssignGreedy(close, &m->prior_used, &m->current_used, &persistent);
   for (const Pair& pair : persistent) {
     const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
+    if (!a.confirmed && !b.confirmed) continue;
     const double confidence = std::min(a.confidence, b.confidence) * (1.0 - pair.cost / (2.0 * options.match_distance_m));
     changes->push_back(MakeChange(ObjectState::kPersistent, &a, &b, confidence));
   }
@@ -207,6 +208,9 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
 void MarkUnobserved(const PatrolRecord& current, const ObjectDiffOptions& options, Matching* m,
                     std::vector<ObjectChange>* changes) {
   m->views.assign(m->p.size(), 0);
+  // Unconfirmed objects only explained sightings as persistent; they take no other state.
+  for (std::size_t i = 0; i < m->p.size(); ++i) m->prior_used[i] = m->prior_used[i] || !m->p[i].confirmed;
+  for (std::size_t j = 0; j < m->c.size(); ++j) m->current_used[j] = m->current_used[j] || !m->c[j].confirmed;
   for (std::size_t i = 0; i < m->p.size(); ++i) {
     if (m->prior_used[i]) continue;
     std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved

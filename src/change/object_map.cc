@@ -343,8 +343,9 @@ std::vector<MapObject> ObjectMapper::Finish() const {
   }
   std::vector<MapObject> kept;
   for (std::size_t i = 0; i < merged.size(); ++i) {
-    if (!alive[i] || merged[i].detections < options_.min_detections) continue;
+    if (!alive[i]) continue;
     kept.push_back(std::move(merged[i]));
+    kept.back().confirmed = kept.back().detections >= options_.min_detections;
     kept.back().id = static_cast<int>(kept.size()) - 1;
     kept.back().height = PointHeight(kept.back().points);
   }

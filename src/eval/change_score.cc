@@ -21,6 +21,7 @@ const TruthObject* FindId(const std::vector<TruthObject>& objects, int id) {
 struct TruthChange {
   std::string state, label;
   std::optional<Eigen::Vector2d> before, after;
+  bool required = true;  // false: reporting it is no error, missing it neither
 };
 
 // The true changes as a patrolling robot can know them: an object that moved counts as moved when the
@@ -40,6 +41,11 @@ std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, co
     const bool moved = (a->centre - b.centre).norm() > kSamePlace;
     if (seen_before && seen_after) {
       truth.push_back({moved ? "moved" : "persistent", b.label, b.centre, a->centre});
+    } else if (!moved && b.detections + a->detections > 0) {
+      // Stayed, seen too rarely in one flight: persistent if the patrol links the sightings, new if it
+      // could not (it never saw it before) — both are right.
+      truth.push_back({"persistent", b.label, b.centre, a->centre, false});
+      if (seen_after) truth.push_back({"new", a->label, std::nullopt, a->centre, false});
     } else if (moved && seen_before) {
       truth.push_back({"removed", b.label, b.centre, std::nullopt});
     } else if (moved && seen_after) {
@@ -135,7 +141,7 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
     };
     std::vector<Candidate> candidates;
     int reported_count = 0, truth_count = 0;
-    for (std::size_t t = 0; t < truth.size(); ++t) truth_count += truth[t].state == state;
+    for (std::size_t t = 0; t < truth.size(); ++t) truth_count += truth[t].state == state && truth[t].required;
     for (std::size_t r = 0; r < reported.size(); ++r) {
       if (reported[r].state != state) continue;
       ++reported_count;
@@ -148,12 +154,13 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
     std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
     std::vector<bool> r_used(reported.size()), t_used(truth.size());
     Counts& counts = score.by_state[state];
+    int optional_matches = 0;
     for (const Candidate& c : candidates) {
       if (r_used[c.r] || t_used[c.t]) continue;
       r_used[c.r] = t_used[c.t] = true;
-      ++counts.true_positives;
+      ++(truth[c.t].required ? counts.true_positives : optional_matches);
     }
-    counts.false_positives = reported_count - counts.true_positives;
+    counts.false_positives = reported_count - counts.true_positives - optional_matches;
     counts.false_negatives = truth_count - counts.true_positives;
   }
   for (const ReportedObject& r : reported) score.unobserved += r.state == "unobserved";

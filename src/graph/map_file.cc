@@ -155,6 +155,7 @@ void WriteObject(const MapObject& o, Writer* w) {
   w->String(o.label);
   w->Value(o.confidence);
   w->Value<std::int32_t>(o.detections);
+  w->Value<std::uint8_t>(o.confirmed ? 1 : 0);
   for (const Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
     for (int k = 0; k < 3; ++k) w->Value((*v)[k]);
   }
@@ -270,6 +271,7 @@ MapObject ReadObject(Reader* r) {
   o.label = r->String();
   o.confidence = r->Value<double>();
   o.detections = r->Value<std::int32_t>();
+  o.confirmed = r->Value<std::uint8_t>() != 0;
   for (Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
     for (int k = 0; k < 3; ++k) (*v)[k] = r->Value<double>();
   }

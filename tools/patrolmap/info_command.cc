@@ -1,4 +1,5 @@
 // patrolmap info MAP
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -35,16 +36,21 @@ int RunInfo(const std::string& path, bool verbose) {
     }
     std::printf("  flight %-24s %4d nodes, %.1f-%.1f s", flight.c_str(), nodes, first, last);
     const PatrolRecord* record = map.Patrol(flight);
-    if (record != nullptr && record->has_objects) std::printf(", %zu objects", record->objects.size());
+    if (record != nullptr && record->has_objects) {
+      const auto confirmed = std::count_if(record->objects.begin(), record->objects.end(),
+                                           [](const MapObject& o) { return o.confirmed; });
+      std::printf(", %zu objects (%zu unconfirmed)", static_cast<std::size_t>(confirmed),
+                  record->objects.size() - static_cast<std::size_t>(confirmed));
+    }
     if (record != nullptr && record->grid.voxel_size > 0) {
       std::printf(", evidence grid %zu voxels of %.2f m", record->grid.voxels.size(), record->grid.voxel_size);
     }
     std::printf("\n");
     if (record == nullptr || !verbose) continue;
     for (const MapObject& o : record->objects) {
-      std::printf("    object %3d %-10s confidence %.2f, %3d detections at (%.2f, %.2f, %.2f), %zu points\n", o.id,
+      std::printf("    object %3d %-10s confidence %.2f, %3d detections at (%.2f, %.2f, %.2f), %zu points%s\n", o.id,
                   o.label.c_str(), o.confidence, o.detections, o.centroid.x(), o.centroid.y(), o.centroid.z(),
-                  o.points.size());
+                  o.points.size(), o.confirmed ? "" : ", unconfirmed");
     }
   }
   return 0;

@@ -10,6 +10,9 @@
 //               nothing matched;
 //   unobserved  a prior object too few current views covered: its state is unknown;
 //   new         a current object matching nothing of the prior patrol.
+// Unconfirmed objects (seen too few times) take part only in the persistent
+// matching: a current object at the place of an unconfirmed prior one is
+// persistent, not new; unconfirmed objects are never reported themselves.
 #pragma once
 
 #include <optional>

@@ -9,9 +9,9 @@
 // at least half of the object's points it sees lie on its depth surface.
 // Every object accumulates label-confidence and label-count pairs; Finish()
 // merges objects whose centroids ended up within merge_distance_m (one object
-// split by a failed association), keeps objects with enough detections and
-// gives each the label with the highest accumulated confidence and that
-// label's mean confidence.
+// split by a failed association), marks objects with too few detections
+// unconfirmed and gives each the label with the highest accumulated
+// confidence and that label's mean confidence.
 #pragma once
 
 #include <array>
@@ -36,7 +36,8 @@ class ObjectMapper {
   void AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
                 const cv::Mat& depth_m, const cv::Mat& image);
 
-  // The objects seen at least min_detections times, with their final label and confidence.
+  // The objects with their final label and confidence; those seen fewer than min_detections times are
+  // kept unconfirmed (they are not reported, but a later patrol's sighting there is then no new object).
   std::vector<MapObject> Finish() const;
 
   int associations() const { return associations_; }   // detections compared with the map

@@ -32,7 +32,7 @@ struct ObjectMapOptions {
   double vehicle_sigma_m = 1.0;       // ... wider for vehicles (labels containing "vehicle", "car", "truck")
   double min_category_prior = 0.1;    // 2D test: smallest prior probability accepted
   double merge_distance_m = 0.5;      // when the patrol ends, objects whose centroids are this close merge
-  int min_detections = 3;             // objects seen fewer times are dropped when the patrol ends
+  int min_detections = 3;             // objects seen fewer times stay unconfirmed: never reported themselves
   double max_range_m = 25.0;          // detections farther than this are ignored
 };
 

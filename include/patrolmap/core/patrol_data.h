@@ -45,6 +45,7 @@ struct MapObject {
   std::string label;                 // the label with the highest accumulated confidence
   double confidence = 0.0;           // mean confidence of the detections with that label
   int detections = 0;
+  bool confirmed = true;             // seen often enough to count; unconfirmed ones only explain later sightings
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // world frame [m]
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (or of its centroids)
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();

@@ -8,7 +8,9 @@
 // when the detector reported it at least `min_detections` times there
 // (groundtruth/detections.csv); a moved object seen in both flights is moved,
 // seen only before removed, seen only after new; an object that stayed counts
-// (as persistent) only when seen in both.
+// as persistent when seen in both. One that stayed but was seen too rarely in
+// one flight is optional: reported persistent (or new, when the patrol never
+// saw it before) it is no error, unreported no miss.
 // A reported object is a hit when a true object of the same state and label
 // lies within `distance_m` (moved: both its positions). Per state: precision,
 // recall and F1, one-to-one matching nearest first.
