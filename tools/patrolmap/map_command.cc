@@ -1,4 +1,5 @@
 // patrolmap map LOG [LOG ...] --out DIR [--config FILE] [--vocabulary FILE] [--every-frame]
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -71,7 +72,10 @@ Status RecordPatrol(const std::string& log, const pipeline::Config& config, cons
       log, config, 0, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
   record.feature_image_width = FeatureWidth(result, record.flight);
   if (record.has_objects) {
-    spdlog::info("{}: {} objects from {} detections ({:.2f} ms per association)", record.flight, record.objects.size(),
+    const auto confirmed =
+        std::count_if(record.objects.begin(), record.objects.end(), [](const MapObject& o) { return o.confirmed; });
+    spdlog::info("{}: {} objects ({} more seen too rarely) from {} detections ({:.3f} ms per association)",
+                 record.flight, confirmed, record.objects.size() - static_cast<std::size_t>(confirmed),
                  stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
   }
   if (record.grid.voxel_size > 0) {
