@@ -25,6 +25,7 @@ check() {  # check NAME PYTHON-EXPRESSION-ON-r (r: the eval JSON's "changes")
 }
 
 # Logs at 376x240 processed at full scale (what a 752x480 log gives the stages after their 0.5 downscale).
+vocabulary="$source_dir/vocab/default.pmvoc"
 config="$work/study.yaml"
 printf 'flow:\n  frames:\n    scale: 1.0\n' > "$config"
 
@@ -33,9 +34,9 @@ series() {  # series NAME EXTRA-SIMULATE-OPTIONS...
   shift
   "$bin" simulate --route l-shape --seed 1 --flights 2 --objects 20 --detections --depth --resolution 376x240 \
     "$@" --out "$work/$name" >/dev/null
-  "$bin" map "$work/$name/flight_1" -c "$config" --out "$work/$name-1" >/dev/null
-  "$bin" patrol "$work/$name/flight_2" --map "$work/$name-1/map.pmap" -c "$config" --out "$work/$name-2" |
-    tail -1
+  "$bin" map "$work/$name/flight_1" -c "$config" --vocabulary "$vocabulary" --out "$work/$name-1" >/dev/null
+  "$bin" patrol "$work/$name/flight_2" --map "$work/$name-1/map.pmap" -c "$config" --vocabulary "$vocabulary" \
+    --out "$work/$name-2" | tail -1
   "$bin" eval "$work/$name-2" --log "$work/$name/flight_2" --log "$work/$name/flight_1" -c "$config" --json \
     > "$work/$name.json"
   $py -c "
