@@ -102,6 +102,17 @@ check "lighting only: no object changed" \
 check "lighting only: no geometry region" "r['geometry']['regions'] == 0" "$json"
 check "lighting only: no appearance region" "r['places_changed'] == 0" "$json"
 
+# An unreadable depth image is named, left out, and the patrol goes on (the grid integrates the first frame).
+corrupted="$work/lighting/flight_2/depth0/data/$(ls "$work/lighting/flight_2/depth0/data" | sort -n | sed -n 1p)"
+echo "not a png" > "$corrupted"
+if "$bin" patrol "$work/lighting/flight_2" --map "$work/lighting-1/map.pmap" -c "$config" --vocabulary "$vocabulary" \
+     --out "$work/corrupt" > /dev/null 2> "$work/corrupt.err" &&
+   grep -q "$corrupted: cannot decode depth image; skipped" "$work/corrupt.err" && [ -f "$work/corrupt/changes.json" ]; then
+  echo "ok   an unreadable depth image is named and skipped"
+else
+  echo "FAIL unreadable depth image: $(cat "$work/corrupt.err")"; failures=$((failures + 1))
+fi
+
 if [ "$failures" != 0 ]; then
   echo "$failures check(s) failed"
   exit 1

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <memory>
 
+#include <spdlog/spdlog.h>
+
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/io/patrol_sensors.h"
@@ -16,6 +18,16 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Reads a depth image; an unreadable one is reported, counted and left empty (the patrol goes on without it).
+bool ReadDepthOrSkip(const std::string& path, cv::Mat* depth, PatrolRecordStats* stats) {
+  const Status status = io::ReadDepthImage(path, depth);
+  if (status.ok()) return true;
+  spdlog::warn("{}; skipped", status.message());
+  if (stats != nullptr) ++stats->skipped_depth_frames;
+  depth->release();
+  return false;
 }
 
 void SampleViews(const std::vector<CameraPoseSample>& poses, std::vector<CameraPoseSample>* views) {
@@ -51,7 +63,7 @@ Status BuildObjectMap(const std::string& log, const io::PatrolSensors& sensors, 
     depth.release();
     const auto depth_at = std::lower_bound(depth_times.begin(), depth_times.end(), frame.timestamp_ns);
     if (depth_at != depth_times.end() && *depth_at == frame.timestamp_ns) {
-      PATROLMAP_RETURN_IF_ERROR(io::ReadDepthImage(sensors.depth[depth_at - depth_times.begin()].path, &depth));
+      ReadDepthOrSkip(sensors.depth[depth_at - depth_times.begin()].path, &depth, stats);
     }
     mapper.AddFrame(frame_detections, *pose, depth, frame.image);
     if (progress) progress(static_cast<std::int64_t>(next), static_cast<std::int64_t>(all.size()));
@@ -80,9 +92,12 @@ Status BuildGrid(const io::PatrolSensors& sensors, const Config& config, PatrolR
     if (entry.timestamp_ns < next) continue;
     const std::optional<CameraPoseSample> pose = io::PoseAt(sensors.poses, entry.timestamp_ns);
     if (!pose) continue;
-    PATROLMAP_RETURN_IF_ERROR(io::ReadDepthImage(entry.path, &depth));
+    if (!ReadDepthOrSkip(entry.path, &depth, stats)) continue;
     if (depth.cols != record->camera.width || depth.rows != record->camera.height) {
-      return Status::DataLoss(entry.path + ": depth image size differs from the camera's");
+      spdlog::warn("{}: depth image is {}x{}, the camera {}x{}; skipped", entry.path, depth.cols, depth.rows,
+                   record->camera.width, record->camera.height);
+      if (stats != nullptr) ++stats->skipped_depth_frames;
+      continue;
     }
     grid.Integrate(depth, record->camera, *pose);
     next = entry.timestamp_ns + step;

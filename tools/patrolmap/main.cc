@@ -1,6 +1,7 @@
 // patrolmap: topological appearance mapping for UAV patrols (offline front end).
 #include <map>
 
+#include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : 2;
   }
+  spdlog::set_default_logger(spdlog::stderr_logger_mt("patrolmap"));  // results on stdout, messages on stderr
   spdlog::set_pattern("%l: %v");
   spdlog::set_level(quiet ? spdlog::level::err : spdlog::level::info);
   for (const auto& [sub, command] : commands) {

@@ -17,6 +17,7 @@ struct PatrolRecordStats {
   int detections = 0, associations = 0, skipped_detections = 0;
   double association_seconds = 0.0;
   int depth_frames = 0;
+  int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
 };
@@ -25,7 +26,8 @@ using ChangeProgress = std::function<void(std::int64_t, std::int64_t)>;
 
 // The patrol record of `log`: its camera, views sampled along the state
 // estimate, the object map (when it has objects0/) and the evidence grid
-// (when it has depth0/). Without poses only the camera is filled.
+// (when it has depth0/). Without poses only the camera is filled. An
+// unreadable depth image is reported on stderr, counted and left out.
 // `feature_image_width` is the width its key-frame features were found at.
 Status BuildPatrolRecord(const std::string& log, const Config& config, int feature_image_width, PatrolRecord* record,
                          PatrolRecordStats* stats = nullptr, const ChangeProgress& progress = {});
