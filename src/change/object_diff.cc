@@ -14,6 +14,7 @@ namespace {
 
 constexpr double kPairDistance = 0.25;      // point-pair test between patrols [m]
 constexpr double kMinPairFraction = 0.5;
+constexpr double kMovedPairDistance = 0.15;  // point-pair test of a moved object's shape [m]
 constexpr double kMinClearance = 1.0;       // voxels this close to an object do not hide it, nor within its half size [m]
 
 // A voxel counts as occupied when most rays ended in it and at least two did.
@@ -96,6 +97,17 @@ struct Pair {
   int prior, current;
   double cost;
 };
+
+// Paper 000's point-pair test for a moved object: the share of the current object's points that, shifted
+// by the centroid difference, lie within kPairDistance of the prior object's points. 1 without points.
+double MovedShapeOverlap(const MapObject& prior, const MapObject& current) {
+  if (prior.points.empty() || current.points.empty()) return 1.0;
+  const Eigen::Vector3f shift = (prior.centroid - current.centroid).cast<float>();
+  std::vector<Eigen::Vector3f> moved;
+  moved.reserve(current.points.size());
+  for (const Eigen::Vector3f& point : current.points) moved.push_back(point + shift);
+  return PairFraction(moved, prior.points, kMovedPairDistance);
+}
 
 // A change that involves a prior object (`prior` may be null for new ones) and a current one (may be null).
 ObjectChange MakeChange(ObjectState state, const MapObject* prior, const MapObject* current, double confidence,
@@ -239,6 +251,7 @@ std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matchin
       const double distance = (m.p[i].centroid - m.c[j].centroid).norm();
       const AppearanceTerms terms = CompareAppearance(m.p[i], m.c[j]);
       if (distance > options.max_move_m || terms.texture.value_or(0.0) > options.max_texture_distance) continue;
+      if (MovedShapeOverlap(m.p[i], m.c[j]) < options.min_shape_overlap) continue;
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
       physical.push_back(distance);
       appearance.push_back(terms.Distance());

@@ -46,6 +46,8 @@ struct ObjectDiffOptions {
                                       // L1 distance) are not a move
   double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
   double image_margin_px = 4.0;       // visibility: its projected centroid must lie this far inside the image
+  double min_shape_overlap = 0.85;    // moved: share of the current object's points, shifted onto the prior
+                                      // object, within 0.15 m of its points (1 when either has none)
   int min_visible_views = 8;          // fewer covering views (sampled at 5 Hz): unobserved instead of removed
 };
 
