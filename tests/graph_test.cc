@@ -1,11 +1,17 @@
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "patrolmap/graph/export.h"
+#include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/graph/topo_map.h"
 #include "test_util.h"
@@ -215,14 +221,6 @@ TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(testing::ReadText(dir / "m.pmap"), before);
 }
 
-}  // namespace
-}  // namespace patrolmap::graph
-
-#include <signal.h>
-#include <sys/wait.h>
-
-namespace patrolmap::graph {
-namespace {
 
 // A big map with `nodes` nodes of 200 features each (about 50 KB a node on disk).
 TopoMap BigMap(int nodes) {
@@ -269,15 +267,6 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
-}  // namespace
-}  // namespace patrolmap::graph
-
-#include <nlohmann/json.hpp>
-
-#include "patrolmap/graph/export.h"
-
-namespace patrolmap::graph {
-namespace {
 
 TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
   const TopoMap map = TwoFlights();
@@ -298,13 +287,6 @@ TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
   EXPECT_EQ(CountOf(ToDot(map), "style=dashed"), 3u);
 }
 
-}  // namespace
-}  // namespace patrolmap::graph
-
-#include "patrolmap/graph/layout.h"
-
-namespace patrolmap::graph {
-namespace {
 
 TEST(Layout, OdometryJacobianMatchesNumericDifferentiation) {
   const double a[3] = {1.2, -0.7, 0.9}, b[3] = {3.1, 0.4, 1.7};
@@ -358,11 +340,6 @@ TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
   EXPECT_NEAR((closed.node(10).layout - closed.node(0).layout).norm(), 10.0, 1.5);  // sides keep their length
 }
 
-}  // namespace
-}  // namespace patrolmap::graph
-
-namespace patrolmap::graph {
-namespace {
 
 TEST(Export, SvgColoursLoopClosuresByTruth) {
   const TopoMap map = TwoFlights();

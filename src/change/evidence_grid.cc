@@ -23,19 +23,6 @@ Eigen::Vector3i UnpackKey(std::uint64_t key) {
   return {part(2 * kBits), part(kBits), part(0)};
 }
 
-bool Less(const VoxelEvidence& a, const Eigen::Vector3i& b) {
-  if (a.x != b.x()) return a.x < b.x();
-  if (a.y != b.y()) return a.y < b.y();
-  return a.z < b.z();
-}
-
-int Compare(const VoxelEvidence& a, const VoxelEvidence& b) {
-  if (a.x != b.x) return a.x < b.x ? -1 : 1;
-  if (a.y != b.y) return a.y < b.y ? -1 : 1;
-  if (a.z != b.z) return a.z < b.z ? -1 : 1;
-  return 0;
-}
-
 double Occupancy(const VoxelEvidence& v) { return static_cast<double>(v.hits) / (v.hits + v.passes); }
 
 struct Region {
@@ -112,13 +99,18 @@ void MergeOverlapping(double tolerance, std::vector<Region>* regions) {
 
 }  // namespace
 
+bool IsOccupied(const VoxelEvidence* voxel) {
+  return voxel != nullptr && voxel->hits >= 2 && voxel->hits > voxel->passes;
+}
+
 Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size) {
   return (point / voxel_size).array().round().cast<int>();
 }
 
 const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector3i& index) {
-  const auto it = std::lower_bound(grid.voxels.begin(), grid.voxels.end(), index, Less);
-  if (it == grid.voxels.end() || it->x != index.x() || it->y != index.y() || it->z != index.z()) return nullptr;
+  const VoxelEvidence key{index.x(), index.y(), index.z(), 0, 0};
+  const auto it = std::lower_bound(grid.voxels.begin(), grid.voxels.end(), key, VoxelBefore);
+  if (it == grid.voxels.end() || VoxelBefore(key, *it)) return nullptr;
   return &*it;
 }
 
@@ -218,8 +210,7 @@ EvidenceGridData EvidenceGrid::ToData() const {
     const Eigen::Vector3i v = UnpackKey(slot.key);
     data.voxels.push_back({v.x(), v.y(), v.z(), slot.hits, slot.passes});
   }
-  std::sort(data.voxels.begin(), data.voxels.end(),
-            [](const VoxelEvidence& a, const VoxelEvidence& b) { return Compare(a, b) < 0; });
+  std::sort(data.voxels.begin(), data.voxels.end(), VoxelBefore);
   return data;
 }
 
@@ -231,8 +222,7 @@ bool OccupiedNeighbour(const EvidenceGridData& grid, const Eigen::Vector3i& inde
     for (int dy = -reach; dy <= reach; ++dy) {
       for (int dx = -reach; dx <= reach; ++dx) {
         if (dx == 0 && dy == 0 && dz == 0) continue;
-        const VoxelEvidence* v = FindVoxel(grid, index + Eigen::Vector3i(dx, dy, dz));
-        if (v != nullptr && v->hits >= 2 && v->hits > v->passes) return true;
+        if (IsOccupied(FindVoxel(grid, index + Eigen::Vector3i(dx, dy, dz)))) return true;
       }
     }
   }
@@ -248,28 +238,23 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
   std::vector<Eigen::Vector3i> changed;
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> deltas;
-  auto a = before.voxels.begin(), b = after.voxels.begin();
   const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
-  while (a != before.voxels.end() && b != after.voxels.end()) {
-    const int order = Compare(*a, *b);
-    if (order < 0) { ++a; continue; }
-    if (order > 0) { ++b; continue; }
-    if (observed(*a) && observed(*b)) {
-      ++change->compared_voxels;
-      const double delta = Occupancy(*b) - Occupancy(*a);
-      const bool one_free = std::min(Occupancy(*a), Occupancy(*b)) <= options.max_free_occupancy;
-      const Eigen::Vector3i index(a->x, a->y, a->z);
-      if (std::abs(delta) > options.min_occupancy_change && one_free &&
-          (options.surface_tolerance_voxels == 0 ||
-           !OccupiedNeighbour(delta > 0 ? before : after, index, options.surface_tolerance_voxels,
-                              options.vertical_tolerance))) {
-        changed.emplace_back(a->x, a->y, a->z);
-        centres.push_back(changed.back().cast<double>() * size);
-        deltas.push_back(delta);
-      }
+  ForEachCommonVoxel(before, after, [&](const VoxelEvidence& a, const VoxelEvidence& b) {
+    if (!observed(a) || !observed(b)) return;
+    ++change->compared_voxels;
+    const double delta = Occupancy(b) - Occupancy(a);
+    const bool one_free = std::min(Occupancy(a), Occupancy(b)) <= options.max_free_occupancy;
+    const Eigen::Vector3i index(a.x, a.y, a.z);
+    if (std::abs(delta) <= options.min_occupancy_change || !one_free) return;
+    if (options.surface_tolerance_voxels > 0 &&
+        OccupiedNeighbour(delta > 0 ? before : after, index, options.surface_tolerance_voxels,
+                          options.vertical_tolerance)) {
+      return;
     }
-    ++a, ++b;
-  }
+    changed.push_back(index);
+    centres.push_back(index.cast<double>() * size);
+    deltas.push_back(delta);
+  });
   std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
   MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
   for (Region& region : regions) {

@@ -17,10 +17,8 @@ constexpr double kMinPairFraction = 0.5;
 constexpr double kMovedPairDistance = 0.15;  // point-pair test of a moved object's shape [m]
 constexpr double kMinClearance = 1.0;       // voxels this close to an object do not hide it, nor within its half size [m]
 
-// A voxel counts as occupied when most rays ended in it and at least two did.
 bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
-  const VoxelEvidence* v = FindVoxel(grid, VoxelIndex(point, grid.voxel_size));
-  return v != nullptr && v->hits >= 2 && v->hits > v->passes;
+  return IsOccupied(FindVoxel(grid, VoxelIndex(point, grid.voxel_size)));
 }
 
 // Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands

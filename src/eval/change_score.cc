@@ -190,27 +190,21 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     return holds(before, p, size / 2) != holds(after, p, size / 2) ||
            holds(before, p, -size / 2) != holds(after, p, -size / 2) || holds(before, p, 0) != holds(after, p, 0);
   };
-  const auto key = [](int x, int y, int z) { return std::make_tuple(x, y, z); };
-  std::vector<std::tuple<int, int, int>> predicted;
-  for (const Eigen::Vector3i& v : changed) predicted.push_back(key(v.x(), v.y(), v.z()));
-  std::sort(predicted.begin(), predicted.end());
-  auto a = before_grid.voxels.begin(), b = after_grid.voxels.begin();
-  while (a != before_grid.voxels.end() && b != after_grid.voxels.end()) {
-    const auto ka = key(a->x, a->y, a->z), kb = key(b->x, b->y, b->z);
-    if (ka < kb) { ++a; continue; }
-    if (kb < ka) { ++b; continue; }
-    if (a->hits + a->passes >= options.min_observations && b->hits + b->passes >= options.min_observations) {
-      ++score.observed_voxels;
-      const Eigen::Vector3d centre = Eigen::Vector3d(a->x, a->y, a->z) * size;
-      const bool is_core = core(centre);
-      const bool in_band = is_core || band(centre);
-      const bool reported = std::binary_search(predicted.begin(), predicted.end(), ka);
-      if (reported && in_band) ++score.voxels.true_positives;
-      if (reported && !in_band) ++score.voxels.false_positives;
-      if (!reported && is_core) ++score.voxels.false_negatives;
-    }
-    ++a, ++b;
-  }
+  std::vector<VoxelEvidence> predicted;
+  for (const Eigen::Vector3i& v : changed) predicted.push_back({v.x(), v.y(), v.z(), 0, 0});
+  std::sort(predicted.begin(), predicted.end(), VoxelBefore);
+  const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
+  ForEachCommonVoxel(before_grid, after_grid, [&](const VoxelEvidence& a, const VoxelEvidence& b) {
+    if (!observed(a) || !observed(b)) return;
+    ++score.observed_voxels;
+    const Eigen::Vector3d centre = Eigen::Vector3d(a.x, a.y, a.z) * size;
+    const bool is_core = core(centre);
+    const bool in_band = is_core || band(centre);
+    const bool reported = std::binary_search(predicted.begin(), predicted.end(), a, VoxelBefore);
+    if (reported && in_band) ++score.voxels.true_positives;
+    if (reported && !in_band) ++score.voxels.false_positives;
+    if (!reported && is_core) ++score.voxels.false_negatives;
+  });
   return score;
 }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <tuple>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -292,9 +291,7 @@ MapObject ReadObject(Reader* r) {
 }
 
 bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
-  return std::is_sorted(voxels.begin(), voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-  });
+  return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore);
 }
 
 Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {

@@ -115,13 +115,12 @@ Status BuildGrid(const io::PatrolSensors& sensors, const Config& config, PatrolR
 
 }  // namespace
 
-Status BuildPatrolRecord(const std::string& log, const Config& config, int feature_image_width, PatrolRecord* record,
+Status BuildPatrolRecord(const std::string& log, const Config& config, PatrolRecord* record,
                          PatrolRecordStats* stats, const ChangeProgress& progress) {
   io::PatrolSensors sensors;
   PATROLMAP_RETURN_IF_ERROR(io::ReadPatrolSensors(log, &sensors));
   *record = PatrolRecord();
   record->flight = sensors.flight_id;
-  record->feature_image_width = feature_image_width;
   if (sensors.camera) record->camera = *sensors.camera;
   if (sensors.poses.empty() || !sensors.camera) return Status::Ok();
   SampleViews(sensors.poses, &record->views);

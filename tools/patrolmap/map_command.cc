@@ -69,7 +69,7 @@ Status RecordPatrol(const std::string& log, const pipeline::Config& config, cons
   pipeline::PatrolRecordStats stats;
   Progress progress("patrol record");
   PATROLMAP_RETURN_IF_ERROR(pipeline::BuildPatrolRecord(
-      log, config, 0, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
+      log, config, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
   record.feature_image_width = FeatureWidth(result, record.flight);
   if (record.has_objects) {
     const auto confirmed =

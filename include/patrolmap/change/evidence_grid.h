@@ -49,6 +49,9 @@ class EvidenceGrid {
 // Voxel key helpers (index = round(coordinate / voxel_size)).
 Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size);
 
+// A voxel counts as occupied when most rays ended in it and at least two did (false for nullptr).
+bool IsOccupied(const VoxelEvidence* voxel);
+
 // The counts of voxel `index`, or nullptr (binary search in the sorted data).
 const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector3i& index);
 

@@ -69,11 +69,33 @@ struct VoxelEvidence {
   std::uint16_t passes = 0;          // rays that passed through it
 };
 
+// The order voxels are stored in: ascending (x, y, z).
+inline bool VoxelBefore(const VoxelEvidence& a, const VoxelEvidence& b) {
+  if (a.x != b.x) return a.x < b.x;
+  if (a.y != b.y) return a.y < b.y;
+  return a.z < b.z;
+}
+
 // An evidence grid as stored: its voxels in ascending (x, y, z) order.
 struct EvidenceGridData {
   double voxel_size = 0.0;  // [m]; 0 when the patrol had no depth
   std::vector<VoxelEvidence> voxels;
 };
+
+// Calls visit(a_voxel, b_voxel) for every voxel both grids hold, in order (a merge of the sorted lists).
+template <typename Visit>
+void ForEachCommonVoxel(const EvidenceGridData& a, const EvidenceGridData& b, Visit visit) {
+  auto i = a.voxels.begin(), j = b.voxels.begin();
+  while (i != a.voxels.end() && j != b.voxels.end()) {
+    if (VoxelBefore(*i, *j)) {
+      ++i;
+    } else if (VoxelBefore(*j, *i)) {
+      ++j;
+    } else {
+      visit(*i++, *j++);
+    }
+  }
+}
 
 // What a patrol (one flight of a map) keeps for change detection.
 struct PatrolRecord {

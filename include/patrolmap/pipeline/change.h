@@ -27,9 +27,9 @@ using ChangeProgress = std::function<void(std::int64_t, std::int64_t)>;
 // The patrol record of `log`: its camera, views sampled along the state
 // estimate, the object map (when it has objects0/) and the evidence grid
 // (when it has depth0/). Without poses only the camera is filled. An
-// unreadable depth image is reported on stderr, counted and left out.
-// `feature_image_width` is the width its key-frame features were found at.
-Status BuildPatrolRecord(const std::string& log, const Config& config, int feature_image_width, PatrolRecord* record,
+// unreadable depth image is reported on stderr, counted and left out. The
+// caller sets feature_image_width (the mapping run knows it).
+Status BuildPatrolRecord(const std::string& log, const Config& config, PatrolRecord* record,
                          PatrolRecordStats* stats = nullptr, const ChangeProgress& progress = {});
 
 // Compares flight `prior` with flight `current` of `map`: appearance at every
