@@ -313,7 +313,7 @@ TEST(ObjectStates, PersistentMovedRemovedNewAndUnobserved) {
       EXPECT_NEAR((*c.after - *c.before).norm(), 3.5, 1e-9);
     }
     if (c.state == ObjectState::kRemoved) {
-      EXPECT_GE(c.covering_views, options.min_visible_views);
+      EXPECT_GE(c.expected_detections, options.min_expected_detections);
     }
     EXPECT_GE(c.confidence, 0.0);
     EXPECT_LE(c.confidence, 1.0);
@@ -343,6 +343,83 @@ TEST(ObjectStates, AnOccupiedWallHidesAPriorObject) {
   const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
   ASSERT_EQ(changes.size(), 1u);
   EXPECT_EQ(changes[0].state, ObjectState::kUnobserved);
+}
+
+TEST(ObjectStates, AViewCoversAnObjectWithHalfItsBoxInTheImage) {
+  const PatrolRecord patrol = Patrol({{"crate", {10, 0, 0.5}}, {"crate", {10, -8.125, 0.5}}});
+  const CameraPoseSample view = LookingAlongX(Eigen::Vector3d(0, 0, 0.5));
+  EXPECT_NEAR(VisibleFraction(patrol.objects[0], kCamera, view), 1.0, 1e-9);
+  // Centred on the image's right edge (u = 64 at 10 m is y = -8.125): about half of it inside.
+  EXPECT_NEAR(VisibleFraction(patrol.objects[1], kCamera, view), 0.5, 0.05);
+  EXPECT_EQ(VisibleFraction(patrol.objects[0], kCamera, LookingAlongX(Eigen::Vector3d(10.2, 0, 0.5))), 0.0);  // inside it
+}
+
+TEST(ObjectStates, RemovedNeedsTheDetectionsTheCurrentViewsWouldHaveGiven) {
+  MapObject object;
+  object.detections = 10;
+  EXPECT_DOUBLE_EQ(ExpectedDetections(object, 5, 4), 4.0);  // at most one detection per view
+  object.detections = 2;
+  EXPECT_DOUBLE_EQ(ExpectedDetections(object, 8, 8), 2.0);
+  EXPECT_DOUBLE_EQ(ExpectedDetections(object, 0, 3), 3.0);  // no own view covered it: one per view
+  // A crate the prior patrol glimpsed in 3 views and detected 3 times: gone when the current patrol's 3 views
+  // of its place show nothing; unknown when only 2 did (2 expected detections, under min_expected_detections).
+  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}});
+  prior.views.resize(3);
+  prior.objects[0].detections = 3;
+  PatrolRecord current = Patrol({});
+  current.views.resize(3);
+  std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].state, ObjectState::kRemoved);
+  EXPECT_DOUBLE_EQ(changes[0].expected_detections, 3.0);
+  EXPECT_NEAR(changes[0].confidence, 0.8 * (1 - std::exp(-3.0)), 1e-9);
+  current.views.resize(2);
+  changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].state, ObjectState::kUnobserved);
+}
+
+// Points every 0.1 m on the surface of an axis-aligned cube standing on the ground at `centre` (x, y).
+std::vector<Eigen::Vector3f> CubePoints(const Eigen::Vector2d& centre, double side) {
+  std::vector<Eigen::Vector3f> points;
+  const int n = static_cast<int>(std::lround(side / 0.1));
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      for (int k = 0; k <= n; ++k) {
+        if (i != 0 && i != n && j != 0 && j != n && k != 0 && k != n) continue;  // inside
+        points.emplace_back(static_cast<float>(centre.x() - side / 2 + i * 0.1),
+                            static_cast<float>(centre.y() - side / 2 + j * 0.1), static_cast<float>(k * 0.1));
+      }
+    }
+  }
+  return points;
+}
+
+TEST(ObjectStates, AMovedObjectKeepsItsTopHeight) {
+  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}});
+  prior.objects[0].points = CubePoints({10, 0}, 1.0);
+  for (const auto& [side, state] : {std::pair{1.0, ObjectState::kMoved}, std::pair{0.8, ObjectState::kRemoved}}) {
+    PatrolRecord current = Patrol({{"crate", {12, 0, side / 2}}});
+    current.objects[0].points = CubePoints({12, 0}, side);
+    const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+    // The smaller crate, centred on the bigger one, lies within the shape test's 0.15 m: only its top tells.
+    ASSERT_FALSE(changes.empty());
+    EXPECT_EQ(changes[0].state, state) << side;
+    EXPECT_EQ(changes.size(), state == ObjectState::kMoved ? 1u : 2u) << side;
+    ObjectDiffOptions no_top_gate;
+    no_top_gate.max_top_difference_m = 1.0;
+    EXPECT_EQ(DiffObjects(prior, current, no_top_gate)[0].state, ObjectState::kMoved) << side;
+  }
+}
+
+TEST(ObjectStates, AnObjectWhosePlaceWentUnseenCanStillHaveMoved) {
+  // Behind every view of the current patrol, the crate left its place for one 4 m away.
+  const PatrolRecord prior = Patrol({{"crate", {-20, 0, 0.5}}});
+  const PatrolRecord current = Patrol({{"crate", {-16, 0, 0.5}}});
+  const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].state, ObjectState::kMoved);
+  EXPECT_EQ(changes[0].covering_views, 0);
 }
 
 // A textured scene, its view after a lighting change, and SIFT features of both.

@@ -22,8 +22,6 @@ bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
 }
 
 // Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands
-// where the object stood (another object, the object moved by a little) does not hide its place.
-// Whether an occupied voxel lies on the line of sight short of `clearance` before the object: what stands
 // where the object stood (another object, the object moved by a little) does not hide its place, nor do
 // voxels inside `see_through` (the boxes of current objects that may be this one, moved).
 bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eigen::Vector3d& to, double clearance,
@@ -163,22 +161,30 @@ Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before, con
   return rotation;
 }
 
-int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options,
+double VisibleFraction(const MapObject& object, const CameraIntrinsics& camera, const CameraPoseSample& view) {
+  const cv::Rect2d box = ProjectBox(camera, view, object.box_min, object.box_max);
+  if (box.area() <= 0.0) return 0.0;
+  return (box & cv::Rect2d(0, 0, camera.width, camera.height)).area() / box.area();
+}
+
+int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const ObjectDiffOptions& options,
                   const std::vector<const MapObject*>& see_through) {
-  const CameraIntrinsics& camera = current.camera;
-  const bool grid = current.grid.voxel_size > 0.0 && !current.grid.voxels.empty();
+  const bool grid = patrol.grid.voxel_size > 0.0 && !patrol.grid.voxels.empty();
   const double clearance = std::max(kMinClearance, 0.5 * (object.box_max - object.box_min).norm());
   int views = 0;
-  for (const CameraPoseSample& view : current.views) {
+  for (const CameraPoseSample& view : patrol.views) {
     const Eigen::Vector3d c = view.ToCamera(object.centroid);
     if (c.z() < 0.3 || c.norm() > options.max_visible_range_m) continue;
-    const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
-    const double m = options.image_margin_px;
-    if (u < m || v < m || u > camera.width - 1 - m || v > camera.height - 1 - m) continue;
-    if (grid && Hidden(current.grid, view.position, object.centroid, clearance, see_through)) continue;
+    if (VisibleFraction(object, patrol.camera, view) < options.min_visible_fraction) continue;
+    if (grid && Hidden(patrol.grid, view.position, object.centroid, clearance, see_through)) continue;
     ++views;
   }
   return views;
+}
+
+double ExpectedDetections(const MapObject& object, int own_views, int views) {
+  const double rate = own_views > 0 ? std::min(1.0, object.detections / static_cast<double>(own_views)) : 1.0;
+  return rate * views;
 }
 
 namespace {
@@ -188,8 +194,18 @@ struct Matching {
   const std::vector<MapObject>& p;
   const std::vector<MapObject>& c;
   std::vector<bool> prior_used, current_used;
-  std::vector<int> views;  // covering views of each prior object (those not persistent)
+  std::vector<int> views;         // covering views of each prior object (those not persistent) ...
+  std::vector<double> expected;   // ... and the detections they would have given
+  std::vector<double> prior_top, current_top;  // 95th percentile of the points' height; 0 without points
 };
+
+Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
+  Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
+             std::vector<bool>(current.objects.size(), false), {}, {}, {}, {}};
+  for (const MapObject& o : m.p) m.prior_top.push_back(PointZQuantile(o.points, 0.95));
+  for (const MapObject& o : m.c) m.current_top.push_back(PointZQuantile(o.points, 0.95));
+  return m;
+}
 
 // Persistent: same label, close, and (with points) passing the point-pair test; nearest first.
 void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<ObjectChange>* changes) {
@@ -214,11 +230,13 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
   }
 }
 
-// Unmatched prior objects too few current views covered are unobserved; the others may be removed or moved.
-void MarkUnobserved(const PatrolRecord& current, const ObjectDiffOptions& options, Matching* m,
-                    std::vector<ObjectChange>* changes) {
+// How well the current patrol saw the place of every unmatched prior object: its covering views there and the
+// detections they would have given, at the rate the prior patrol detected the object in its own covering views.
+// Unconfirmed objects only explained sightings as persistent; they take no other state.
+void MeasureCoverage(const PatrolRecord& prior, const PatrolRecord& current, const ObjectDiffOptions& options,
+                     Matching* m) {
   m->views.assign(m->p.size(), 0);
-  // Unconfirmed objects only explained sightings as persistent; they take no other state.
+  m->expected.assign(m->p.size(), 0.0);
   for (std::size_t i = 0; i < m->p.size(); ++i) m->prior_used[i] = m->prior_used[i] || !m->p[i].confirmed;
   for (std::size_t j = 0; j < m->c.size(); ++j) m->current_used[j] = m->current_used[j] || !m->c[j].confirmed;
   for (std::size_t i = 0; i < m->p.size(); ++i) {
@@ -231,9 +249,7 @@ void MarkUnobserved(const PatrolRecord& current, const ObjectDiffOptions& option
       }
     }
     m->views[i] = CoveringViews(m->p[i], current, options, candidates);
-    if (m->views[i] >= options.min_visible_views) continue;
-    m->prior_used[i] = true;
-    changes->push_back(MakeChange(ObjectState::kUnobserved, &m->p[i], nullptr, m->p[i].confidence, m->views[i]));
+    m->expected[i] = ExpectedDetections(m->p[i], CoveringViews(m->p[i], prior, options), m->views[i]);
   }
 }
 
@@ -249,6 +265,10 @@ std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matchin
       const double distance = (m.p[i].centroid - m.c[j].centroid).norm();
       const AppearanceTerms terms = CompareAppearance(m.p[i], m.c[j]);
       if (distance > options.max_move_m || terms.texture.value_or(0.0) > options.max_texture_distance) continue;
+      if (m.prior_top[i] > 0.0 && m.current_top[j] > 0.0 &&
+          std::abs(m.prior_top[i] - m.current_top[j]) > options.max_top_difference_m) {
+        continue;
+      }
       if (MovedShapeOverlap(m.p[i], m.c[j]) < options.min_shape_overlap) continue;
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
       physical.push_back(distance);
@@ -272,6 +292,7 @@ void MatchMoved(const ObjectDiffOptions& options, Matching* m, std::vector<Objec
     const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
     ObjectChange change = MakeChange(ObjectState::kMoved, &a, &b, std::min(a.confidence, b.confidence) * (1.0 - 0.5 * pair.cost),
                                      m->views[pair.prior]);
+    change.expected_detections = m->expected[pair.prior];
     change.weighted_distance = pair.cost;
     change.rotation = RegisterRotation(a.points, b.points);
     changes->push_back(change);
@@ -282,16 +303,20 @@ void MatchMoved(const ObjectDiffOptions& options, Matching* m, std::vector<Objec
 
 std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
                                       const ObjectDiffOptions& options) {
-  Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
-             std::vector<bool>(current.objects.size(), false), {}};
+  Matching m = StartMatching(prior, current);
   std::vector<ObjectChange> changes;
   MatchPersistent(options, &m, &changes);
-  MarkUnobserved(current, options, &m, &changes);
+  MeasureCoverage(prior, current, options, &m);
   MatchMoved(options, &m, &changes);
   for (std::size_t i = 0; i < m.p.size(); ++i) {
     if (m.prior_used[i]) continue;
-    const double confidence = m.p[i].confidence * std::min(1.0, m.views[i] / (2.0 * options.min_visible_views));
-    changes.push_back(MakeChange(ObjectState::kRemoved, &m.p[i], nullptr, confidence, m.views[i]));
+    // The chance that the object, still in place, would have been detected: 1 - exp(-expected detections).
+    const bool seen = m.expected[i] >= options.min_expected_detections;
+    const double confidence = m.p[i].confidence * (seen ? 1.0 - std::exp(-m.expected[i]) : 1.0);
+    ObjectChange change = MakeChange(seen ? ObjectState::kRemoved : ObjectState::kUnobserved, &m.p[i], nullptr,
+                                     confidence, m.views[i]);
+    change.expected_detections = m.expected[i];
+    changes.push_back(change);
   }
   for (std::size_t j = 0; j < m.c.size(); ++j) {
     if (m.current_used[j]) continue;

@@ -163,16 +163,18 @@ float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array
   return cdf[values[values.size() / 2]];
 }
 
-double PointHeight(const std::vector<Eigen::Vector3f>& points) {
+double PointZQuantile(const std::vector<Eigen::Vector3f>& points, double q) {
   if (points.size() < 10) return 0.0;
   std::vector<float> z;
+  z.reserve(points.size());
   for (const Eigen::Vector3f& p : points) z.push_back(p.z());
-  const auto at = [&z](double q) {
-    const auto k = z.begin() + static_cast<std::ptrdiff_t>(q * (z.size() - 1));
-    std::nth_element(z.begin(), k, z.end());
-    return *k;
-  };
-  return at(0.95) - at(0.05);
+  const auto k = z.begin() + static_cast<std::ptrdiff_t>(q * (z.size() - 1));
+  std::nth_element(z.begin(), k, z.end());
+  return *k;
+}
+
+double PointHeight(const std::vector<Eigen::Vector3f>& points) {
+  return PointZQuantile(points, 0.95) - PointZQuantile(points, 0.05);
 }
 
 cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,

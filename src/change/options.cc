@@ -21,6 +21,9 @@ bool ChangeOptions::IsValid(std::string* error) const {
                "change.object_map.min_pair_fraction must lie in [0, 1]", error) &&
          Check(object_map.min_detections >= 1, "change.object_map.min_detections must be at least 1", error) &&
          Check(objects.match_distance_m > 0, "change.objects.match_distance_m must be positive", error) &&
+         Check(objects.min_visible_fraction >= 0 && objects.min_visible_fraction <= 1,
+               "change.objects.min_visible_fraction must lie in [0, 1]", error) &&
+         Check(objects.min_expected_detections > 0, "change.objects.min_expected_detections must be positive", error) &&
          Check(objects.physical_weight >= 0 && objects.appearance_weight >= 0,
                "change.objects weights must not be negative", error) &&
          Check(grid.voxel_size_m >= 0.02, "change.grid.voxel_size_m must be at least 0.02", error) &&

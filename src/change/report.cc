@@ -45,6 +45,7 @@ json ObjectJson(const ObjectChange& o) {
   json object = {{"state", ToString(o.state)},     {"label", o.label},
                  {"confidence", o.confidence},     {"prior_id", o.prior_id},
                  {"current_id", o.current_id},     {"covering_views", o.covering_views},
+                 {"expected_detections", o.expected_detections},
                  {"before", o.before ? Vector(*o.before) : json(nullptr)},
                  {"after", o.after ? Vector(*o.after) : json(nullptr)}};
   if (o.state == ObjectState::kMoved) {
@@ -225,14 +226,15 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
   }
   if (report.objects_compared) {
     html << "<h2>Objects</h2>\n<table><tr><th>state</th><th>label</th><th>confidence</th><th>before [m]</th>"
-            "<th>after [m]</th><th>covering views</th></tr>\n";
+            "<th>after [m]</th><th>covering views</th><th>expected detections</th></tr>\n";
     const auto position = [](const std::optional<Eigen::Vector3d>& p) {
       return p ? Number(p->x()) + ", " + Number(p->y()) + ", " + Number(p->z()) : std::string("&ndash;");
     };
     for (const ObjectChange& o : report.objects) {
       html << "<tr><td style='color:" << StateColour(o.state) << "'>" << ToString(o.state) << "</td><td>"
            << graph::EscapeXml(o.label) << "</td><td>" << Number(o.confidence) << "</td><td>" << position(o.before)
-           << "</td><td>" << position(o.after) << "</td><td>" << o.covering_views << "</td></tr>\n";
+           << "</td><td>" << position(o.after) << "</td><td>" << o.covering_views << "</td><td>"
+           << Number(o.expected_detections) << "</td></tr>\n";
     }
     html << "</table>\n";
   }

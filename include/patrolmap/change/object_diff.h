@@ -2,13 +2,15 @@
 //   persistent  a current object of the same label within the match distance
 //               of a prior one (and passing the point-pair test when both have points);
 //   moved       a prior object gone from its place paired with a new object of the
-//               same label by paper 003's weighted, min-max normalised physical and
-//               appearance distance; the rigid motion by SVD of the point covariances;
-//   removed     a prior object that enough current views covered (projected into the
-//               image, in range, not behind occupied voxels of the current evidence
-//               grid other than those of a current object that may be it, moved) but
-//               nothing matched;
-//   unobserved  a prior object too few current views covered: its state is unknown;
+//               same label, alike in texture, shape and top height, by paper 003's
+//               weighted, min-max normalised physical and appearance distance; the
+//               rigid motion by SVD of the point covariances;
+//   removed     a prior object nothing matched although the current views covering
+//               it (in range, half its box inside the image, not behind occupied voxels
+//               of the current evidence grid other than those of a current object that
+//               may be it, moved) would have detected it often enough: as many times as
+//               min_expected_detections at the rate the prior patrol detected it;
+//   unobserved  a prior object the current patrol did not see well enough to tell;
 //   new         a current object matching nothing of the prior patrol.
 // Unconfirmed objects (seen too few times) take part only in the persistent
 // matching: a current object at the place of an unconfirmed prior one is
@@ -38,6 +40,7 @@ struct ObjectChange {
   std::optional<Eigen::Vector3d> before;   // prior position (not for new)
   std::optional<Eigen::Vector3d> after;    // current position (not for removed or unobserved)
   int covering_views = 0;                  // current views that covered the prior object
+  double expected_detections = 0.0;        // detections they would have given of it (removed, unobserved, moved)
   // moved: after ~ rotation * (before-point - before) + after, from the SVD registration.
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   double weighted_distance = 0.0;          // moved: paper 003's delta
@@ -52,12 +55,20 @@ struct AppearanceTerms {
 };
 AppearanceTerms CompareAppearance(const MapObject& a, const MapObject& b);
 
-// How many of `views` cover `object`: in front, within range, the projected
-// centroid inside the image by the margin, and (with a grid) no occupied voxel
-// on the line of sight short of the object's half size (at least 1 m) before it.
-// Voxels inside `see_through` (current objects that may be this one, moved) do not hide it.
-int CoveringViews(const MapObject& object, const PatrolRecord& current, const ObjectDiffOptions& options,
+// Share of the object's projected box inside the image; 0 when a corner lies behind the camera.
+double VisibleFraction(const MapObject& object, const CameraIntrinsics& camera, const CameraPoseSample& view);
+
+// How many of the patrol's views cover `object`: its centroid in front and
+// within range, at least min_visible_fraction of its box inside the image, and
+// (with a grid) no occupied voxel on the line of sight short of the object's
+// half size (at least 1 m) before it. Voxels inside `see_through` (current
+// objects that may be this one, moved) do not hide it.
+int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const ObjectDiffOptions& options,
                   const std::vector<const MapObject*>& see_through = {});
+
+// Detections `views` covering views would give of `object`, at the rate its own patrol detected it in its
+// `own_views` covering views there (detections per view, at most 1; 1 when no own view covered it).
+double ExpectedDetections(const MapObject& object, int own_views, int views);
 
 std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,
                                       const ObjectDiffOptions& options);

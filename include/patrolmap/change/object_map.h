@@ -91,6 +91,9 @@ void CumulativeHistogram(const cv::Mat& image, std::array<float, 256>* cdf);
 // box's central half. Unchanged by any monotonic change of the lighting (gain, offset, gamma).
 float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array<float, 256>& cdf);
 
+// The q-quantile (q in [0, 1]) of the points' z [m]; 0 with fewer than 10 points.
+double PointZQuantile(const std::vector<Eigen::Vector3f>& points, double q);
+
 // Vertical extent of points (5th to 95th percentile of z) [m]; 0 with fewer than 10 points.
 double PointHeight(const std::vector<Eigen::Vector3f>& points);
 

@@ -45,10 +45,14 @@ struct ObjectDiffOptions {
   double max_texture_distance = 0.15; // pairs whose gradient-orientation histograms differ more (half their
                                       // L1 distance) are not a move
   double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
-  double image_margin_px = 4.0;       // visibility: its projected centroid must lie this far inside the image
+  double min_visible_fraction = 0.5;  // visibility: at least this share of its projected box inside the image
+  double min_expected_detections = 3; // removed: the current views covering a prior object would have given at
+                                      // least this many detections at the rate the prior patrol detected it
+                                      // (detections per covering view, at most 1); fewer: unobserved
   double min_shape_overlap = 0.85;    // moved: share of the current object's points, shifted onto the prior
                                       // object, within 0.15 m of its points (1 when either has none)
-  int min_visible_views = 8;          // fewer covering views (sampled at 5 Hz): unobserved instead of removed
+  double max_top_difference_m = 0.1;  // moved: the tops of the two objects (95th percentile of their points'
+                                      // height) differ by at most this; objects stand on level ground
 };
 
 // Evidence grid of one patrol (paper 004).

@@ -99,9 +99,10 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.objects.appearance_weight", &change.objects.appearance_weight);
   visitor->Field("change.objects.max_texture_distance", &change.objects.max_texture_distance);
   visitor->Field("change.objects.max_visible_range_m", &change.objects.max_visible_range_m);
-  visitor->Field("change.objects.image_margin_px", &change.objects.image_margin_px);
+  visitor->Field("change.objects.min_visible_fraction", &change.objects.min_visible_fraction);
+  visitor->Field("change.objects.min_expected_detections", &change.objects.min_expected_detections);
   visitor->Field("change.objects.min_shape_overlap", &change.objects.min_shape_overlap);
-  visitor->Field("change.objects.min_visible_views", &change.objects.min_visible_views);
+  visitor->Field("change.objects.max_top_difference_m", &change.objects.max_top_difference_m);
   visitor->Field("change.grid.voxel_size_m", &change.grid.voxel_size_m);
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
   visitor->Field("change.grid.rays_per_row", &change.grid.rays_per_row);
