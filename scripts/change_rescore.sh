@@ -23,8 +23,11 @@ for dir in "$study"/*/; do
 done | /usr/bin/python3 -c "
 import json, sys
 totals = {}
+app = [0, 0, 0, 0]
 for line in sys.stdin:
     c = json.loads(line)
+    a = c.get('appearance')
+    if a: app[0] += a['regions']; app[1] += a['regions_on_change']; app[2] += a['changes']; app[3] += a['changes_found']
     for state, k in list(c.get('objects', {}).items()) + [('voxels', c.get('geometry', {}))]:
         if not isinstance(k, dict) or not k: continue
         t = totals.setdefault(state, [0, 0, 0])
@@ -32,4 +35,5 @@ for line in sys.stdin:
 for state, (tp, fp, fn) in totals.items():
     p = tp / (tp + fp) if tp + fp else 0.0; r = tp / (tp + fn) if tp + fn else 0.0
     print('%-10s %d/%d/%d  P %.3f R %.3f F1 %.3f' % (state, tp, fp, fn, p, r, 2 * p * r / (p + r) if p + r else 0.0))
+print('appearance %d/%d regions on object changes, %d/%d visible changes found' % (app[1], app[0], app[3], app[2]))
 "

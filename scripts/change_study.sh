@@ -50,6 +50,7 @@ out = sys.argv[1]
 lines = [json.loads(l) for l in open(out + "/lines.jsonl")]
 total = {}
 geo = [0, 0, 0]
+app = [0, 0, 0, 0]  # regions, on a change, visible changes, found
 for r in lines:
     c = r["changes"]
     states = c.get("objects", {})
@@ -63,6 +64,10 @@ for r in lines:
     if g:
         geo[0] += g["true_positives"]; geo[1] += g["false_positives"]; geo[2] += g["false_negatives"]
         row.append(f"voxels P {g['precision']:.2f} R {g['recall']:.2f} IoU {g['iou']:.2f} ({g['regions']} regions)")
+    a = c.get("appearance")
+    if a:
+        app[0] += a["regions"]; app[1] += a["regions_on_change"]; app[2] += a["changes"]; app[3] += a["changes_found"]
+        row.append(f"regions {a['regions_on_change']}/{a['regions']} on changes, {a['changes_found']}/{a['changes']} changes found")
     row.append(f"places {c['places_changed']}/{c['places_compared']} changed")
     print("  ".join(row))
 def prf(tp, fp, fn):
@@ -79,5 +84,10 @@ p, r, f = prf(*geo)
 iou = geo[0] / sum(geo) if sum(geo) else 0.0
 summary["voxels"] = {"tp": geo[0], "fp": geo[1], "fn": geo[2], "precision": p, "recall": r, "f1": f, "iou": iou}
 print(f"  voxels     {geo[0]}/{geo[1]}/{geo[2]}  P {p:.2f} R {r:.2f} F1 {f:.2f} IoU {iou:.2f}")
+p = app[1] / app[0] if app[0] else 0.0
+r = app[3] / app[2] if app[2] else 0.0
+summary["appearance"] = {"regions": app[0], "regions_on_change": app[1], "changes": app[2], "changes_found": app[3],
+                         "precision": p, "recall": r}
+print(f"  appearance {app[1]}/{app[0]} regions on object changes (P {p:.2f}), {app[3]}/{app[2]} visible changes found (R {r:.2f})")
 json.dump(summary, open(out + "/summary.json", "w"), indent=1)
 PY

@@ -233,5 +233,47 @@ TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
   EXPECT_DOUBLE_EQ(score.Iou(), 0.5);
 }
 
+TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
+  // A camera at the origin looking along +x (camera z forward = world x, x right = world -y, y down = -z).
+  CameraPoseSample pose;
+  Eigen::Matrix3d r;
+  r.col(0) = Eigen::Vector3d(0, -1, 0), r.col(1) = Eigen::Vector3d(0, 0, -1), r.col(2) = Eigen::Vector3d(1, 0, 0);
+  pose.rotation = Eigen::Quaterniond(r);
+  pose.position = Eigen::Vector3d(0, 0, 0.5);
+  const CameraIntrinsics camera{100, 100, 80, 50, 160, 100};
+  std::vector<TruthObject> before = {Truth(1, "crate", 10, 0, 10), Truth(2, "crate", 10, 3, 10),
+                                     Truth(3, "crate", 10, -3, 10), Truth(4, "crate", -10, 0, 10)};
+  std::vector<TruthObject> after = {Truth(1, "crate", 10, 0, 10), Truth(3, "crate", 12, -3, 10), Truth(5, "crate", 8, 2, 10)};
+  for (auto* objects : {&before, &after}) {
+    for (TruthObject& o : *objects) o.seen_ns = {1'000'000'000};
+  }
+  after[2].seen_ns = {2'000'000'000};  // the new crate 5 was not seen near the key frame: not visible there
+  ChangeScoreOptions options;
+  options.min_area_px = 20;
+  // Before: 2 (removed) and 3 (moved away) are changes, 1 stayed, 4 is behind the camera.
+  const std::vector<cv::Rect2d> prior = VisibleChangeBoxes(before, after, 1'000'000'000, pose, camera, options);
+  ASSERT_EQ(prior.size(), 2u);
+  EXPECT_NEAR(prior[0].x + prior[0].width / 2, 80 - 100 * 3.0 / 10, 3);  // world +y is image left
+  EXPECT_NEAR(prior[0].width, 100 * (3.5 / 9.5 - 2.5 / 10.5), 1e-6);    // from its near left to its far right edge
+  const std::vector<cv::Rect2d> current = VisibleChangeBoxes(after, before, 1'000'000'000, pose, camera, options);
+  ASSERT_EQ(current.size(), 1u);  // crate 3 at its new place
+  // One region on crate 2's old place, one on crate 3's new place, one on the unchanged crate 1.
+  const RegionBoxes on_two{prior[0], prior[0]}, on_three{cv::Rect2d(0, 0, 1, 1), current[0]};
+  const cv::Rect2d centre(75, 45, 10, 10);
+  const AppearanceScore score = ScoreAppearance({{prior, current}}, {{on_two, on_three, {centre, centre}}}, options);
+  EXPECT_EQ(score.regions, 3);
+  EXPECT_EQ(score.regions_on_change, 2);
+  EXPECT_EQ(score.changes, 3);
+  EXPECT_EQ(score.changes_found, 2);  // crate 3's old place in the prior frame has no region
+  EXPECT_NEAR(score.Precision(), 2.0 / 3.0, 1e-12);
+  // The registration shifts the other key frame 60 px to the right: crate 2 (centre u ~ 50) falls outside it.
+  std::vector<cv::Rect2d> kept = prior;
+  Eigen::Matrix3d shift = Eigen::Matrix3d::Identity();
+  shift(0, 2) = -60.0;
+  KeepInOverlap(shift, 160, 100, &kept);
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_GT(kept[0].x, prior[0].x);
+}
+
 }  // namespace
 }  // namespace patrolmap::eval

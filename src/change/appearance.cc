@@ -148,10 +148,8 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8, CV_32S);
   const int min_area = std::max(1, static_cast<int>(options.min_area_fraction * compared));
-  std::vector<bool> inlier_prior(prior.keypoints.size(), false);
-  for (std::size_t i = 0; i < matches.size(); ++i) {
-    if (inlier[i]) inlier_prior[matches[i].trainIdx] = true;
-  }
+  std::vector<bool> matched_prior(prior.keypoints.size(), false), matched_current(current.keypoints.size(), false);
+  for (const cv::DMatch& m : matches) matched_prior[m.trainIdx] = matched_current[m.queryIdx] = true;
   std::vector<cv::Point2f> prior_points, prior_in_current;
   for (const cv::KeyPoint& k : prior.keypoints) prior_points.push_back(k.pt / prior.feature_scale);
   if (!prior_points.empty()) cv::perspectiveTransform(prior_points, prior_in_current, h);
@@ -163,12 +161,20 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
                                   stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
     region.prior_box = PriorBox(region.current_box, h, prior.image.size());
     region.score = cv::mean(local, labels == label)[0];
+    const cv::Rect2f box(region.current_box);
     for (std::size_t k = 0; k < prior_in_current.size(); ++k) {
-      const cv::Point p(cvRound(prior_in_current[k].x), cvRound(prior_in_current[k].y));
-      if (!region.current_box.contains(p) || labels.at<int>(p) != label) continue;
+      if (!box.contains(prior_in_current[k])) continue;
       ++region.prior_features;
-      if (!inlier_prior[k]) ++region.unmatched_prior_features;
+      region.unmatched_prior_features += !matched_prior[k];
     }
+    for (std::size_t k = 0; k < current.keypoints.size(); ++k) {
+      if (!box.contains(current.keypoints[k].pt / current.feature_scale)) continue;
+      ++region.current_features;
+      region.unmatched_current_features += !matched_current[k];
+    }
+    const int features = region.prior_features + region.current_features;
+    const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
+    if (features > 0 && unmatched < options.min_unmatched_share * features) continue;
     result.regions.push_back(region);
   }
   std::sort(result.regions.begin(), result.regions.end(),

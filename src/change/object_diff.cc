@@ -44,14 +44,13 @@ bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eig
 
 AppearanceTerms CompareAppearance(const MapObject& a, const MapObject& b) {
   AppearanceTerms terms;
-  constexpr std::size_t kBins = 8;
-  if (a.descriptor.size() >= kBins && b.descriptor.size() >= kBins) {
+  if (a.descriptor.size() >= kOrientationBins && b.descriptor.size() >= kOrientationBins) {
     double l1 = 0.0;
-    for (std::size_t i = 0; i < kBins; ++i) l1 += std::abs(a.descriptor[i] - b.descriptor[i]);
+    for (std::size_t i = 0; i < kOrientationBins; ++i) l1 += std::abs(a.descriptor[i] - b.descriptor[i]);
     terms.texture = 0.5 * l1;
   }
-  if (a.descriptor.size() > kBins && b.descriptor.size() > kBins) {
-    terms.brightness = std::abs(a.descriptor[kBins] - b.descriptor[kBins]);
+  if (a.descriptor.size() > kBrightnessRankAt && b.descriptor.size() > kBrightnessRankAt) {
+    terms.brightness = std::abs(a.descriptor[kBrightnessRankAt] - b.descriptor[kBrightnessRankAt]);
   }
   if (a.height > 0.0 && b.height > 0.0) terms.height = std::abs(a.height - b.height) / std::max(a.height, b.height);
   return terms;
@@ -183,8 +182,7 @@ int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const Obj
 }
 
 double ExpectedDetections(const MapObject& object, int own_views, int views) {
-  const double rate = own_views > 0 ? std::min(1.0, object.detections / static_cast<double>(own_views)) : 1.0;
-  return rate * views;
+  return own_views > 0 ? object.detections * static_cast<double>(views) / own_views : static_cast<double>(views);
 }
 
 namespace {
@@ -202,8 +200,8 @@ struct Matching {
 Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
   Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
              std::vector<bool>(current.objects.size(), false), {}, {}, {}, {}};
-  for (const MapObject& o : m.p) m.prior_top.push_back(PointZQuantile(o.points, 0.95));
-  for (const MapObject& o : m.c) m.current_top.push_back(PointZQuantile(o.points, 0.95));
+  for (const MapObject& o : m.p) m.prior_top.push_back(PointQuantile(o.points, 2, 0.95));
+  for (const MapObject& o : m.c) m.current_top.push_back(PointQuantile(o.points, 2, 0.95));
   return m;
 }
 

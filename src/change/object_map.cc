@@ -163,18 +163,18 @@ float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array
   return cdf[values[values.size() / 2]];
 }
 
-double PointZQuantile(const std::vector<Eigen::Vector3f>& points, double q) {
+double PointQuantile(const std::vector<Eigen::Vector3f>& points, int axis, double q) {
   if (points.size() < 10) return 0.0;
-  std::vector<float> z;
-  z.reserve(points.size());
-  for (const Eigen::Vector3f& p : points) z.push_back(p.z());
-  const auto k = z.begin() + static_cast<std::ptrdiff_t>(q * (z.size() - 1));
-  std::nth_element(z.begin(), k, z.end());
+  std::vector<float> values;
+  values.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) values.push_back(p[axis]);
+  const auto k = values.begin() + static_cast<std::ptrdiff_t>(q * (values.size() - 1));
+  std::nth_element(values.begin(), k, values.end());
   return *k;
 }
 
 double PointHeight(const std::vector<Eigen::Vector3f>& points) {
-  return PointZQuantile(points, 0.95) - PointZQuantile(points, 0.05);
+  return PointQuantile(points, 2, 0.95) - PointQuantile(points, 2, 0.05);
 }
 
 cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,
@@ -350,6 +350,12 @@ std::vector<MapObject> ObjectMapper::Finish() const {
     kept.back().confirmed = kept.back().detections >= options_.min_detections;
     kept.back().id = static_cast<int>(kept.size()) - 1;
     kept.back().height = PointHeight(kept.back().points);
+    if (kept.back().points.size() >= 10) {  // the extent of its points, a stray one or two left out
+      for (int axis = 0; axis < 3; ++axis) {
+        kept.back().box_min[axis] = PointQuantile(kept.back().points, axis, 0.02);
+        kept.back().box_max[axis] = PointQuantile(kept.back().points, axis, 0.98);
+      }
+    }
   }
   return kept;
 }

@@ -26,7 +26,9 @@ json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
   for (const AppearanceRegion& r : a.regions) {
     regions.push_back({{"current_box", Box(r.current_box)}, {"prior_box", Box(r.prior_box)}, {"area_px", r.area_px},
                        {"score", r.score}, {"prior_features", r.prior_features},
-                       {"unmatched_prior_features", r.unmatched_prior_features}});
+                       {"unmatched_prior_features", r.unmatched_prior_features},
+                       {"current_features", r.current_features},
+                       {"unmatched_current_features", r.unmatched_current_features}});
   }
   return {{"prior_node", place.prior_node},
           {"current_node", place.current_node},

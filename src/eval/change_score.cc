@@ -103,20 +103,26 @@ Status ReadTruthObjects(const std::string& log, std::vector<TruthObject>* object
   };
   PATROLMAP_RETURN_IF_ERROR(ReadTable(log + "/groundtruth/objects.csv", nullptr, parse, objects));
   struct Origin {
+    TimestampNs timestamp_ns = 0;
     int id = -1;
   };
   const auto parse_origin = [](const CsvReader& csv, const std::vector<std::string_view>& f, Origin* o) {
     if (f.size() < 3) return csv.Error("expected 3 columns");
     std::int64_t id = 0;
+    PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(f[0], "timestamp", &o->timestamp_ns));
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(f[2], "object_id", &id));
     o->id = static_cast<int>(id);
     return Status::Ok();
   };
   std::vector<Origin> origins;
   PATROLMAP_RETURN_IF_ERROR(ReadTable(log + "/groundtruth/detections.csv", nullptr, parse_origin, &origins));
-  std::unordered_map<int, int> counts;
-  for (const Origin& o : origins) ++counts[o.id];
-  for (TruthObject& o : *objects) o.detections = counts[o.id];
+  std::unordered_map<int, std::vector<TimestampNs>> seen;
+  for (const Origin& o : origins) seen[o.id].push_back(o.timestamp_ns);
+  for (TruthObject& o : *objects) {
+    o.seen_ns = seen[o.id];
+    std::sort(o.seen_ns.begin(), o.seen_ns.end());
+    o.detections = static_cast<int>(o.seen_ns.size());
+  }
   return Status::Ok();
 }
 
@@ -205,6 +211,88 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     if (reported && !in_band) ++score.voxels.false_positives;
     if (!reported && is_core) ++score.voxels.false_negatives;
   });
+  return score;
+}
+
+}  // namespace patrolmap::eval
+
+namespace patrolmap::eval {
+namespace {
+
+bool SeenNear(const TruthObject& object, TimestampNs time_ns, double within_s) {
+  const TimestampNs within = static_cast<TimestampNs>(within_s * 1e9);
+  const auto it = std::lower_bound(object.seen_ns.begin(), object.seen_ns.end(), time_ns - within);
+  return it != object.seen_ns.end() && *it <= time_ns + within;
+}
+
+// The object's box projected into the image, clipped to it; empty when a corner lies behind the camera.
+cv::Rect2d ProjectTruthBox(const TruthObject& o, const CameraPoseSample& pose, const CameraIntrinsics& camera) {
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  for (const Eigen::Vector3d& corner : StandingBoxCorners(o.centre, o.yaw, o.length, o.width, o.height)) {
+    const Eigen::Vector3d c = pose.ToCamera(corner);
+    if (c.z() < 0.1) return {};
+    const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
+    x0 = std::min(x0, u), y0 = std::min(y0, v), x1 = std::max(x1, u), y1 = std::max(y1, v);
+  }
+  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0) & cv::Rect2d(0, 0, camera.width, camera.height);
+}
+
+bool Overlaps(const cv::Rect2d& a, const cv::Rect2d& b, double min_overlap) {
+  const double smaller = std::min(a.area(), b.area());
+  return smaller > 0.0 && (a & b).area() >= min_overlap * smaller;
+}
+
+}  // namespace
+
+std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
+                                           TimestampNs time_ns, const CameraPoseSample& pose,
+                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
+  std::vector<cv::Rect2d> boxes;
+  for (const TruthObject& o : here) {
+    const TruthObject* there = FindId(other, o.id);
+    if (there != nullptr && (there->centre - o.centre).norm() <= kSamePlace) continue;  // unchanged
+    if (!SeenNear(o, time_ns, options.visible_within_s)) continue;
+    const cv::Rect2d box = ProjectTruthBox(o, pose, camera);
+    if (box.area() >= options.min_area_px) boxes.push_back(box);
+  }
+  return boxes;
+}
+
+void KeepInOverlap(const Eigen::Matrix3d& to_other, int width, int height, std::vector<cv::Rect2d>* boxes) {
+  const auto outside = [&](const cv::Rect2d& box) {
+    const Eigen::Vector3d p = to_other * Eigen::Vector3d(box.x + box.width / 2, box.y + box.height / 2, 1.0);
+    if (p.z() <= 0.0) return true;
+    const double u = p.x() / p.z(), v = p.y() / p.z();
+    return u < 0.0 || v < 0.0 || u >= width || v >= height;
+  };
+  boxes->erase(std::remove_if(boxes->begin(), boxes->end(), outside), boxes->end());
+}
+
+double AppearanceScore::Precision() const { return Ratio(regions_on_change, regions); }
+double AppearanceScore::Recall() const { return Ratio(changes_found, changes); }
+
+AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth, const std::vector<std::vector<RegionBoxes>>& regions,
+                                const ChangeScoreOptions& options) {
+  AppearanceScore score;
+  for (std::size_t p = 0; p < truth.size() && p < regions.size(); ++p) {
+    const PlaceTruth& t = truth[p];
+    const auto on = [&](const RegionBoxes& r, const cv::Rect2d& box, bool prior) {
+      return Overlaps(prior ? r.prior : r.current, box, options.min_overlap);
+    };
+    for (const RegionBoxes& r : regions[p]) {
+      ++score.regions;
+      const bool hit = std::any_of(t.prior.begin(), t.prior.end(), [&](const cv::Rect2d& b) { return on(r, b, true); }) ||
+                       std::any_of(t.current.begin(), t.current.end(), [&](const cv::Rect2d& b) { return on(r, b, false); });
+      score.regions_on_change += hit;
+    }
+    for (const bool prior : {true, false}) {
+      for (const cv::Rect2d& box : prior ? t.prior : t.current) {
+        ++score.changes;
+        score.changes_found += std::any_of(regions[p].begin(), regions[p].end(),
+                                           [&](const RegionBoxes& r) { return on(r, box, prior); });
+      }
+    }
+  }
   return score;
 }
 

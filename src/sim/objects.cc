@@ -108,18 +108,13 @@ bool Hidden(const Scene& scene, const Eigen::Vector3d& camera, const WorldObject
 }
 
 bool ProjectBox(const WorldObject& object, const CameraIntrinsics& camera, const CameraPose& pose, cv::Rect2d* box) {
-  const Eigen::Vector2d along(std::cos(object.yaw), std::sin(object.yaw)), across(-along.y(), along.x());
   double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
-  for (double a : {-0.5, 0.5}) {
-    for (double b : {-0.5, 0.5}) {
-      for (double z : {0.0, object.height}) {
-        const Eigen::Vector2d ground = object.centre + a * object.length * along + b * object.width * across;
-        Eigen::Vector2d pixel;
-        if (!Project(camera, pose, Eigen::Vector3d(ground.x(), ground.y(), z), &pixel)) return false;
-        x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
-        y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
-      }
-    }
+  for (const Eigen::Vector3d& corner :
+       StandingBoxCorners(object.centre, object.yaw, object.length, object.width, object.height)) {
+    Eigen::Vector2d pixel;
+    if (!Project(camera, pose, corner, &pixel)) return false;
+    x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
+    y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
   }
   *box = cv::Rect2d(x0, y0, x1 - x0, y1 - y0) & cv::Rect2d(0, 0, camera.width, camera.height);
   return box->width >= 8.0 && box->height >= 8.0;

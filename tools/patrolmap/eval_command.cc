@@ -6,7 +6,9 @@
 #include <memory>
 #include <string>
 
+#include <Eigen/Dense>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
@@ -16,6 +18,7 @@
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/change.h"
 #include "patrolmap/eval/loop_closure_score.h"
+#include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/readers.h"
 
 namespace patrolmap::tools {
@@ -128,6 +131,66 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
   return Status::Ok();
 }
 
+// Geometry of the recomputed report, per voxel.
+void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& report,
+                     const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
+                     const eval::ChangeScoreOptions& options, nlohmann::json* result) {
+  const eval::GeometryScore score = eval::ScoreGeometry(report.geometry.changed_voxels, map.Patrol(report.prior_flight)->grid,
+                                                        map.Patrol(report.current_flight)->grid, before, after, options);
+  (*result)["geometry"] = CountsJson(score.voxels);
+  (*result)["geometry"]["iou"] = score.Iou();
+  (*result)["geometry"]["observed_voxels"] = score.observed_voxels;
+  (*result)["geometry"]["regions"] = report.geometry.regions.size();
+}
+
+// The visible object changes in the key frame of `node` (a node of the flight whose objects are `here`), from
+// the flight's patrol record; false without one.
+bool KeyFrameTruth(const graph::TopoMap& map, int node, const std::vector<eval::TruthObject>& here,
+                   const std::vector<eval::TruthObject>& other, const eval::ChangeScoreOptions& options,
+                   std::vector<cv::Rect2d>* boxes) {
+  const graph::NodeData& n = map.node(node);
+  const PatrolRecord* patrol = map.Patrol(n.flight);
+  if (patrol == nullptr || !patrol->camera.valid() || n.thumbnail.empty()) return false;
+  const std::optional<CameraPoseSample> pose = io::PoseAt(patrol->views, n.timestamp_ns);
+  if (!pose) return false;
+  const CameraIntrinsics thumbnail = patrol->camera.Scaled(static_cast<double>(n.thumbnail.cols) / patrol->camera.width);
+  *boxes = eval::VisibleChangeBoxes(here, other, n.timestamp_ns, *pose, thumbnail, options);
+  return true;
+}
+
+// Appearance regions of the recomputed report against the object changes visible in the two key frames.
+void ScoreAppearanceOf(const graph::TopoMap& map, const change::ChangeReport& report,
+                       const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
+                       const change::AppearanceOptions& appearance, eval::ChangeScoreOptions options,
+                       nlohmann::json* result) {
+  std::vector<eval::PlaceTruth> truth;
+  std::vector<std::vector<eval::RegionBoxes>> regions;
+  for (const change::PlaceChange& place : report.places) {
+    if (!place.appearance.registered) continue;
+    const cv::Mat& thumbnail = map.node(place.current_node).thumbnail;
+    options.min_area_px = appearance.min_area_fraction * thumbnail.total();
+    eval::PlaceTruth t;
+    if (!KeyFrameTruth(map, place.prior_node, before, after, options, &t.prior) ||
+        !KeyFrameTruth(map, place.current_node, after, before, options, &t.current)) {
+      continue;
+    }
+    Eigen::Matrix3d current_from_prior;
+    cv::cv2eigen(place.appearance.homography, current_from_prior);
+    const cv::Mat& prior_thumbnail = map.node(place.prior_node).thumbnail;
+    eval::KeepInOverlap(current_from_prior, thumbnail.cols, thumbnail.rows, &t.prior);
+    eval::KeepInOverlap(current_from_prior.inverse(), prior_thumbnail.cols, prior_thumbnail.rows, &t.current);
+    truth.push_back(t);
+    regions.emplace_back();
+    for (const change::AppearanceRegion& r : place.appearance.regions) regions.back().push_back({r.prior_box, r.current_box});
+  }
+  if (truth.empty()) return;
+  const eval::AppearanceScore score = eval::ScoreAppearance(truth, regions, options);
+  (*result)["appearance"] = {{"places", truth.size()},           {"regions", score.regions},
+                             {"regions_on_change", score.regions_on_change}, {"changes", score.changes},
+                             {"changes_found", score.changes_found}, {"precision", score.Precision()},
+                             {"recall", score.Recall()}};
+}
+
 // Changes of RUN (changes.json, and the grids in map.pmap) against the two flights' ground truth.
 Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLog>& logs, nlohmann::json* report) {
   const std::string path = arguments.run + "/changes.json";
@@ -161,7 +224,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     for (const auto& [state, counts] : score.by_state) result["objects"][state] = CountsJson(counts);
     result["objects"]["unobserved_reported"] = score.unobserved;
   }
-  if (!changes["geometry"].is_null() && std::filesystem::exists(arguments.run + "/map.pmap")) {
+  if (std::filesystem::exists(arguments.run + "/map.pmap")) {
     pipeline::Config config;
     graph::TopoMap map;
     change::ChangeReport recomputed;
@@ -170,12 +233,8 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, prior, current, config.change, &recomputed));
     eval::ChangeScoreOptions options = arguments.changes;
     options.min_observations = config.change.geometry.min_observations;
-    const eval::GeometryScore score = eval::ScoreGeometry(recomputed.geometry.changed_voxels, map.Patrol(prior)->grid,
-                                                          map.Patrol(current)->grid, before, after, options);
-    result["geometry"] = CountsJson(score.voxels);
-    result["geometry"]["iou"] = score.Iou();
-    result["geometry"]["observed_voxels"] = score.observed_voxels;
-    result["geometry"]["regions"] = recomputed.geometry.regions.size();
+    if (recomputed.geometry_compared) ScoreGeometryOf(map, recomputed, before, after, options, &result);
+    ScoreAppearanceOf(map, recomputed, before, after, config.change.appearance, options, &result);
   }
   (*report)["changes"] = result;
   return Status::Ok();
@@ -196,6 +255,15 @@ void PrintChangeTable(const nlohmann::json& c) {
     for (const char* state : {"new", "removed", "moved", "persistent"}) {
       PrintCounts((std::string("objects ") + state).c_str(), c["objects"][state]);
     }
+  }
+  if (c.contains("appearance")) {
+    const nlohmann::json& a = c["appearance"];
+    const double p = a["precision"].get<double>(), r = a["recall"].get<double>();
+    std::printf("%-18s %5d %6d %7d %10.2f %7.2f %6.2f\n", "appearance regions", a["regions_on_change"].get<int>(),
+                a["regions"].get<int>() - a["regions_on_change"].get<int>(),
+                a["changes"].get<int>() - a["changes_found"].get<int>(), p, r, p + r > 0 ? 2 * p * r / (p + r) : 0.0);
+    std::printf("appearance: %d regions, %d object changes visible in the key frames of %d registered places\n",
+                a["regions"].get<int>(), a["changes"].get<int>(), a["places"].get<int>());
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);

@@ -6,7 +6,10 @@
 // match within a small shift (parallax), form the changed regions:
 // connected, above a minimum size, each with a score and its box in both
 // images. A lighting-only change differs in the global but not in the local
-// comparison, so it yields no region.
+// comparison, so it yields no region. A region whose features (prior and
+// current, inside its box) mostly still match between the two key frames
+// shows the same things seen from elsewhere (parallax off the registered
+// plane), not a change, and is dropped; featureless regions are kept.
 #pragma once
 
 #include <vector>
@@ -33,8 +36,10 @@ struct AppearanceRegion {
   cv::Rect prior_box;     // the same region in the prior key frame
   int area_px = 0;
   double score = 0.0;     // mean structure change in the region (1 - contrast-structure term)
-  int prior_features = 0;           // prior features that fall in the region
-  int unmatched_prior_features = 0; // ... of which no longer match (they support the change)
+  int prior_features = 0;             // prior features inside the region's box (mapped into the current frame)
+  int unmatched_prior_features = 0;   // ... of which no current feature matches (they support the change)
+  int current_features = 0;           // current features inside the box
+  int unmatched_current_features = 0; // ... of which no prior feature matches
 };
 
 struct AppearanceChange {

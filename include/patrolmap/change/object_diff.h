@@ -8,8 +8,9 @@
 //   removed     a prior object nothing matched although the current views covering
 //               it (in range, half its box inside the image, not behind occupied voxels
 //               of the current evidence grid other than those of a current object that
-//               may be it, moved) would have detected it often enough: as many times as
-//               min_expected_detections at the rate the prior patrol detected it;
+//               may be it, moved) would have detected it often enough: at least
+//               min_expected_detections times, its prior detections scaled by the
+//               ratio of the covering views now and in its own patrol;
 //   unobserved  a prior object the current patrol did not see well enough to tell;
 //   new         a current object matching nothing of the prior patrol.
 // Unconfirmed objects (seen too few times) take part only in the persistent
@@ -66,8 +67,8 @@ double VisibleFraction(const MapObject& object, const CameraIntrinsics& camera, 
 int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const ObjectDiffOptions& options,
                   const std::vector<const MapObject*>& see_through = {});
 
-// Detections `views` covering views would give of `object`, at the rate its own patrol detected it in its
-// `own_views` covering views there (detections per view, at most 1; 1 when no own view covered it).
+// Detections `views` covering views would give of `object`: its detections scaled by how many views covered
+// it then (`own_views`, in its own patrol) and now; one per view when no own view covered it.
 double ExpectedDetections(const MapObject& object, int own_views, int views);
 
 std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRecord& current,

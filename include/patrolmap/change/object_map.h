@@ -9,7 +9,8 @@
 // at least half of the object's points it sees lie on its depth surface.
 // Every object accumulates label-confidence and label-count pairs; Finish()
 // merges objects whose centroids ended up within merge_distance_m (one object
-// split by a failed association), marks objects with too few detections
+// split by a failed association), gives objects with points the points' extent
+// (2nd to 98th percentile) as their box, marks objects with too few detections
 // unconfirmed and gives each the label with the highest accumulated
 // confidence and that label's mean confidence.
 #pragma once
@@ -23,6 +24,10 @@
 #include "patrolmap/core/patrol_data.h"
 
 namespace patrolmap::change {
+
+// Layout of MapObject::descriptor.
+constexpr std::size_t kOrientationBins = 8;    // [0, 8): gradient-orientation histogram
+constexpr std::size_t kBrightnessRankAt = 8;   // brightness rank
 
 class ObjectMapper {
  public:
@@ -91,8 +96,8 @@ void CumulativeHistogram(const cv::Mat& image, std::array<float, 256>* cdf);
 // box's central half. Unchanged by any monotonic change of the lighting (gain, offset, gamma).
 float BrightnessRank(const cv::Mat& image, const cv::Rect& box, const std::array<float, 256>& cdf);
 
-// The q-quantile (q in [0, 1]) of the points' z [m]; 0 with fewer than 10 points.
-double PointZQuantile(const std::vector<Eigen::Vector3f>& points, double q);
+// The q-quantile (q in [0, 1]) of the points' coordinate `axis` (0 x, 1 y, 2 z) [m]; 0 with fewer than 10 points.
+double PointQuantile(const std::vector<Eigen::Vector3f>& points, int axis, double q);
 
 // Vertical extent of points (5th to 95th percentile of z) [m]; 0 with fewer than 10 points.
 double PointHeight(const std::vector<Eigen::Vector3f>& points);

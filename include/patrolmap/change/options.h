@@ -17,6 +17,8 @@ struct AppearanceOptions {
   double min_structure_change = 0.5; // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
   double structure_sigma_px = 1.5;   // Gaussian window of that term
   double min_area_fraction = 0.01;   // regions smaller than this share of the compared area are dropped
+  double min_unmatched_share = 0.5;  // ... and so are regions with features of which fewer than this share lost
+                                     // their match between the key frames (parallax, not change)
 };
 
 // Object map of one patrol (paper 000, with the 2D fallback of paper 001).
@@ -42,16 +44,16 @@ struct ObjectDiffOptions {
   double max_move_m = 8.0;            // moved: the two positions at most this far apart (farther: removed + new)
   double physical_weight = 0.6;       // alpha of paper 003's weighted normalised distance
   double appearance_weight = 0.4;     // beta
-  double max_texture_distance = 0.15; // pairs whose gradient-orientation histograms differ more (half their
+  double max_texture_distance = 0.25; // pairs whose gradient-orientation histograms differ more (half their
                                       // L1 distance) are not a move
   double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
   double min_visible_fraction = 0.5;  // visibility: at least this share of its projected box inside the image
   double min_expected_detections = 3; // removed: the current views covering a prior object would have given at
-                                      // least this many detections at the rate the prior patrol detected it
-                                      // (detections per covering view, at most 1); fewer: unobserved
+                                      // least this many detections (its prior detections x covering views now /
+                                      // covering views in its own patrol); fewer: unobserved
   double min_shape_overlap = 0.85;    // moved: share of the current object's points, shifted onto the prior
                                       // object, within 0.15 m of its points (1 when either has none)
-  double max_top_difference_m = 0.1;  // moved: the tops of the two objects (95th percentile of their points'
+  double max_top_difference_m = 0.05;  // moved: the tops of the two objects (95th percentile of their points'
                                       // height) differ by at most this; objects stand on level ground
 };
 

@@ -47,7 +47,8 @@ struct MapObject {
   int detections = 0;
   bool confirmed = true;             // seen often enough to count; unconfirmed ones only explain later sightings
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // world frame [m]
-  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (or of its centroids)
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (2nd to 98th
+                                                       // percentile; without points: its mean detected size)
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3f> points;                 // segmented points (voxel-filtered); empty without depth
   std::vector<float> descriptor;  // appearance, mean over its views: 8-bin gradient-orientation histogram, then

@@ -3,6 +3,7 @@
 // image coordinates are pixels with the origin at the top-left pixel centre.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -69,5 +70,10 @@ struct KeyLocation {
 };
 
 const char* ToString(ExtremumKind kind);
+
+// The 8 corners of a box standing on z = 0 at `centre`, turned by `yaw` about the vertical, `length` along
+// the yaw direction and `width` across it.
+std::array<Eigen::Vector3d, 8> StandingBoxCorners(const Eigen::Vector2d& centre, double yaw, double length,
+                                                  double width, double height);
 
 }  // namespace patrolmap

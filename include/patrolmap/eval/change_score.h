@@ -23,6 +23,18 @@
 // of one flight only partly (centre within half a voxel of its faces) is a
 // tolerance band, where reporting is a hit and not reporting no miss.
 // Precision = hits / reported, recall = core voxels reported / core voxels.
+//
+// Appearance (per region, at the places both patrols compared): an object
+// change is visible in a key frame when the object stands in that flight but
+// not at that place in the other (new, removed, or either end of a move), the
+// flight's detector reported it within `visible_within_s` of the key frame,
+// its box projected into the key frame's thumbnail covers at least
+// `min_area_px` inside the image, and the registration of the two key frames
+// maps its centre into the other one (the stage compares only their overlap).
+// A region lies on a change when its box in
+// the current (prior) key frame overlaps the current (prior) change's box by
+// at least `min_overlap` of the smaller of the two. Precision = regions on a
+// change / regions; recall = changes some region lies on / changes.
 #pragma once
 
 #include <map>
@@ -42,6 +54,7 @@ struct TruthObject {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   double yaw = 0.0, length = 0.0, width = 0.0, height = 0.0;
   int detections = 0;  // how often the flight's detector reported it
+  std::vector<TimestampNs> seen_ns;  // ... and when (ascending)
   bool Contains(const Eigen::Vector3d& point, double margin) const;
 };
 
@@ -70,6 +83,9 @@ struct ChangeScoreOptions {
   double distance_m = 1.0;
   int min_detections = 3;
   int min_observations = 3;
+  double visible_within_s = 0.25;
+  double min_area_px = 100.0;  // thumbnail pixels
+  double min_overlap = 0.3;
 };
 
 ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported, const std::vector<TruthObject>& before,
@@ -84,5 +100,32 @@ struct GeometryScore {
 GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const EvidenceGridData& before_grid,
                             const EvidenceGridData& after_grid, const std::vector<TruthObject>& before,
                             const std::vector<TruthObject>& after, const ChangeScoreOptions& options);
+
+// The boxes, in a key frame of the flight whose objects are `here`, of the objects changed with respect to
+// `other` that the key frame shows. `camera` is the thumbnail's camera, `pose` the key frame's.
+std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
+                                           TimestampNs time_ns, const CameraPoseSample& pose,
+                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options);
+
+// Keeps the boxes whose centre `to_other` (a homography) maps inside a width x height image.
+void KeepInOverlap(const Eigen::Matrix3d& to_other, int width, int height, std::vector<cv::Rect2d>* boxes);
+
+struct PlaceTruth {
+  std::vector<cv::Rect2d> prior, current;  // visible change boxes in the two key frames
+};
+struct RegionBoxes {
+  cv::Rect2d prior, current;
+};
+
+struct AppearanceScore {
+  int regions = 0, regions_on_change = 0;
+  int changes = 0, changes_found = 0;
+  double Precision() const;
+  double Recall() const;
+};
+
+// One entry per compared place in both vectors.
+AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth, const std::vector<std::vector<RegionBoxes>>& regions,
+                                const ChangeScoreOptions& options);
 
 }  // namespace patrolmap::eval
