@@ -4,25 +4,7 @@
 set -u
 bin=$1
 source_dir=$2
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-failures=0
-passes=0
-
-expect() {  # expect NAME WANTED_CODE PATTERN -- COMMAND...
-  local name=$1 wanted=$2 pattern=$3
-  shift 4
-  local output code
-  output=$("$@" 2>&1)
-  code=$?
-  if [[ $code -ne $wanted ]] || ! grep -qE -- "$pattern" <<<"$output"; then
-    echo "FAIL $name: exit $code (wanted $wanted), output:"
-    echo "$output" | head -5
-    failures=$((failures + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
+source "$(dirname "$0")/shell_lib.sh"
 
 expect "no subcommand" 2 "subcommand" -- "$bin"
 expect "missing log" 1 "$work/nothing: no such file or folder" -- "$bin" detect "$work/nothing" --out "$work/o"
@@ -119,5 +101,4 @@ expect "vocab build" 0 "words \(k=4, L=2\)" -- \
 expect "vocab build bad k" 1 "branching k must be in" -- \
   "$bin" vocab build "$source_dir/flight_logs/sample" -k 1 --out "$work/bad.pmvoc"
 
-echo "cli: $passes passed, $failures failed"
-[[ $failures -eq 0 ]]
+finish cli

@@ -340,6 +340,28 @@ TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
   EXPECT_NEAR((closed.node(10).layout - closed.node(0).layout).norm(), 10.0, 1.5);  // sides keep their length
 }
 
+TEST(Layout, AFirstNodeWithoutEdgesIsLaidOutToo) {
+  // A one-node flight (a log stopped after its first key location) followed by a two-node one.
+  TopoMap map;
+  LayoutInput input;
+  for (const char* flight : {"a", "b", "b"}) {
+    NodeData node;
+    node.flight = flight;
+    node.timestamp_ns = 1'000'000'000LL * map.node_count();
+    map.AddNode(std::move(node));
+    input.heading.push_back(0.0);
+  }
+  TopoMap single;
+  single.AddNode(NodeData{});
+  LayoutInput one;
+  one.heading = {0.0};
+  ASSERT_TRUE(LayoutMap(one, {}, &single).ok());
+  EXPECT_EQ(single.node(0).layout, Eigen::Vector2d::Zero());
+  map.AddEdge(1, 2, EdgeData{});
+  ASSERT_TRUE(LayoutMap(input, {}, &map).ok());
+  EXPECT_NEAR((map.node(2).layout - map.node(1).layout).norm(), 1.0, 1e-6);
+}
+
 
 TEST(Export, SvgColoursLoopClosuresByTruth) {
   const TopoMap map = TwoFlights();

@@ -271,17 +271,14 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 #include "patrolmap/eval/loop_closure_score.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/map.h"
+#include "patrolmap/pipeline/onboard.h"
 
 namespace patrolmap::pipeline {
 namespace {
 
-// The same street flown twice under different lighting; every processed frame of both flights is a node.
-// Mapped together, and as a patrol against flight 1's saved map: the results must agree exactly.
-// Loop closures of the second flight against the first are scored against the simulator's places.
-TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
-  testing::TempDir dir;
-  Config config;
-  config.place.exclude_recent_s = 1e9;  // only the other flight counts here
+// The same street flown twice under different lighting (logs street-1 and street-2 in `dir`), and a small
+// vocabulary from the first flight's frames.
+void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vocab::Vocabulary* vocabulary) {
   std::vector<cv::Mat> training;
   for (int flight = 1; flight <= 2; ++flight) {
     sim::StreetOptions street;
@@ -307,8 +304,18 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   vocab::VocabularyOptions vocabulary_options;
   vocabulary_options.branching = 8;
   vocabulary_options.depth = 3;
+  ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, vocabulary).ok());
+}
+
+// Every processed frame of both flights is a node. Mapped together, and as a patrol against flight 1's saved
+// map: the results must agree exactly. Loop closures of the second flight against the first are scored
+// against the simulator's places.
+TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
+  testing::TempDir dir;
+  Config config;
+  config.place.exclude_recent_s = 1e9;  // only the other flight counts here
   vocab::Vocabulary vocabulary;
-  ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, &vocabulary).ok());
+  ASSERT_NO_FATAL_FAILURE(TwoStreetFlights(dir.path(), config, &vocabulary));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   MapResult result;
   KeyFrameSelection every;
@@ -358,6 +365,73 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
     EXPECT_EQ(joint[i].data.inliers, patrolled[i].data.inliers);
   }
   EXPECT_EQ(score.false_positives, 0);
+}
+
+// Maps each flight's key locations through the onboard mapper (frames one by one, as live) into `result`.
+void MapOnboard(const std::filesystem::path& log, const Config& config, const OnboardOptions& options,
+                place::PlaceRecognizer* recognizer, MapResult* result, OnboardStats* stats) {
+  std::unique_ptr<io::FrameSource> source;
+  ASSERT_TRUE(io::OpenLog(log, config.input, &source).ok());
+  OnboardMapper mapper(config, source->info(), recognizer, options);
+  Frame frame;
+  while (source->Next(mapper.NeedsImage(), &frame).ok()) ASSERT_TRUE(mapper.AddFrame(frame).ok());
+  ASSERT_TRUE(mapper.Finish(result).ok());
+  *stats = mapper.stats();
+}
+
+// The onboard mapper gives the map `patrolmap map` gives (key locations from the whole log, then the place
+// stage), whether place recognition runs on its worker thread or inline.
+TEST(OnboardEndToEnd, SameMapAsOfflineOnAWorkerOrInline) {
+  testing::TempDir dir;
+  Config config;
+  vocab::Vocabulary vocabulary;
+  ASSERT_NO_FATAL_FAILURE(TwoStreetFlights(dir.path(), config, &vocabulary));
+  place::PlaceRecognizer offline_recognizer(&vocabulary, config.place);
+  MapResult offline;
+  for (const char* flight : {"street-1", "street-2"}) {
+    std::unique_ptr<io::FrameSource> source;
+    ASSERT_TRUE(io::OpenLog(dir / flight, config.input, &source).ok());
+    DetectionResult detection;
+    ASSERT_TRUE(RunDetection(source.get(), config.flow, &detection).ok());
+    KeyFrameSelection selection;
+    for (const KeyLocation& k : detection.key_locations) selection.frames.push_back(k.frame_index);
+    ASSERT_TRUE(RecognisePlaces(dir / flight, config, selection, &offline_recognizer, &offline).ok());
+  }
+  ASSERT_GE(offline.nodes.size(), 4u);
+  for (const bool worker : {true, false}) {
+    OnboardOptions options;
+    options.place_worker = worker;
+    options.queue_capacity = 1;
+    place::PlaceRecognizer recognizer(&vocabulary, config.place);
+    MapResult onboard;
+    OnboardStats stats;
+    for (const char* flight : {"street-1", "street-2"}) {
+      ASSERT_NO_FATAL_FAILURE(MapOnboard(dir / flight, config, options, &recognizer, &onboard, &stats));
+      EXPECT_EQ(stats.lost_key_frames, 0);
+    }
+    ASSERT_EQ(onboard.nodes.size(), offline.nodes.size()) << worker;
+    for (std::size_t i = 0; i < onboard.nodes.size(); ++i) {
+      EXPECT_EQ(onboard.nodes[i].frame_index, offline.nodes[i].frame_index);
+      EXPECT_EQ(onboard.nodes[i].flight, offline.nodes[i].flight);
+      EXPECT_EQ(onboard.nodes[i].features, offline.nodes[i].features);
+      EXPECT_EQ(onboard.nodes[i].heading, offline.nodes[i].heading);
+    }
+    ASSERT_EQ(onboard.loop_closures.size(), offline.loop_closures.size()) << worker;
+    for (std::size_t i = 0; i < onboard.loop_closures.size(); ++i) {
+      EXPECT_EQ(onboard.loop_closures[i].query_node, offline.loop_closures[i].query_node);
+      EXPECT_EQ(onboard.loop_closures[i].matched_node, offline.loop_closures[i].matched_node);
+      EXPECT_EQ(onboard.loop_closures[i].verification.inliers, offline.loop_closures[i].verification.inliers);
+    }
+  }
+  // A ring of one frame cannot hold a frame until its key location is confirmed: those are lost, counted.
+  OnboardOptions tiny;
+  tiny.ring_frames = 1;
+  place::PlaceRecognizer recognizer(&vocabulary, config.place);
+  MapResult result;
+  OnboardStats stats;
+  ASSERT_NO_FATAL_FAILURE(MapOnboard(dir / "street-1", config, tiny, &recognizer, &result, &stats));
+  EXPECT_GT(stats.lost_key_frames, 0);
+  EXPECT_EQ(result.nodes.size() + stats.lost_key_frames, static_cast<std::size_t>(stats.key_frames + stats.lost_key_frames));
 }
 
 }  // namespace

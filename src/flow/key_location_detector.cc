@@ -61,6 +61,7 @@ const cv::Mat& KeyLocationDetector::Downscale(const cv::Mat& image) {
 
 void KeyLocationDetector::ProcessSelected(const Frame& frame, DetectorOutput* output) {
   const cv::Mat& image = Downscale(frame.image);
+  last_image_ = image;
   if (!voter_) voter_.emplace(options_.voting, image.cols, image.rows);
   tracker_.Track(image, &vectors_);
   if (derotate_ && previous_processed_ns_) Derotate(frame.timestamp_ns, image.cols);

@@ -95,7 +95,8 @@ Status LayoutMap(const LayoutInput& input, const LayoutOptions& options, TopoMap
                                new ceres::CauchyLoss(options.robust_scale), a, b);
     }
   }
-  if (n > 0) problem.SetParameterBlockConstant(poses[0].data());
+  // The first node anchors the layout (a node without edges is in no residual and needs no anchor).
+  if (n > 0 && problem.HasParameterBlock(poses[0].data())) problem.SetParameterBlockConstant(poses[0].data());
   ceres::Solver::Options solver;
   solver.max_num_iterations = options.max_iterations;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;

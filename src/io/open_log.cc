@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 
@@ -46,11 +47,12 @@ std::string FormatPattern(const std::string& pattern, int index) {
   return buffer.data();
 }
 
-// Reads frames from a video; unreadable frames end the stream (codecs cannot resync).
+// Reads frames from a video or a camera; unreadable frames end the stream (codecs cannot resync). A video's
+// frames are timed by their index and rate, a camera's by the clock since the first.
 class VideoSource : public FrameSource {
  public:
-  VideoSource(LogInfo info, cv::VideoCapture capture)
-      : info_(std::move(info)), capture_(std::move(capture)) {}
+  VideoSource(LogInfo info, cv::VideoCapture capture, bool live = false)
+      : info_(std::move(info)), capture_(std::move(capture)), live_(live) {}
 
   Status Next(bool decode_image, Frame* frame) override {
     frame->imu.clear();
@@ -58,6 +60,11 @@ class VideoSource : public FrameSource {
     if (!capture_.grab()) return Status::EndOfStream();
     frame->index = next_index_++;
     frame->timestamp_ns = SecondsToNs(static_cast<double>(frame->index) / info_.frame_rate_hz);
+    if (live_) {
+      const auto now = std::chrono::steady_clock::now();
+      if (frame->index == 0) start_ = now;
+      frame->timestamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now - start_).count();
+    }
     if (decode_image) {
       capture_.retrieve(buffer_);
       if (buffer_.channels() == 1) {
@@ -73,6 +80,8 @@ class VideoSource : public FrameSource {
  private:
   LogInfo info_;
   cv::VideoCapture capture_;
+  bool live_ = false;
+  std::chrono::steady_clock::time_point start_;
   cv::Mat buffer_;
   std::int64_t next_index_ = 0;
 };
@@ -134,6 +143,16 @@ Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
   const double count = capture.get(cv::CAP_PROP_FRAME_COUNT);
   info.frame_count = count > 0.0 ? static_cast<std::int64_t>(count) : -1;
   *source = std::make_unique<VideoSource>(std::move(info), std::move(capture));
+  return Status::Ok();
+}
+
+Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
+  PATROLMAP_RETURN_IF_ERROR(CheckFrameRate(options));
+  cv::VideoCapture capture(device);
+  if (!capture.isOpened()) return Status::NotFound("camera " + std::to_string(device) + ": cannot be opened");
+  const double reported_rate = capture.get(cv::CAP_PROP_FPS);
+  LogInfo info = MakeInfo("camera" + std::to_string(device), "camera", reported_rate > 0.0 ? reported_rate : options.frame_rate_hz);
+  *source = std::make_unique<VideoSource>(std::move(info), std::move(capture), true);
   return Status::Ok();
 }
 

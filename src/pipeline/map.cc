@@ -24,45 +24,40 @@ cv::Mat Thumbnail(const cv::Mat& image) {
   return thumbnail;
 }
 
-// Integrates the yaw rate about the measured up axis (the accelerometer's mean
-// direction), so the IMU may be mounted any way round.
-class YawIntegrator {
- public:
-  void Add(const std::vector<ImuSample>& samples) {
-    for (const ImuSample& sample : samples) {
-      if (sample.accel.norm() > 1.0) up_ = (0.99 * up_ + 0.01 * sample.accel.normalized()).normalized();
-      if (has_previous_) yaw_ += sample.gyro.dot(up_) * NsToSeconds(sample.timestamp_ns - previous_ns_);
-      previous_ns_ = sample.timestamp_ns;
-      has_previous_ = true;
-    }
+}  // namespace
+
+void YawIntegrator::Add(const std::vector<ImuSample>& samples) {
+  for (const ImuSample& sample : samples) {
+    if (sample.accel.norm() > 1.0) up_ = (0.99 * up_ + 0.01 * sample.accel.normalized()).normalized();
+    if (has_previous_) yaw_ += sample.gyro.dot(up_) * NsToSeconds(sample.timestamp_ns - previous_ns_);
+    previous_ns_ = sample.timestamp_ns;
+    has_previous_ = true;
   }
-  double yaw() const { return yaw_; }
-
- private:
-  Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
-  double yaw_ = 0.0;
-  TimestampNs previous_ns_ = 0;
-  bool has_previous_ = false;
-};
-
-void Record(const place::KeyFrame& key_frame, const place::PlaceResult& place, double heading,
-            const std::optional<Eigen::Vector3d>& gps, std::map<int, std::int64_t>* frame_of, MapResult* result) {
-  result->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
-                           Thumbnail(key_frame.image), heading,
-                           gps ? std::optional<Eigen::Vector2d>(gps->head<2>()) : std::nullopt,
-                           key_frame.image.cols});
-  (*frame_of)[place.node] = key_frame.frame_index;
-  result->seconds_features += place.seconds_features;
-  result->seconds_query += place.seconds_query;
-  result->seconds_verify += place.seconds_verify;
-  result->seconds_add += place.seconds_add;
-  if (!place.match) return;
-  const auto matched = frame_of->find(place.match->node);
-  result->loop_closures.push_back({place.node, place.match->node, key_frame.frame_index,
-                                   matched == frame_of->end() ? -1 : matched->second, *place.match});
 }
 
-}  // namespace
+PlaceStage::PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result) : recognizer_(recognizer), result_(result) {
+  for (const MapNode& node : result->nodes) frame_of_[node.node] = node.frame_index;
+}
+
+Status PlaceStage::Add(const KeyFrameInput& input) {
+  const place::KeyFrame& key_frame = input.key_frame;
+  place::PlaceResult place;
+  PATROLMAP_RETURN_IF_ERROR(recognizer_->AddKeyFrame(key_frame, &place));
+  result_->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
+                            Thumbnail(key_frame.image), input.heading,
+                            input.gps ? std::optional<Eigen::Vector2d>(input.gps->head<2>()) : std::nullopt,
+                            key_frame.image.cols});
+  frame_of_[place.node] = key_frame.frame_index;
+  result_->seconds_features += place.seconds_features;
+  result_->seconds_query += place.seconds_query;
+  result_->seconds_verify += place.seconds_verify;
+  result_->seconds_add += place.seconds_add;
+  if (!place.match) return Status::Ok();
+  const auto matched = frame_of_.find(place.match->node);
+  result_->loop_closures.push_back({place.node, place.match->node, key_frame.frame_index,
+                                    matched == frame_of_.end() ? -1 : matched->second, *place.match});
+  return Status::Ok();
+}
 
 Status RecognisePlaces(const std::string& log, const Config& config, const KeyFrameSelection& selection,
                        place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress) {
@@ -70,25 +65,24 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
   const int step = config.flow.frames.step;
   const double scale = config.flow.frames.scale;
-  std::map<int, std::int64_t> frame_of;
-  for (const MapNode& node : result->nodes) frame_of[node.node] = node.frame_index;
+  PlaceStage places(recognizer, result);
   Frame frame;
   Status status;
   std::int64_t next = 0;
-  place::KeyFrame key_frame;
-  key_frame.flight = source->info().flight_id;
+  KeyFrameInput input;
+  input.key_frame.flight = source->info().flight_id;
   YawIntegrator yaw;
   while ((status = source->Next(Selected(selection, next, step), &frame)).ok()) {
     next = frame.index + 1;
     yaw.Add(frame.imu);
     if (frame.image.empty() || !Selected(selection, frame.index, step)) continue;
-    if (scale < 1.0) cv::resize(frame.image, key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
-    else key_frame.image = frame.image;
-    key_frame.timestamp_ns = frame.timestamp_ns;
-    key_frame.frame_index = frame.index;
-    place::PlaceResult place;
-    PATROLMAP_RETURN_IF_ERROR(recognizer->AddKeyFrame(key_frame, &place));
-    Record(key_frame, place, yaw.yaw(), frame.gps, &frame_of, result);
+    if (scale < 1.0) cv::resize(frame.image, input.key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
+    else input.key_frame.image = frame.image;
+    input.key_frame.timestamp_ns = frame.timestamp_ns;
+    input.key_frame.frame_index = frame.index;
+    input.heading = yaw.yaw();
+    input.gps = frame.gps;
+    PATROLMAP_RETURN_IF_ERROR(places.Add(input));
     if (progress) progress(frame.index, source->info().frame_count);
   }
   return status.end_of_stream() ? Status::Ok() : status;

@@ -54,6 +54,8 @@ class KeyLocationDetector {
   // True when flow is de-rotated (option on, IMU extrinsics and intrinsics known).
   bool derotating() const { return derotate_; }
   int processed_frames() const { return processed_frames_; }
+  // The image the last processed frame was tracked in (at the flow scale); valid until the next Process().
+  const cv::Mat& last_image() const { return last_image_; }
 
  private:
   void ProcessSelected(const Frame& frame, DetectorOutput* output);
@@ -76,6 +78,7 @@ class KeyLocationDetector {
   std::optional<TimestampNs> previous_processed_ns_;
   std::vector<ImuSample> pending_imu_;
   cv::Mat small_;
+  cv::Mat last_image_;
   std::vector<FlowVector> vectors_;
   std::vector<PolarVector> polar_;
   std::vector<std::uint8_t> accepted_;

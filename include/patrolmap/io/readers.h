@@ -28,6 +28,10 @@ Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& op
 Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
                  std::unique_ptr<FrameSource>* source);
 
+// Camera device `device` (OpenCV VideoCapture index, /dev/videoN on Linux); frames converted to grey and
+// timed by the clock from the first one; flight id "cameraN".
+Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source);
+
 // EuRoC/ASL layout (DESIGN.md): <log>/cam0/data.csv and cam0/data/, optional
 // cam0/sensor.yaml, imu0/data.csv (+ imu0/sensor.yaml), meta.yaml and
 // state_groundtruth_estimate0/data.csv (platform speed). A top folder holding

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <functional>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,40 @@ struct KeyFrameSelection {
 };
 
 using MapProgress = std::function<void(std::int64_t, std::int64_t)>;
+
+// Integrates the gyro's yaw rate about the measured up axis (the accelerometer's mean direction), so the IMU
+// may be mounted any way round: the heading a node keeps.
+class YawIntegrator {
+ public:
+  void Add(const std::vector<ImuSample>& samples);
+  double yaw() const { return yaw_; }
+
+ private:
+  Eigen::Vector3d up_ = Eigen::Vector3d::UnitZ();
+  double yaw_ = 0.0;
+  TimestampNs previous_ns_ = 0;
+  bool has_previous_ = false;
+};
+
+// A frame chosen as a node, at the place stage's scale, with what the map keeps of it besides its features.
+struct KeyFrameInput {
+  place::KeyFrame key_frame;
+  double heading = 0.0;
+  std::optional<Eigen::Vector3d> gps;
+};
+
+// The place stage of a mapping run: recognises each key frame's place and records its node and loop
+// closure in `result` (which may hold the nodes of earlier flights).
+class PlaceStage {
+ public:
+  PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result);
+  Status Add(const KeyFrameInput& input);
+
+ private:
+  place::PlaceRecognizer* recognizer_;
+  MapResult* result_;
+  std::map<int, std::int64_t> frame_of_;  // node -> frame index
+};
 
 // Reads `log` again, describes each selected frame at the flow stage's scale
 // and passes it through `recognizer` (which may already hold earlier flights).
