@@ -413,6 +413,42 @@ TEST(ObjectStates, AMovedObjectKeepsItsTopHeight) {
   }
 }
 
+TEST(ObjectStates, AnObjectSeenFromOneSideBeforeIsPersistentWhenSeenWhole) {
+  PatrolRecord prior = Patrol({{"barrel", {10, 0, 0.5}}});
+  for (const Eigen::Vector3f& p : CubePoints({10, 0}, 1.0)) {
+    if (p.x() < 9.55f) prior.objects[0].points.push_back(p);  // only the face towards the flight
+  }
+  PatrolRecord current = Patrol({{"barrel", {10.1, 0, 0.5}}});
+  current.objects[0].points = CubePoints({10.1, 0}, 1.0);
+  const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0].state, ObjectState::kPersistent);
+}
+
+TEST(ObjectStates, OnlyAnObjectThatMayBeTheMovedOneIsLookedThrough) {
+  // A crate stood at x = 10; the current patrol has a new crate at x = 7 in front of that place, whose
+  // voxels fill the line of sight. Of the same size it may be the crate moved (looked through, paired as a
+  // move); taller, it is another crate that hides the place: the prior one is unobserved, not removed.
+  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}});
+  prior.objects[0].points = CubePoints({10, 0}, 1.0);
+  for (const auto& [side, state] : {std::pair{1.0, ObjectState::kMoved}, std::pair{1.4, ObjectState::kUnobserved}}) {
+    PatrolRecord current = Patrol({{"crate", {7, 0, side / 2}}});
+    current.objects[0].points = CubePoints({7, 0}, side);
+    current.objects[0].box_min = Eigen::Vector3d(7 - side / 2, -side / 2, 0);
+    current.objects[0].box_max = Eigen::Vector3d(7 + side / 2, side / 2, side);
+    current.grid.voxel_size = 0.2;
+    for (int x = 33; x <= 37; ++x) {
+      for (int y = -5; y <= 5; ++y) {
+        for (int z = 0; z <= 7; ++z) current.grid.voxels.push_back({x, y, z, 9, 0});
+      }
+    }
+    std::sort(current.grid.voxels.begin(), current.grid.voxels.end(), VoxelBefore);
+    const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+    ASSERT_FALSE(changes.empty());
+    EXPECT_EQ(changes[0].state, state) << side;
+  }
+}
+
 TEST(ObjectStates, AnObjectWhosePlaceWentUnseenCanStillHaveMoved) {
   // Behind every view of the current patrol, the crate left its place for one 4 m away.
   const PatrolRecord prior = Patrol({{"crate", {-20, 0, 0.5}}});

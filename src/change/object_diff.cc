@@ -213,7 +213,10 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
       const MapObject &a = m->p[i], &b = m->c[j];
       const double distance = (a.centroid - b.centroid).norm();
       if (a.label != b.label || distance > options.match_distance_m) continue;
-      if (!a.points.empty() && !b.points.empty() && PairFraction(b.points, a.points, kPairDistance) < kMinPairFraction) {
+      // Paper 000's point-pair test, from the object seen less (a partial view lies on the fuller one).
+      const bool b_smaller = b.points.size() <= a.points.size();
+      if (!a.points.empty() && !b.points.empty() &&
+          PairFraction(b_smaller ? b.points : a.points, b_smaller ? a.points : b.points, kPairDistance) < kMinPairFraction) {
         continue;
       }
       close.push_back({static_cast<int>(i), static_cast<int>(j), distance});
@@ -226,6 +229,19 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
     const double confidence = std::min(a.confidence, b.confidence) * (1.0 - pair.cost / (2.0 * options.match_distance_m));
     changes->push_back(MakeChange(ObjectState::kPersistent, &a, &b, confidence));
   }
+}
+
+// Whether unmatched current object j may be unmatched prior object i moved: same label, within max_move_m,
+// alike in texture and top height, and of the same shape (paper 000's point-pair test after the move).
+bool MayHaveMoved(const ObjectDiffOptions& options, const Matching& m, std::size_t i, std::size_t j) {
+  if (m.prior_used[i] || m.current_used[j] || m.p[i].label != m.c[j].label) return false;
+  if ((m.p[i].centroid - m.c[j].centroid).norm() > options.max_move_m) return false;
+  if (CompareAppearance(m.p[i], m.c[j]).texture.value_or(0.0) > options.max_texture_distance) return false;
+  if (m.prior_top[i] > 0.0 && m.current_top[j] > 0.0 &&
+      std::abs(m.prior_top[i] - m.current_top[j]) > options.max_top_difference_m) {
+    return false;
+  }
+  return MovedShapeOverlap(m.p[i], m.c[j]) >= options.min_shape_overlap;
 }
 
 // How well the current patrol saw the place of every unmatched prior object: its covering views there and the
@@ -241,17 +257,14 @@ void MeasureCoverage(const PatrolRecord& prior, const PatrolRecord& current, con
     if (m->prior_used[i]) continue;
     std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved
     for (std::size_t j = 0; j < m->c.size(); ++j) {
-      if (!m->current_used[j] && m->c[j].label == m->p[i].label &&
-          (m->c[j].centroid - m->p[i].centroid).norm() <= options.max_move_m) {
-        candidates.push_back(&m->c[j]);
-      }
+      if (MayHaveMoved(options, *m, i, j)) candidates.push_back(&m->c[j]);
     }
     m->views[i] = CoveringViews(m->p[i], current, options, candidates);
     m->expected[i] = ExpectedDetections(m->p[i], CoveringViews(m->p[i], prior, options), m->views[i]);
   }
 }
 
-// Move candidates (paper 003): same label within max_move_m and alike in texture, ordered by the weighted,
+// Move candidates (paper 003): pairs that may have moved (MayHaveMoved), ordered by the weighted,
 // min-max normalised physical and appearance distances. The normalised distance only orders them: the
 // worst candidate always scores 1, so the gates are absolute.
 std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matching& m) {
@@ -259,18 +272,10 @@ std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matchin
   std::vector<double> physical, appearance;
   for (std::size_t i = 0; i < m.p.size(); ++i) {
     for (std::size_t j = 0; j < m.c.size(); ++j) {
-      if (m.prior_used[i] || m.current_used[j] || m.p[i].label != m.c[j].label) continue;
-      const double distance = (m.p[i].centroid - m.c[j].centroid).norm();
-      const AppearanceTerms terms = CompareAppearance(m.p[i], m.c[j]);
-      if (distance > options.max_move_m || terms.texture.value_or(0.0) > options.max_texture_distance) continue;
-      if (m.prior_top[i] > 0.0 && m.current_top[j] > 0.0 &&
-          std::abs(m.prior_top[i] - m.current_top[j]) > options.max_top_difference_m) {
-        continue;
-      }
-      if (MovedShapeOverlap(m.p[i], m.c[j]) < options.min_shape_overlap) continue;
+      if (!MayHaveMoved(options, m, i, j)) continue;
       candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
-      physical.push_back(distance);
-      appearance.push_back(terms.Distance());
+      physical.push_back((m.p[i].centroid - m.c[j].centroid).norm());
+      appearance.push_back(CompareAppearance(m.p[i], m.c[j]).Distance());
     }
   }
   const auto normalise = [](const std::vector<double>& values, std::size_t k) {
