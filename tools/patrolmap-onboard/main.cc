@@ -97,6 +97,17 @@ void PrintSummary(const Arguments& arguments, const pipeline::OnboardStats& s, c
               pace.max_lag_seconds, arguments.out.c_str());
 }
 
+// The patrol record of a flight mapped onboard: no objects or evidence grid (they need the whole log), but
+// the camera and the width its key-frame features were found at, which a later `patrolmap patrol` or `diff`
+// needs to compare the flight's key frames.
+PatrolRecord AppearanceRecord(const io::LogInfo& info, const pipeline::MapResult& result) {
+  PatrolRecord record;
+  record.flight = info.flight_id;
+  if (info.camera) record.camera = *info.camera;
+  record.feature_image_width = result.nodes.front().feature_width;
+  return record;
+}
+
 Status Run(const Arguments& arguments) {
   pipeline::Config config;
   if (!arguments.config.empty()) PATROLMAP_RETURN_IF_ERROR(pipeline::LoadConfig(arguments.config, &config));
@@ -122,6 +133,7 @@ Status Run(const Arguments& arguments) {
     PATROLMAP_RETURN_IF_ERROR(
         WriteFileAtomically(arguments.out + "/key_locations.csv", pipeline::KeyLocationsCsv(mapper.key_locations())));
     graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+    if (!result.nodes.empty()) map.SetPatrol(AppearanceRecord(source->info(), result));
     PATROLMAP_RETURN_IF_ERROR(graph::LayoutMap(graph::LayoutInputOf(map), graph::LayoutOptions{}, &map));
     PATROLMAP_RETURN_IF_ERROR(pipeline::WriteMapOutputs(map, arguments.out));
     PATROLMAP_RETURN_IF_ERROR(graph::SaveMap(map, arguments.out + "/map.pmap"));
