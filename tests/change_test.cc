@@ -533,6 +533,7 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
   scene(block - cv::Point(7, 0)).copyTo(current(block));
   AppearanceOptions keep_all;
   keep_all.min_unmatched_share = 0.0;
+  keep_all.max_shifted_similarity = 1.1;
   const AppearanceChange all = DetectAppearanceChange(Describe(scene), Describe(current), keep_all);
   ASSERT_TRUE(all.registered);
   ASSERT_FALSE(all.regions.empty());  // the registration cannot fit both planes: pixels differ somewhere
@@ -541,6 +542,12 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
     EXPECT_LT(r.unmatched_prior_features + r.unmatched_current_features, 0.5 * (r.prior_features + r.current_features));
   }
   EXPECT_TRUE(DetectAppearanceChange(Describe(scene), Describe(current), AppearanceOptions{}).regions.empty());
+  // Each test alone drops them too: the features still match, and the content is there a few pixels off.
+  AppearanceOptions features_only = keep_all, shift_only = keep_all;
+  features_only.min_unmatched_share = 0.5;
+  shift_only.max_shifted_similarity = AppearanceOptions{}.max_shifted_similarity;
+  EXPECT_TRUE(DetectAppearanceChange(Describe(scene), Describe(current), features_only).regions.empty());
+  EXPECT_LT(DetectAppearanceChange(Describe(scene), Describe(current), shift_only).regions.size(), all.regions.size());
 }
 
 TEST(Appearance, UnrelatedImagesAreNotRegistered) {

@@ -98,6 +98,20 @@ cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const 
   return cv::boundingRect(mapped) & cv::Rect(0, 0, prior_size.width, prior_size.height);
 }
 
+// The best normalised cross-correlation (free of gain and offset) of the current image's `box` with the
+// registered prior image shifted by up to `radius` pixels: near 1 when the region shows what the prior
+// showed a little further on (parallax off the registered plane).
+double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv::Rect& box, int radius) {
+  const cv::Rect image(0, 0, current.cols, current.rows);
+  const cv::Rect search = cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) & image;
+  if (box.width < 3 || box.height < 3 || search.width < box.width || search.height < box.height) return 0.0;
+  cv::Mat scores;
+  cv::matchTemplate(prior(search), current(box), scores, cv::TM_CCOEFF_NORMED);
+  double best = 0.0;
+  cv::minMaxLoc(scores, nullptr, &best);
+  return best;
+}
+
 }  // namespace
 
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
@@ -175,6 +189,10 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
     const int features = region.prior_features + region.current_features;
     const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
     if (features > 0 && unmatched < options.min_unmatched_share * features) continue;
+    if (ShiftedSimilarity(current_f, warped, region.current_box, options.parallax_search_px) >
+        options.max_shifted_similarity) {
+      continue;  // the same content a few pixels off: parallax, not change
+    }
     result.regions.push_back(region);
   }
   std::sort(result.regions.begin(), result.regions.end(),

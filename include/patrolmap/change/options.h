@@ -19,6 +19,8 @@ struct AppearanceOptions {
   double min_area_fraction = 0.01;   // regions smaller than this share of the compared area are dropped
   double min_unmatched_share = 0.5;  // ... and so are regions with features of which fewer than this share lost
                                      // their match between the key frames (parallax, not change)
+  int parallax_search_px = 8;        // ... and regions whose content the registered prior image shows, up to
+  double max_shifted_similarity = 0.7; // this far off, with a normalised cross-correlation above this
 };
 
 // Object map of one patrol (paper 000, with the 2D fallback of paper 001).

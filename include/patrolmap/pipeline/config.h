@@ -81,6 +81,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.appearance.structure_sigma_px", &change.appearance.structure_sigma_px);
   visitor->Field("change.appearance.min_area_fraction", &change.appearance.min_area_fraction);
   visitor->Field("change.appearance.min_unmatched_share", &change.appearance.min_unmatched_share);
+  visitor->Field("change.appearance.parallax_search_px", &change.appearance.parallax_search_px);
+  visitor->Field("change.appearance.max_shifted_similarity", &change.appearance.max_shifted_similarity);
   visitor->Field("change.object_map.centroid_gate_m", &change.object_map.centroid_gate_m);
   visitor->Field("change.object_map.pair_distance_m", &change.object_map.pair_distance_m);
   visitor->Field("change.object_map.min_pair_fraction", &change.object_map.min_pair_fraction);
