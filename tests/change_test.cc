@@ -396,12 +396,19 @@ std::vector<Eigen::Vector3f> CubePoints(const Eigen::Vector2d& centre, double si
   return points;
 }
 
+// A patrol holding one crate: a cube of side `side` standing at (x, 0), with its surface points and box.
+PatrolRecord CratePatrol(double x, double side) {
+  PatrolRecord record = Patrol({{"crate", {x, 0, side / 2}}});
+  record.objects[0].points = CubePoints({x, 0}, side);
+  record.objects[0].box_min = Eigen::Vector3d(x - side / 2, -side / 2, 0);
+  record.objects[0].box_max = Eigen::Vector3d(x + side / 2, side / 2, side);
+  return record;
+}
+
 TEST(ObjectStates, AMovedObjectKeepsItsTopHeight) {
-  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}});
-  prior.objects[0].points = CubePoints({10, 0}, 1.0);
+  const PatrolRecord prior = CratePatrol(10, 1.0);
   for (const auto& [side, state] : {std::pair{1.0, ObjectState::kMoved}, std::pair{0.8, ObjectState::kRemoved}}) {
-    PatrolRecord current = Patrol({{"crate", {12, 0, side / 2}}});
-    current.objects[0].points = CubePoints({12, 0}, side);
+    const PatrolRecord current = CratePatrol(12, side);
     const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
     // The smaller crate, centred on the bigger one, lies within the shape test's 0.15 m: only its top tells.
     ASSERT_FALSE(changes.empty());
@@ -429,13 +436,9 @@ TEST(ObjectStates, OnlyAnObjectThatMayBeTheMovedOneIsLookedThrough) {
   // A crate stood at x = 10; the current patrol has a new crate at x = 7 in front of that place, whose
   // voxels fill the line of sight. Of the same size it may be the crate moved (looked through, paired as a
   // move); taller, it is another crate that hides the place: the prior one is unobserved, not removed.
-  PatrolRecord prior = Patrol({{"crate", {10, 0, 0.5}}});
-  prior.objects[0].points = CubePoints({10, 0}, 1.0);
+  const PatrolRecord prior = CratePatrol(10, 1.0);
   for (const auto& [side, state] : {std::pair{1.0, ObjectState::kMoved}, std::pair{1.4, ObjectState::kUnobserved}}) {
-    PatrolRecord current = Patrol({{"crate", {7, 0, side / 2}}});
-    current.objects[0].points = CubePoints({7, 0}, side);
-    current.objects[0].box_min = Eigen::Vector3d(7 - side / 2, -side / 2, 0);
-    current.objects[0].box_max = Eigen::Vector3d(7 + side / 2, side / 2, side);
+    PatrolRecord current = CratePatrol(7, side);
     current.grid.voxel_size = 0.2;
     for (int x = 33; x <= 37; ++x) {
       for (int y = -5; y <= 5; ++y) {

@@ -195,11 +195,12 @@ struct Matching {
   std::vector<int> views;         // covering views of each prior object (those not persistent) ...
   std::vector<double> expected;   // ... and the detections they would have given
   std::vector<double> prior_top, current_top;  // 95th percentile of the points' height; 0 without points
+  std::vector<std::pair<int, int>> movable;    // (prior, current) pairs that may be one object moved
 };
 
 Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
   Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
-             std::vector<bool>(current.objects.size(), false), {}, {}, {}, {}};
+             std::vector<bool>(current.objects.size(), false), {}, {}, {}, {}, {}};
   for (const MapObject& o : m.p) m.prior_top.push_back(PointQuantile(o.points, 2, 0.95));
   for (const MapObject& o : m.c) m.current_top.push_back(PointQuantile(o.points, 2, 0.95));
   return m;
@@ -246,7 +247,8 @@ bool MayHaveMoved(const ObjectDiffOptions& options, const Matching& m, std::size
 
 // How well the current patrol saw the place of every unmatched prior object: its covering views there and the
 // detections they would have given, at the rate the prior patrol detected the object in its own covering views.
-// Unconfirmed objects only explained sightings as persistent; they take no other state.
+// Unconfirmed objects only explained sightings as persistent; they take no other state. Also finds the pairs
+// that may be one object moved (the move candidates, and what the visibility test looks through).
 void MeasureCoverage(const PatrolRecord& prior, const PatrolRecord& current, const ObjectDiffOptions& options,
                      Matching* m) {
   m->views.assign(m->p.size(), 0);
@@ -257,26 +259,25 @@ void MeasureCoverage(const PatrolRecord& prior, const PatrolRecord& current, con
     if (m->prior_used[i]) continue;
     std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved
     for (std::size_t j = 0; j < m->c.size(); ++j) {
-      if (MayHaveMoved(options, *m, i, j)) candidates.push_back(&m->c[j]);
+      if (!MayHaveMoved(options, *m, i, j)) continue;
+      m->movable.emplace_back(static_cast<int>(i), static_cast<int>(j));
+      candidates.push_back(&m->c[j]);
     }
     m->views[i] = CoveringViews(m->p[i], current, options, candidates);
     m->expected[i] = ExpectedDetections(m->p[i], CoveringViews(m->p[i], prior, options), m->views[i]);
   }
 }
 
-// Move candidates (paper 003): pairs that may have moved (MayHaveMoved), ordered by the weighted,
+// Move candidates (paper 003): the pairs that may be one object moved, ordered by the weighted,
 // min-max normalised physical and appearance distances. The normalised distance only orders them: the
 // worst candidate always scores 1, so the gates are absolute.
 std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matching& m) {
   std::vector<Pair> candidates;
   std::vector<double> physical, appearance;
-  for (std::size_t i = 0; i < m.p.size(); ++i) {
-    for (std::size_t j = 0; j < m.c.size(); ++j) {
-      if (!MayHaveMoved(options, m, i, j)) continue;
-      candidates.push_back({static_cast<int>(i), static_cast<int>(j), 0.0});
-      physical.push_back((m.p[i].centroid - m.c[j].centroid).norm());
-      appearance.push_back(CompareAppearance(m.p[i], m.c[j]).Distance());
-    }
+  for (const auto& [i, j] : m.movable) {
+    candidates.push_back({i, j, 0.0});
+    physical.push_back((m.p[i].centroid - m.c[j].centroid).norm());
+    appearance.push_back(CompareAppearance(m.p[i], m.c[j]).Distance());
   }
   const auto normalise = [](const std::vector<double>& values, std::size_t k) {
     const auto [lo, hi] = std::minmax_element(values.begin(), values.end());

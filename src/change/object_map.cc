@@ -1,9 +1,9 @@
 #include "patrolmap/change/object_map.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
-#include <array>
 #include <unordered_set>
 
 #include <nanoflann.hpp>
@@ -179,16 +179,12 @@ double PointHeight(const std::vector<Eigen::Vector3f>& points) {
 
 cv::Rect2d ProjectBox(const CameraIntrinsics& camera, const CameraPoseSample& pose, const Eigen::Vector3d& box_min,
                       const Eigen::Vector3d& box_max) {
-  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d world((corner & 1) ? box_max.x() : box_min.x(), (corner & 2) ? box_max.y() : box_min.y(),
-                                (corner & 4) ? box_max.z() : box_min.z());
-    const Eigen::Vector3d c = pose.ToCamera(world);
-    if (c.z() < 0.1) return {};
-    const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
-    x0 = std::min(x0, u), y0 = std::min(y0, v), x1 = std::max(x1, u), y1 = std::max(y1, v);
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int k = 0; k < 8; ++k) {
+    corners[k] = Eigen::Vector3d((k & 1) ? box_max.x() : box_min.x(), (k & 2) ? box_max.y() : box_min.y(),
+                                 (k & 4) ? box_max.z() : box_min.z());
   }
-  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+  return ProjectCorners(camera, pose, corners);
 }
 
 ObjectMapper::ObjectMapper(const ObjectMapOptions& options, const CameraIntrinsics& camera)

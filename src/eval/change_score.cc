@@ -214,9 +214,6 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
   return score;
 }
 
-}  // namespace patrolmap::eval
-
-namespace patrolmap::eval {
 namespace {
 
 bool SeenNear(const TruthObject& object, TimestampNs time_ns, double within_s) {
@@ -227,14 +224,8 @@ bool SeenNear(const TruthObject& object, TimestampNs time_ns, double within_s) {
 
 // The object's box projected into the image, clipped to it; empty when a corner lies behind the camera.
 cv::Rect2d ProjectTruthBox(const TruthObject& o, const CameraPoseSample& pose, const CameraIntrinsics& camera) {
-  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
-  for (const Eigen::Vector3d& corner : StandingBoxCorners(o.centre, o.yaw, o.length, o.width, o.height)) {
-    const Eigen::Vector3d c = pose.ToCamera(corner);
-    if (c.z() < 0.1) return {};
-    const double u = camera.fx * c.x() / c.z() + camera.cx, v = camera.fy * c.y() / c.z() + camera.cy;
-    x0 = std::min(x0, u), y0 = std::min(y0, v), x1 = std::max(x1, u), y1 = std::max(y1, v);
-  }
-  return cv::Rect2d(x0, y0, x1 - x0, y1 - y0) & cv::Rect2d(0, 0, camera.width, camera.height);
+  return ProjectCorners(camera, pose, StandingBoxCorners(o.centre, o.yaw, o.length, o.width, o.height)) &
+         cv::Rect2d(0, 0, camera.width, camera.height);
 }
 
 bool Overlaps(const cv::Rect2d& a, const cv::Rect2d& b, double min_overlap) {

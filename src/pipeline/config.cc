@@ -168,4 +168,11 @@ std::string ConfigToYaml(const Config& config) {
   return std::string(emitter.c_str()) + "\n";
 }
 
+Status LoadCheckedConfig(const std::string& path, Config* config) {
+  if (!path.empty()) PATROLMAP_RETURN_IF_ERROR(LoadConfig(path, config));
+  std::string error;
+  if (!config->IsValid(&error)) return Status::InvalidArgument(error);
+  return Status::Ok();
+}
+
 }  // namespace patrolmap::pipeline

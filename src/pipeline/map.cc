@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/core/files.h"
+#include "patrolmap/graph/layout.h"
+#include "patrolmap/graph/map_file.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -143,6 +145,25 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
   }
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/nodes.csv", nodes.str()));
   return WriteFileAtomically(folder + "/loop_closures.csv", closures.str());
+}
+
+Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary) {
+  PATROLMAP_RETURN_IF_ERROR(vocab::Vocabulary::Load(path, vocabulary));
+  if (vocabulary->dimension() != 128) return Status::InvalidArgument(path + ": not a SIFT vocabulary");
+  return Status::Ok();
+}
+
+int FeatureWidth(const MapResult& result, const std::string& flight) {
+  for (const MapNode& node : result.nodes) {
+    if (node.flight == flight) return node.feature_width;
+  }
+  return 0;
+}
+
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder) {
+  PATROLMAP_RETURN_IF_ERROR(graph::LayoutMap(graph::LayoutInputOf(*map), graph::LayoutOptions{}, map));
+  PATROLMAP_RETURN_IF_ERROR(WriteMapOutputs(*map, folder));
+  return graph::SaveMap(*map, folder + "/map.pmap");
 }
 
 }  // namespace patrolmap::pipeline

@@ -15,7 +15,6 @@
 #include <spdlog/spdlog.h>
 
 #include "patrolmap/core/files.h"
-#include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/pipeline/detect.h"
@@ -104,20 +103,19 @@ PatrolRecord AppearanceRecord(const io::LogInfo& info, const pipeline::MapResult
   PatrolRecord record;
   record.flight = info.flight_id;
   if (info.camera) record.camera = *info.camera;
-  record.feature_image_width = result.nodes.front().feature_width;
+  record.feature_image_width = pipeline::FeatureWidth(result, info.flight_id);
   return record;
 }
 
 Status Run(const Arguments& arguments) {
   pipeline::Config config;
-  if (!arguments.config.empty()) PATROLMAP_RETURN_IF_ERROR(pipeline::LoadConfig(arguments.config, &config));
+  PATROLMAP_RETURN_IF_ERROR(pipeline::LoadCheckedConfig(arguments.config, &config));
   std::string error;
-  if (!config.IsValid(&error) || !arguments.options.IsValid(&error)) return Status::InvalidArgument(error);
+  if (!arguments.options.IsValid(&error)) return Status::InvalidArgument(error);
   graph::TopoMap prior;
   if (!arguments.prior_map.empty()) PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.prior_map, &prior));
   vocab::Vocabulary vocabulary;
-  PATROLMAP_RETURN_IF_ERROR(vocab::Vocabulary::Load(arguments.vocabulary, &vocabulary));
-  if (vocabulary.dimension() != 128) return Status::InvalidArgument(arguments.vocabulary + ": not a SIFT vocabulary");
+  PATROLMAP_RETURN_IF_ERROR(pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary));
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(arguments, config, &source));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
@@ -134,9 +132,7 @@ Status Run(const Arguments& arguments) {
         WriteFileAtomically(arguments.out + "/key_locations.csv", pipeline::KeyLocationsCsv(mapper.key_locations())));
     graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
     if (!result.nodes.empty()) map.SetPatrol(AppearanceRecord(source->info(), result));
-    PATROLMAP_RETURN_IF_ERROR(graph::LayoutMap(graph::LayoutInputOf(map), graph::LayoutOptions{}, &map));
-    PATROLMAP_RETURN_IF_ERROR(pipeline::WriteMapOutputs(map, arguments.out));
-    PATROLMAP_RETURN_IF_ERROR(graph::SaveMap(map, arguments.out + "/map.pmap"));
+    PATROLMAP_RETURN_IF_ERROR(pipeline::SaveMapRun(&map, arguments.out));
     PrintSummary(arguments, mapper.stats(), result, pace);
   }
   return Status::Ok();

@@ -17,13 +17,7 @@ inline int Fail(const Status& status) {
   return 1;
 }
 
-// Loads `path` over the defaults (none: defaults only) and checks the result.
-inline Status LoadCheckedConfig(const std::string& path, pipeline::Config* config) {
-  if (!path.empty()) PATROLMAP_RETURN_IF_ERROR(pipeline::LoadConfig(path, config));
-  std::string error;
-  if (!config->IsValid(&error)) return Status::InvalidArgument(error);
-  return Status::Ok();
-}
+using pipeline::LoadCheckedConfig;
 
 // Prints one line on what changed between the report's flights (diff and patrol).
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out);

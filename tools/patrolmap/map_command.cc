@@ -7,7 +7,6 @@
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/pipeline/detect.h"
-#include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/change.h"
 #include "patrolmap/pipeline/map.h"
@@ -54,14 +53,6 @@ void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& resu
               1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
 }
 
-// The width the flight's key-frame features were found at (from its first node), 0 when it has none.
-int FeatureWidth(const pipeline::MapResult& result, const std::string& flight) {
-  for (const pipeline::MapNode& node : result.nodes) {
-    if (node.flight == flight) return node.feature_width;
-  }
-  return 0;
-}
-
 // The patrol record of `log` (object map, evidence grid, views) for change detection.
 Status RecordPatrol(const std::string& log, const pipeline::Config& config, const pipeline::MapResult& result,
                     graph::TopoMap* map) {
@@ -70,7 +61,7 @@ Status RecordPatrol(const std::string& log, const pipeline::Config& config, cons
   Progress progress("patrol record");
   PATROLMAP_RETURN_IF_ERROR(pipeline::BuildPatrolRecord(
       log, config, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
-  record.feature_image_width = FeatureWidth(result, record.flight);
+  record.feature_image_width = pipeline::FeatureWidth(result, record.flight);
   if (record.has_objects) {
     const auto confirmed =
         std::count_if(record.objects.begin(), record.objects.end(), [](const MapObject& o) { return o.confirmed; });
@@ -109,10 +100,7 @@ int RunMap(const MapArguments& arguments) {
   graph::TopoMap prior;
   Status status = LoadCheckedConfig(arguments.config, &config);
   if (status.ok() && !arguments.prior_map.empty()) status = graph::LoadMap(arguments.prior_map, &prior);
-  if (status.ok()) status = vocab::Vocabulary::Load(arguments.vocabulary, &vocabulary);
-  if (status.ok() && vocabulary.dimension() != 128) {
-    status = Status::InvalidArgument(arguments.vocabulary + ": not a SIFT vocabulary");
-  }
+  if (status.ok()) status = pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary);
   if (!status.ok()) return Fail(status);
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   pipeline::SeedRecognizer(prior, &recognizer);
@@ -129,9 +117,7 @@ int RunMap(const MapArguments& arguments) {
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = RecordPatrol(arguments.logs[i], config, result, &map);
   }
-  if (status.ok()) status = graph::LayoutMap(graph::LayoutInputOf(map), graph::LayoutOptions{}, &map);
-  if (status.ok()) status = pipeline::WriteMapOutputs(map, arguments.out);
-  if (status.ok()) status = graph::SaveMap(map, arguments.out + "/map.pmap");
+  if (status.ok()) status = pipeline::SaveMapRun(&map, arguments.out);
   if (!status.ok()) return Fail(status);
   PrintSummary(arguments, result);
   if (!arguments.prior_map.empty()) status = ReportChanges(prior, map, config, arguments.out);

@@ -5,6 +5,7 @@
 // z up [m]. Camera frame: x right, y down, z forward.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -28,6 +29,11 @@ struct CameraPoseSample {
     return rotation.conjugate() * (in_world - position);
   }
 };
+
+// The image box around `corners` seen from `pose` through `camera` (not clipped to the image); empty when
+// any of them lies less than 0.1 m in front of the camera.
+cv::Rect2d ProjectCorners(const CameraIntrinsics& camera, const CameraPoseSample& pose,
+                          const std::array<Eigen::Vector3d, 8>& corners);
 
 // One object detection of one frame (objects0/data.csv).
 struct ObjectObservation {

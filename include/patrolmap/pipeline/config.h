@@ -126,6 +126,9 @@ void VisitConfig(Config* config, Visitor* visitor) {
 // combination fails with a message naming the file, the key and the line.
 Status LoadConfig(const std::string& path, Config* config);
 
+// The defaults, with `path` loaded over them unless it is empty, checked (Config::IsValid).
+Status LoadCheckedConfig(const std::string& path, Config* config);
+
 // The configuration as YAML (every key, nested sections).
 std::string ConfigToYaml(const Config& config);
 

@@ -102,6 +102,15 @@ graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognize
 // empty recognizer, in order, so a later flight is matched against them.
 void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer);
 
+// Loads the SIFT vocabulary the place stage needs; fails naming the file when it is not one.
+Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary);
+
+// The width the key-frame features of `flight` were found at (from its first node), 0 when it has none.
+int FeatureWidth(const MapResult& result, const std::string& flight);
+
+// Lays the map out (graph::LayoutMap) and writes DIR/nodes.csv, DIR/loop_closures.csv and DIR/map.pmap.
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder);
+
 // Writes the whole map as DIR/nodes.csv (node,flight,timestamp_ns,frame_index,
 // features) and DIR/loop_closures.csv (query_node,matched_node,query_frame,
 // matched_frame,bow_score,matched_fraction,inliers), each atomically.
