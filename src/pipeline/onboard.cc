@@ -53,7 +53,7 @@ Status OnboardMapper::AddFrame(const Frame& frame) {
   output_.samples.clear();  // only the key locations are kept: memory stays bounded over hours
   for (const KeyLocation& key_location : output_.key_locations) PATROLMAP_RETURN_IF_ERROR(Hand(key_location));
   output_.key_locations.clear();
-  return PlaceStatus();
+  return place_failed_.load() ? PlaceStatus() : Status::Ok();  // no lock per frame while all is well
 }
 
 // Keeps the processed frame's image (at the flow scale, as `patrolmap map` describes key frames) in the
@@ -111,7 +111,10 @@ void OnboardMapper::Work() {
     const Status status = places_.Add(input);  // only this thread touches the place stage
     lock.lock();
     queue_.pop_front();
-    if (!status.ok() && place_status_.ok()) place_status_ = status;
+    if (!status.ok() && place_status_.ok()) {
+      place_status_ = status;
+      place_failed_.store(true);
+    }
     changed_.notify_all();
   }
 }

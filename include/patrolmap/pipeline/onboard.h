@@ -8,6 +8,7 @@
 // for the same log and configuration.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -95,6 +96,7 @@ class OnboardMapper {
   std::deque<KeyFrameInput> queue_;
   bool closing_ = false;
   Status place_status_;
+  std::atomic<bool> place_failed_{false};  // place_status_ holds an error
   std::thread worker_;
 };
 
