@@ -39,10 +39,11 @@ void BM_FlowStagePerProcessedFrame(benchmark::State& state) {
   cv::setNumThreads(1);
   const std::vector<cv::Mat>& frames = StreetFrames(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   flow::KeyLocationOptions options;
-  options.frames.step = 1;     // the frames given are already the processed ones
-  options.frames.scale = 1.0;  // and already at processing size
+  options.frames.scale = 1.0;  // the frames given are already at processing size
   options.tracker.max_forward_backward_px = static_cast<double>(state.range(2));
-  flow::KeyLocationDetector detector(options, {});
+  flow::CameraContext context;
+  context.frame_rate_hz = options.frames.rate_hz;  // and already the processed ones
+  flow::KeyLocationDetector detector(options, context);
   flow::DetectorOutput output;
   Frame frame;
   std::size_t next = 0;

@@ -85,9 +85,9 @@ std::vector<FlowSample> Samples(const std::vector<double>& values, double rate_h
   return samples;
 }
 
-std::vector<double> Smooth(const std::vector<double>& values, SmoothingOptions options,
+std::vector<double> Smooth(const std::vector<double>& values, int window, SmoothingMode mode,
                            std::vector<int>* released_after = nullptr) {
-  WindowSmoother smoother(options);
+  WindowSmoother smoother(window, mode);
   std::vector<FlowSample> released;
   for (const FlowSample& sample : Samples(values)) {
     smoother.Add(sample, &released);
@@ -101,33 +101,33 @@ std::vector<double> Smooth(const std::vector<double>& values, SmoothingOptions o
 
 TEST(WindowSmoother, CenteredWindowTruncatesAtTheEnds) {
   std::vector<int> released_after;
-  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, {3, SmoothingMode::kCentered}, &released_after);
+  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, 3, SmoothingMode::kCentered, &released_after);
   EXPECT_EQ(smoothed, (std::vector<double>{1.5, 2, 3, 4, 4.5}));
   EXPECT_EQ(released_after, (std::vector<int>{0, 1, 2, 3, 4}));  // one sample late
 }
 
 TEST(WindowSmoother, CausalWindowLagsAndReleasesAtOnce) {
   std::vector<int> released_after;
-  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, {3, SmoothingMode::kCausal}, &released_after);
+  const std::vector<double> smoothed = Smooth({1, 2, 3, 4, 5}, 3, SmoothingMode::kCausal, &released_after);
   EXPECT_EQ(smoothed, (std::vector<double>{1, 1.5, 2, 3, 4}));
   EXPECT_EQ(released_after, (std::vector<int>{1, 2, 3, 4, 5}));
 }
 
 TEST(WindowSmoother, NaNSamplesAreLeftOut) {
   const double nan = std::nan("");
-  const std::vector<double> smoothed = Smooth({1, nan, 3}, {3, SmoothingMode::kCentered});
+  const std::vector<double> smoothed = Smooth({1, nan, 3}, 3, SmoothingMode::kCentered);
   EXPECT_DOUBLE_EQ(smoothed[1], 2.0);
-  EXPECT_TRUE(std::isnan(Smooth({nan, nan}, {1, SmoothingMode::kCentered})[0]));
+  EXPECT_TRUE(std::isnan(Smooth({nan, nan}, 1, SmoothingMode::kCentered)[0]));
 }
 
 TEST(WindowSmoother, PaperWindowCentresAStepOnItsMidpoint) {
   std::vector<double> step(100, 0.0);
   std::fill(step.begin() + 50, step.end(), 1.0);
-  const std::vector<double> smoothed = Smooth(step, {30, SmoothingMode::kCentered});
+  const std::vector<double> smoothed = Smooth(step, 30, SmoothingMode::kCentered);
   EXPECT_DOUBLE_EQ(smoothed[35], 1.0 / 30.0);  // window [21, 50] holds one 1
   EXPECT_DOUBLE_EQ(smoothed[49], 15.0 / 30.0);
   EXPECT_DOUBLE_EQ(smoothed[64], 1.0);
-  const std::vector<double> causal = Smooth(step, {30, SmoothingMode::kCausal});
+  const std::vector<double> causal = Smooth(step, 30, SmoothingMode::kCausal);
   EXPECT_DOUBLE_EQ(causal[64], 15.0 / 30.0);  // lag of (30 - 1) / 2 samples
 }
 
@@ -309,7 +309,8 @@ TEST(KeyLocationOptions, DefaultsAreTableOneAndChecksNameTheField) {
   EXPECT_TRUE(options.IsValid(&error));
   EXPECT_EQ(options.voting.accept, 3);
   EXPECT_EQ(options.voting.reject, 2);
-  EXPECT_EQ(options.smoothing.window, 30);
+  EXPECT_DOUBLE_EQ(options.frames.rate_hz, 6.0);      // every 5th frame at 30 fps
+  EXPECT_DOUBLE_EQ(options.smoothing.window_s, 5.0);  // Table I: 30 processed frames at 6 per second
   EXPECT_DOUBLE_EQ(options.extrema.min_change, 0.02);
   EXPECT_DOUBLE_EQ(options.extrema.min_time_s, 2.0);
   options.voting.reject = 4;
@@ -319,15 +320,63 @@ TEST(KeyLocationOptions, DefaultsAreTableOneAndChecksNameTheField) {
 
 TEST(KeyLocationDetectorDeathTest, InvalidOptionsAbort) {
   KeyLocationOptions options;
-  options.smoothing.window = 0;
-  EXPECT_DEATH(KeyLocationDetector(options, CameraContext{}), "smoothing.window");
+  options.smoothing.window_s = 0;
+  EXPECT_DEATH(KeyLocationDetector(options, CameraContext{}), "flow.smoothing.window_s = 0");
+}
+
+// Durations are seconds: the paper's 30 fps / every 5th frame / 30-frame window, and the same times at
+// the rates of a KITTI car log (10 Hz) and a EuRoC flight (20 Hz).
+TEST(FrameTiming, DurationsInSecondsGiveTheFramesOfEachRate) {
+  const KeyLocationOptions options;
+  const FrameTiming paper = ResolveFrameTiming(options, 30.0);
+  EXPECT_EQ(paper.step, 5);
+  EXPECT_EQ(paper.window, 30);
+  const FrameTiming kitti = ResolveFrameTiming(options, 10.0);
+  EXPECT_EQ(kitti.step, 2);     // round(10 / 6)
+  EXPECT_EQ(kitti.window, 25);  // 5 s at 5 processed frames per second
+  const FrameTiming euroc = ResolveFrameTiming(options, 20.0);
+  EXPECT_EQ(euroc.step, 3);
+  EXPECT_EQ(euroc.window, 33);  // 5 s at 6.67 per second
+  const FrameTiming slow = ResolveFrameTiming(options, 1.0);  // a 1 Hz image collection: every image
+  EXPECT_EQ(slow.step, 1);
+  EXPECT_EQ(slow.window, 5);
+  const FrameTiming unknown = ResolveFrameTiming(options, 0.0);
+  EXPECT_EQ(unknown.step, 1);
+  EXPECT_EQ(unknown.window, 30);
+}
+
+TEST(KeyLocationOptions, OutOfRangeValuesNameKeyValueAndRule) {
+  KeyLocationOptions options;
+  options.voting.max_votes = 300;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_EQ(error, "flow.voting.max_votes = 300: must be an integer in [3, 100]");
+  options = KeyLocationOptions();
+  options.frames.scale = std::nan("");
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_EQ(error, "flow.frames.scale = nan: must be a number in [0.05, 1]");
+}
+
+TEST(KeyLocationDetector, FramesWithoutUsableImageAreCountedNotProcessed) {
+  KeyLocationOptions options;
+  KeyLocationDetector detector(options, CameraContext{});
+  DetectorOutput output;
+  Frame frame;
+  frame.image = cv::Mat(1, 1, CV_8UC1, cv::Scalar(0));  // 1x1: nothing to track
+  detector.Process(frame, &output);
+  frame.index = 1;
+  frame.image.release();
+  detector.Process(frame, &output);
+  EXPECT_EQ(detector.unusable_frames(), 2);
+  EXPECT_EQ(detector.processed_frames(), 0);
 }
 
 TEST(KeyLocationDetector, StaticSceneGivesNoKeyLocation) {
   KeyLocationOptions options;
-  options.frames.step = 1;
   options.frames.scale = 1.0;
-  KeyLocationDetector detector(options, CameraContext{});
+  CameraContext context;
+  context.frame_rate_hz = options.frames.rate_hz;  // every frame
+  KeyLocationDetector detector(options, context);
   DetectorOutput output;
   Frame frame;
   const cv::Mat image = Texture(5);
@@ -345,10 +394,12 @@ TEST(KeyLocationDetector, StaticSceneGivesNoKeyLocation) {
 
 TEST(KeyLocationDetector, LengthResponseIsImageWidthsPerSecond) {
   KeyLocationOptions options;
-  options.frames.step = 1;
   options.frames.scale = 1.0;
-  options.smoothing.window = 1;
-  KeyLocationDetector detector(options, CameraContext{});
+  options.smoothing.window_s = 0.2;  // one processed frame
+  CameraContext context;
+  context.frame_rate_hz = 5.0;
+  options.frames.rate_hz = 5.0;  // every frame
+  KeyLocationDetector detector(options, context);
   DetectorOutput output;
   const cv::Mat texture = Texture(9);
   Frame frame;
@@ -367,8 +418,10 @@ TEST(KeyLocationDetector, LengthResponseIsImageWidthsPerSecond) {
 }
 
 TEST(KeyLocationDetector, ProcessesEveryStepthFrameOnly) {
-  KeyLocationOptions options;  // step 5
-  KeyLocationDetector detector(options, CameraContext{});
+  KeyLocationOptions options;  // 6 processed frames per second: every 5th of 30 fps
+  CameraContext context;
+  context.frame_rate_hz = 30.0;
+  KeyLocationDetector detector(options, context);
   DetectorOutput output;
   Frame frame;
   const cv::Mat image = Texture(5);

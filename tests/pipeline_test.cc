@@ -30,6 +30,50 @@ void FlattenKeys(const YAML::Node& node, const std::string& prefix, std::set<std
   }
 }
 
+// Records every configurable key with the kind of its field.
+struct KeyKinds {
+  std::vector<std::string> doubles, integers;
+  void Field(const std::string& path, double*) { doubles.push_back(path); }
+  void Field(const std::string& path, int*) { integers.push_back(path); }
+  template <typename T>
+  void Field(const std::string&, T*) {}
+};
+
+// The YAML file that sets the dotted `key` to `value`.
+std::string YamlSetting(const std::string& key, const std::string& value) {
+  std::string yaml, indent;
+  std::size_t start = 0;
+  for (std::size_t dot = key.find('.'); dot != std::string::npos; start = dot + 1, dot = key.find('.', start)) {
+    yaml += indent + key.substr(start, dot - start) + ":\n";
+    indent += "  ";
+  }
+  return yaml + indent + key.substr(start) + ": " + value + "\n";
+}
+
+// Every key refuses an out-of-range value with a message that names the file, the key and the value:
+// NaN and infinity for every number, the largest or smallest 32-bit integer for every integer.
+TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
+  testing::TempDir dir;
+  KeyKinds kinds;
+  Config defaults;
+  VisitConfig(&defaults, &kinds);
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 83u);  // every numeric key (the rest are switches)
+  const auto refused = [&](const std::string& key, const std::string& value) {
+    testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
+    Config config;
+    const Status status = LoadConfig(dir / "bad.yaml", &config);
+    return !status.ok() && status.message().find("bad.yaml") != std::string::npos &&
+           status.message().find(key) != std::string::npos;
+  };
+  for (const std::string& key : kinds.doubles) {
+    EXPECT_TRUE(refused(key, ".nan")) << key << " = nan";
+    EXPECT_TRUE(refused(key, ".inf") || refused(key, "-.inf")) << key << " = inf";
+  }
+  for (const std::string& key : kinds.integers) {
+    EXPECT_TRUE(refused(key, "2147483647") || refused(key, "-2147483647")) << key;
+  }
+}
+
 TEST(Config, DefaultFileMirrorsTheOptionsStructsOneToOne) {
   Config loaded;
   loaded.flow.voting.accept = 99;  // must be overwritten by the file
@@ -54,9 +98,9 @@ TEST(Config, UnknownKeyNamesFileLineAndKey) {
 TEST(Config, WrongTypesAndBadValuesAreReported) {
   testing::TempDir dir;
   Config config;
-  testing::WriteText(dir / "a.yaml", "flow:\n  smoothing:\n    window: wide\n");
+  testing::WriteText(dir / "a.yaml", "flow:\n  smoothing:\n    window_s: wide\n");
   Status status = LoadConfig(dir / "a.yaml", &config);
-  EXPECT_NE(status.message().find("a.yaml:3: flow.smoothing.window: expected an integer, got 'wide'"),
+  EXPECT_NE(status.message().find("a.yaml:3: flow.smoothing.window_s: expected a number, got 'wide'"),
             std::string::npos)
       << status.message();
   testing::WriteText(dir / "b.yaml", "flow:\n  response:\n    quantity: speed\n");
@@ -75,14 +119,14 @@ TEST(Config, PartialFileKeepsOtherDefaults) {
   ASSERT_TRUE(LoadConfig(dir / "p.yaml", &config).ok());
   EXPECT_EQ(config.flow.smoothing.mode, flow::SmoothingMode::kCausal);
   EXPECT_DOUBLE_EQ(config.flow.extrema.min_time_s, 3.5);
-  EXPECT_EQ(config.flow.smoothing.window, 30);
+  EXPECT_DOUBLE_EQ(config.flow.smoothing.window_s, 5.0);
 }
 
 // Runs the detector over a simulated flight rendered in memory (only the frames it processes), with the
 // flight's IMU samples and camera-IMU rotation as a log would carry them.
 flow::DetectorOutput RunOnFlight(const sim::SimulatedFlight& flight, const flow::KeyLocationOptions& options) {
   const Eigen::Matrix3d camera_from_imu = sim::BodyFromCamera(flight.mount_angle).transpose();
-  flow::KeyLocationDetector detector(options, {flight.camera, camera_from_imu});
+  flow::KeyLocationDetector detector(options, {flight.camera, camera_from_imu, flight.frame_rate_hz});
   sim::Renderer renderer(&flight.scene, flight.camera, flight.lighting);
   const std::vector<ImuSample> imu = sim::ImuSamples(flight);
   std::size_t next_imu = 0;
@@ -307,7 +351,7 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
   ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, vocabulary).ok());
 }
 
-// Every processed frame of both flights is a node. Mapped together, and as a patrol against flight 1's saved
+// Every processed frame (every 5th) of both flights is a node. Mapped together, and as a patrol against flight 1's saved
 // map: the results must agree exactly. Loop closures of the second flight against the first are scored
 // against the simulator's places.
 TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
@@ -318,8 +362,8 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   ASSERT_NO_FATAL_FAILURE(TwoStreetFlights(dir.path(), config, &vocabulary));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   MapResult result;
-  KeyFrameSelection every;
-  every.every_frame = true;
+  KeyFrameSelection every;  // every processed frame: every 5th of the 30 fps logs
+  for (std::int64_t frame = 0; frame < 1000; frame += 5) every.frames.push_back(frame);
   for (const char* flight : {"street-1", "street-2"}) {
     ASSERT_TRUE(RecognisePlaces(dir / flight, config, every, &recognizer, &result).ok());
   }
@@ -351,7 +395,7 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   graph::TopoMap prior;
   ASSERT_TRUE(graph::LoadMap(dir / "first.pmap", &prior).ok());
   place::PlaceRecognizer patrol_recognizer(&vocabulary, config.place);
-  SeedRecognizer(prior, &patrol_recognizer);
+  ASSERT_TRUE(SeedRecognizer(prior, "first.pmap", vocabulary, &patrol_recognizer).ok());
   MapResult patrol;
   ASSERT_TRUE(RecognisePlaces(dir / "street-2", config, every, &patrol_recognizer, &patrol).ok());
   const graph::TopoMap extended = BuildTopoMap(patrol, patrol_recognizer, &prior);
@@ -425,7 +469,7 @@ TEST(OnboardEndToEnd, SameMapAsOfflineOnAWorkerOrInline) {
   }
   // A ring of one frame cannot hold a frame until its key location is confirmed: those are lost, counted.
   OnboardOptions tiny;
-  tiny.ring_frames = 1;
+  tiny.ring_s = 0.1;  // under one processed frame: the ring holds 1
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   MapResult result;
   OnboardStats stats;

@@ -1,40 +1,85 @@
 #include "patrolmap/change/options.h"
 
+#include "patrolmap/core/option_check.h"
+
 namespace patrolmap::change {
 namespace {
 
-bool Check(bool ok, const char* message, std::string* error) {
-  if (!ok && error != nullptr) *error = message;
-  return ok;
+void CheckAppearance(const AppearanceOptions& a, OptionCheck* check) {
+  check->AboveAtMost("change.appearance.ratio", a.ratio, 0.0, 1.0)
+      .AboveAtMost("change.appearance.inlier_threshold_px", a.inlier_threshold_px, 0.0, 100.0)
+      .InRange("change.appearance.min_inliers", a.min_inliers, 4, 100000)
+      .InRange("change.appearance.blur_sigma_px", a.blur_sigma_px, 0.0, 50.0)
+      .InRange("change.appearance.search_radius_px", a.search_radius_px, 0, 50)
+      .InRange("change.appearance.min_difference", a.min_difference, 0.0, 255.0)
+      .InRange("change.appearance.min_structure_change", a.min_structure_change, 0.0, 2.0)
+      .AboveAtMost("change.appearance.structure_sigma_px", a.structure_sigma_px, 0.0, 50.0)
+      .InRange("change.appearance.min_area_fraction", a.min_area_fraction, 0.0, 1.0)
+      .InRange("change.appearance.min_unmatched_share", a.min_unmatched_share, 0.0, 1.0)
+      .InRange("change.appearance.parallax_search_px", a.parallax_search_px, 0, 100)
+      .InRange("change.appearance.max_shifted_similarity", a.max_shifted_similarity, -1.0, 1.0);
+}
+
+void CheckObjectMap(const ObjectMapOptions& m, OptionCheck* check) {
+  check->AboveAtMost("change.object_map.centroid_gate_m", m.centroid_gate_m, 0.0, 1000.0)
+      .AboveAtMost("change.object_map.pair_distance_m", m.pair_distance_m, 0.0, 100.0)
+      .InRange("change.object_map.min_pair_fraction", m.min_pair_fraction, 0.0, 1.0)
+      .InRange("change.object_map.point_voxel_m", m.point_voxel_m, 0.005, 10.0)
+      .AboveAtMost("change.object_map.segment_depth_m", m.segment_depth_m, 0.0, 100.0)
+      .InRange("change.object_map.max_segment_samples", m.max_segment_samples, 1, 1000000)
+      .InRange("change.object_map.min_box_iou", m.min_box_iou, 0.0, 1.0)
+      .AboveAtMost("change.object_map.category_sigma_m", m.category_sigma_m, 0.0, 1000.0)
+      .AboveAtMost("change.object_map.vehicle_sigma_m", m.vehicle_sigma_m, 0.0, 1000.0)
+      .InRange("change.object_map.min_category_prior", m.min_category_prior, 0.0, 1.0)
+      .InRange("change.object_map.merge_distance_m", m.merge_distance_m, 0.0, 1000.0)
+      .InRange("change.object_map.min_detections", m.min_detections, 1, 1000000)
+      .AboveAtMost("change.object_map.max_range_m", m.max_range_m, 0.0, 10000.0);
+}
+
+void CheckObjects(const ObjectDiffOptions& o, OptionCheck* check) {
+  check->AboveAtMost("change.objects.match_distance_m", o.match_distance_m, 0.0, 1000.0)
+      .InRange("change.objects.max_move_m", o.max_move_m, 0.0, 10000.0)
+      .InRange("change.objects.physical_weight", o.physical_weight, 0.0, 1000.0)
+      .InRange("change.objects.appearance_weight", o.appearance_weight, 0.0, 1000.0)
+      .InRange("change.objects.max_texture_distance", o.max_texture_distance, 0.0, 1.0)
+      .AboveAtMost("change.objects.max_visible_range_m", o.max_visible_range_m, 0.0, 10000.0)
+      .InRange("change.objects.min_visible_fraction", o.min_visible_fraction, 0.0, 1.0)
+      .AboveAtMost("change.objects.min_expected_detections", o.min_expected_detections, 0.0, 1e6)
+      .InRange("change.objects.min_shape_overlap", o.min_shape_overlap, 0.0, 1.0)
+      .InRange("change.objects.max_top_difference_m", o.max_top_difference_m, 0.0, 1000.0);
+}
+
+void CheckGrid(const EvidenceGridOptions& g, OptionCheck* check) {
+  check->InRange("change.grid.voxel_size_m", g.voxel_size_m, 0.02, 100.0)
+      .AboveAtMost("change.grid.max_range_m", g.max_range_m, 0.0, 1000.0)
+      .Holds("change.grid.max_range_m", g.max_range_m, g.max_range_m / g.voxel_size_m < 1e4,
+             "must be under 10000 voxels (change.grid.voxel_size_m)")
+      .InRange("change.grid.rays_per_row", g.rays_per_row, 1, 10000)
+      .AboveAtMost("change.grid.rate_hz", g.rate_hz, 0.0, 1000.0)
+      .InRange("change.grid.max_voxels", g.max_voxels, 1, 400000000);
+}
+
+void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
+  check->Holds("change.geometry.min_occupancy_change", g.min_occupancy_change,
+               g.min_occupancy_change > 0.0 && g.min_occupancy_change < 1.0, "must be a number in (0, 1)")
+      .InRange("change.geometry.max_free_occupancy", g.max_free_occupancy, 0.0, 1.0)
+      .InRange("change.geometry.min_observations", g.min_observations, 1, 1000000)
+      .InRange("change.geometry.surface_tolerance_voxels", g.surface_tolerance_voxels, 0, 10)
+      .InRange("change.geometry.join_distance_m", g.join_distance_m, 0.0, 1000.0)
+      .InRange("change.geometry.min_region_voxels", g.min_region_voxels, 1, 100000000)
+      .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0);
 }
 
 }  // namespace
 
 bool ChangeOptions::IsValid(std::string* error) const {
-  return Check(appearance.ratio > 0 && appearance.ratio <= 1, "change.appearance.ratio must lie in (0, 1]", error) &&
-         Check(appearance.min_inliers >= 4, "change.appearance.min_inliers must be at least 4", error) &&
-         Check(appearance.search_radius_px >= 0, "change.appearance.search_radius_px must not be negative", error) &&
-         Check(appearance.structure_sigma_px > 0, "change.appearance.structure_sigma_px must be positive", error) &&
-         Check(object_map.centroid_gate_m > 0, "change.object_map.centroid_gate_m must be positive", error) &&
-         Check(object_map.point_voxel_m > 0, "change.object_map.point_voxel_m must be positive", error) &&
-         Check(object_map.min_pair_fraction >= 0 && object_map.min_pair_fraction <= 1,
-               "change.object_map.min_pair_fraction must lie in [0, 1]", error) &&
-         Check(object_map.min_detections >= 1, "change.object_map.min_detections must be at least 1", error) &&
-         Check(objects.match_distance_m > 0, "change.objects.match_distance_m must be positive", error) &&
-         Check(objects.min_visible_fraction >= 0 && objects.min_visible_fraction <= 1,
-               "change.objects.min_visible_fraction must lie in [0, 1]", error) &&
-         Check(objects.min_expected_detections > 0, "change.objects.min_expected_detections must be positive", error) &&
-         Check(objects.physical_weight >= 0 && objects.appearance_weight >= 0,
-               "change.objects weights must not be negative", error) &&
-         Check(grid.voxel_size_m >= 0.02, "change.grid.voxel_size_m must be at least 0.02", error) &&
-         Check(grid.max_range_m > 0 && grid.max_range_m / grid.voxel_size_m < 1e5,
-               "change.grid.max_range_m must be positive and under 100000 voxels", error) &&
-         Check(grid.rays_per_row >= 1, "change.grid.rays_per_row must be at least 1", error) &&
-         Check(grid.rate_hz > 0, "change.grid.rate_hz must be positive", error) &&
-         Check(grid.max_voxels > 0, "change.grid.max_voxels must be positive", error) &&
-         Check(geometry.min_occupancy_change > 0 && geometry.min_occupancy_change < 1,
-               "change.geometry.min_occupancy_change must lie in (0, 1)", error) &&
-         Check(geometry.min_observations >= 1, "change.geometry.min_observations must be at least 1", error);
+  OptionCheck check(error);
+  CheckAppearance(appearance, &check);
+  CheckObjectMap(object_map, &check);
+  CheckObjects(objects, &check);
+  CheckGrid(grid, &check);
+  CheckGeometry(geometry, &check);
+  return check.ok();
 }
 
 }  // namespace patrolmap::change

@@ -36,8 +36,9 @@ bool CheckedOptions(const KeyLocationOptions& options) {
 }  // namespace
 
 KeyLocationDetector::KeyLocationDetector(const KeyLocationOptions& options, const CameraContext& context)
-    : options_(options), context_(context), tracker_(options.edges, options.tracker),
-      smoother_(options.smoothing), extrema_(options.extrema) {
+    : options_(options), context_(context), timing_(ResolveFrameTiming(options, context.frame_rate_hz)),
+      tracker_(options.edges, options.tracker), smoother_(timing_.window, options.smoothing.mode),
+      extrema_(options.extrema) {
   PATROLMAP_CHECK(CheckedOptions(options));
   derotate_ = options.response.derotate_with_imu && context.camera && context.camera_from_imu;
 }
@@ -48,12 +49,22 @@ void KeyLocationDetector::Process(const Frame& frame, DetectorOutput* output) {
     --frames_until_next_;
     return;
   }
-  PATROLMAP_CHECK(!frame.image.empty());
-  ProcessSelected(frame, output);
-  frames_until_next_ = options_.frames.step - 1;
+  if (Usable(frame.image)) {
+    ProcessSelected(frame, output);
+  } else {
+    ++unusable_frames_;
+  }
+  frames_until_next_ = timing_.step - 1;
+}
+
+bool KeyLocationDetector::Usable(const cv::Mat& image) const {
+  const double scale = std::min(options_.frames.scale, 1.0);
+  return !image.empty() && image.type() == CV_8UC1 && image.cols * scale >= kMinProcessedSide &&
+         image.rows * scale >= kMinProcessedSide && (last_image_.empty() || image.size() == last_size_);
 }
 
 const cv::Mat& KeyLocationDetector::Downscale(const cv::Mat& image) {
+  last_size_ = image.size();
   if (options_.frames.scale >= 1.0) return image;
   cv::resize(image, small_, cv::Size(), options_.frames.scale, options_.frames.scale, cv::INTER_AREA);
   return small_;

@@ -1,68 +1,72 @@
 #include "patrolmap/flow/options.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "patrolmap/core/option_check.h"
+
 namespace patrolmap::flow {
 namespace {
 
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
+void CheckFrames(const FrameOptions& frames, OptionCheck* check) {
+  check->AboveAtMost("flow.frames.rate_hz", frames.rate_hz, 0.0, 1000.0)
+      .InRange("flow.frames.scale", frames.scale, 0.05, 1.0);
 }
 
-bool CheckFrames(const FrameOptions& frames, std::string* error) {
-  if (frames.step < 1) return Fail(error, "flow.frames.step must be at least 1");
-  if (!(frames.scale > 0.0 && frames.scale <= 1.0)) return Fail(error, "flow.frames.scale must be in (0, 1]");
-  return true;
+void CheckEdges(const EdgeOptions& edges, OptionCheck* check) {
+  check->InRange("flow.edges.canny_low", edges.canny_low, 0.0, 10000.0)
+      .InRange("flow.edges.canny_high", edges.canny_high, edges.canny_low, 10000.0)
+      .InRange("flow.edges.max_points", edges.max_points, 1, 100000)
+      .InRange("flow.edges.grid_columns", edges.grid_columns, 1, 256)
+      .InRange("flow.edges.grid_rows", edges.grid_rows, 1, 256)
+      .InRange("flow.edges.border", edges.border, 0, 1000);
 }
 
-bool CheckEdges(const EdgeOptions& edges, std::string* error) {
-  if (!(edges.canny_low >= 0.0 && edges.canny_high >= edges.canny_low)) {
-    return Fail(error, "flow.edges: need 0 <= canny_low <= canny_high");
-  }
-  if (edges.max_points < 1) return Fail(error, "flow.edges.max_points must be at least 1");
-  if (edges.grid_columns < 1 || edges.grid_rows < 1) return Fail(error, "flow.edges grid must be at least 1x1");
-  if (edges.border < 0) return Fail(error, "flow.edges.border must not be negative");
-  return true;
+void CheckTracker(const TrackerOptions& tracker, OptionCheck* check) {
+  check->InRange("flow.tracker.window_size", tracker.window_size, 3, 101)
+      .InRange("flow.tracker.pyramid_levels", tracker.pyramid_levels, 0, 8)
+      .InRange("flow.tracker.max_iterations", tracker.max_iterations, 1, 1000)
+      .AboveAtMost("flow.tracker.epsilon", tracker.epsilon, 0.0, 10.0)
+      .InRange("flow.tracker.min_eigen_threshold", tracker.min_eigen_threshold, 0.0, 1.0)
+      .InRange("flow.tracker.max_forward_backward_px", tracker.max_forward_backward_px, 0.0, 1000.0);
 }
 
-bool CheckTracker(const TrackerOptions& tracker, std::string* error) {
-  if (tracker.window_size < 3) return Fail(error, "flow.tracker.window_size must be at least 3");
-  if (tracker.pyramid_levels < 0) return Fail(error, "flow.tracker.pyramid_levels must not be negative");
-  if (tracker.max_iterations < 1) return Fail(error, "flow.tracker.max_iterations must be at least 1");
-  if (!(tracker.epsilon > 0.0)) return Fail(error, "flow.tracker.epsilon must be positive");
-  if (!(tracker.min_eigen_threshold >= 0.0)) return Fail(error, "flow.tracker.min_eigen_threshold must not be negative");
-  if (!(tracker.max_forward_backward_px >= 0.0)) {
-    return Fail(error, "flow.tracker.max_forward_backward_px must not be negative");
-  }
-  return true;
+void CheckVoting(const VotingOptions& voting, OptionCheck* check) {
+  check->InRange("flow.voting.theta_bins", voting.theta_bins, 1, 3600)
+      .AboveAtMost("flow.voting.r_bin_fraction", voting.r_bin_fraction, 0.0, 1.0)
+      .InRange("flow.voting.accept", voting.accept, 1, 100)
+      .InRange("flow.voting.reject", voting.reject, 0, voting.accept)
+      .InRange("flow.voting.max_votes", voting.max_votes, voting.accept, 100);
 }
 
-bool CheckVoting(const VotingOptions& voting, std::string* error) {
-  if (voting.theta_bins < 1) return Fail(error, "flow.voting.theta_bins must be at least 1");
-  if (!(voting.r_bin_fraction > 0.0)) return Fail(error, "flow.voting.r_bin_fraction must be positive");
-  if (voting.reject < 0 || voting.accept < voting.reject) {
-    return Fail(error, "flow.voting: need 0 <= reject <= accept");
-  }
-  if (voting.max_votes < voting.accept) return Fail(error, "flow.voting.max_votes must be at least accept");
-  return true;
-}
-
-bool CheckResponse(const ResponseOptions& response, std::string* error) {
-  if (!(response.reference_speed_mps > 0.0)) return Fail(error, "flow.response.reference_speed_mps must be positive");
-  if (!(response.min_speed_mps > 0.0)) return Fail(error, "flow.response.min_speed_mps must be positive");
-  return true;
+void CheckResponse(const ResponseOptions& response, OptionCheck* check) {
+  check->AboveAtMost("flow.response.reference_speed_mps", response.reference_speed_mps, 0.0, 1000.0)
+      .AboveAtMost("flow.response.min_speed_mps", response.min_speed_mps, 0.0, 1000.0);
 }
 
 }  // namespace
 
 bool KeyLocationOptions::IsValid(std::string* error) const {
-  if (!CheckFrames(frames, error) || !CheckEdges(edges, error) || !CheckTracker(tracker, error) ||
-      !CheckVoting(voting, error) || !CheckResponse(response, error)) {
-    return false;
-  }
-  if (smoothing.window < 1) return Fail(error, "flow.smoothing.window must be at least 1");
-  if (!(extrema.min_change > 0.0)) return Fail(error, "flow.extrema.min_change must be positive");
-  if (!(extrema.min_time_s >= 0.0)) return Fail(error, "flow.extrema.min_time_s must not be negative");
-  return true;
+  OptionCheck check(error);
+  CheckFrames(frames, &check);
+  CheckEdges(edges, &check);
+  CheckTracker(tracker, &check);
+  CheckVoting(voting, &check);
+  CheckResponse(response, &check);
+  check.AboveAtMost("flow.smoothing.window_s", smoothing.window_s, 0.0, 3600.0)
+      .AboveAtMost("flow.extrema.min_change", extrema.min_change, 0.0, 1000.0)
+      .InRange("flow.extrema.min_time_s", extrema.min_time_s, 0.0, 3600.0);
+  return check.ok();
+}
+
+FrameTiming ResolveFrameTiming(const KeyLocationOptions& options, double frame_rate_hz) {
+  FrameTiming timing;
+  const bool known = std::isfinite(frame_rate_hz) && frame_rate_hz > 0.0;
+  timing.step = known ? std::max(1, static_cast<int>(std::lround(frame_rate_hz / options.frames.rate_hz))) : 1;
+  timing.processed_rate_hz = known ? frame_rate_hz / timing.step : options.frames.rate_hz;
+  const double window = std::round(options.smoothing.window_s * timing.processed_rate_hz);
+  timing.window = static_cast<int>(std::clamp(window, 1.0, 1e6));
+  return timing;
 }
 
 const char* ToString(ResponseQuantity quantity) {

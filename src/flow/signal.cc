@@ -4,14 +4,17 @@
 #include <cmath>
 #include <limits>
 
+#include "patrolmap/core/status.h"
+
 namespace patrolmap::flow {
 
-WindowSmoother::WindowSmoother(const SmoothingOptions& options) {
-  if (options.mode == SmoothingMode::kCentered) {
-    behind_ = (options.window - 1) / 2;
-    ahead_ = options.window - 1 - behind_;
+WindowSmoother::WindowSmoother(int window, SmoothingMode mode) {
+  PATROLMAP_CHECK(window >= 1);
+  if (mode == SmoothingMode::kCentered) {
+    behind_ = (window - 1) / 2;
+    ahead_ = window - 1 - behind_;
   } else {
-    behind_ = options.window - 1;
+    behind_ = window - 1;
     ahead_ = 0;
   }
 }

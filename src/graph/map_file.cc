@@ -13,7 +13,8 @@ namespace patrolmap::graph {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
-constexpr std::uint32_t kVersion = 2;  // 2: PTRL section (patrol records)
+constexpr std::uint32_t kVersion = 3;  // 2: PTRL section (patrol records); 3: VOCB section (vocabulary)
+constexpr std::uint32_t kOldestVersion = 1;
 
 class Writer {
  public:
@@ -195,6 +196,13 @@ std::string PatrolSection(const TopoMap& map) {
   return std::move(w.bytes());
 }
 
+std::string VocabularySection(const TopoMap& map) {
+  Writer w;
+  w.Value(map.vocabulary().fingerprint);
+  w.String(map.vocabulary().name);
+  return std::move(w.bytes());
+}
+
 void AppendSection(const char (&tag)[5], const std::string& payload, std::string* file) {
   file->append(tag, 4);
   const std::uint64_t length = payload.size(), checksum = Checksum(payload.data(), payload.size());
@@ -319,32 +327,47 @@ Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();
 }
 
+Status ParseVocabulary(const std::string& path, Reader* r, TopoMap* map) {
+  TopoMap::VocabularyTag tag;
+  tag.fingerprint = r->Value<std::uint64_t>();
+  tag.name = r->String();
+  if (r->failed() || !r->done()) return Corrupt(path, "vocabulary section");
+  map->set_vocabulary(std::move(tag));
+  return Status::Ok();
+}
+
+// Which sections a file has given so far; each may appear once.
+struct SectionsSeen {
+  bool nodes = false, edges = false, features = false, patrols = false, vocabulary = false;
+};
+
 Status ParseSection(const std::string& path, const std::string& tag, const char* payload, std::size_t length,
-                    TopoMap* map, bool* nodes, bool* edges) {
+                    TopoMap* map, SectionsSeen* seen) {
   Reader reader(payload, length);
-  if (tag == "NODE" && !*nodes) {
-    *nodes = true;
-    return ParseNodes(path, &reader, map);
-  }
-  if (tag == "EDGE" && *nodes && !*edges) {
-    *edges = true;
-    return ParseEdges(path, &reader, map);
-  }
-  if (tag == "FEAT" && *nodes) return ParseFeatures(path, &reader, map);
-  if (tag == "PTRL") return ParsePatrols(path, &reader, map);
-  return Corrupt(path, "unexpected section " + tag);
+  const auto once = [&](bool* flag) {
+    const bool first = !*flag;
+    *flag = true;
+    return first;
+  };
+  if (tag == "NODE" && once(&seen->nodes)) return ParseNodes(path, &reader, map);
+  if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, &reader, map);
+  if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, &reader, map);
+  if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, &reader, map);
+  if (tag == "VOCB" && once(&seen->vocabulary)) return ParseVocabulary(path, &reader, map);
+  return Corrupt(path, "unexpected or repeated section " + tag);
 }
 
 }  // namespace
 
 Status SaveMap(const TopoMap& map, const std::string& path) {
   std::string file(kMagic, 8);
-  const std::uint32_t header[2] = {kVersion, 4};
+  const std::uint32_t header[2] = {kVersion, 5};
   file.append(reinterpret_cast<const char*>(header), sizeof(header));
   AppendSection("NODE", NodeSection(map), &file);
   AppendSection("EDGE", EdgeSection(map), &file);
   AppendSection("FEAT", FeatureSection(map), &file);
   AppendSection("PTRL", PatrolSection(map), &file);
+  AppendSection("VOCB", VocabularySection(map), &file);
   return WriteFileAtomically(path, file);
 }
 
@@ -358,13 +381,16 @@ Status LoadMap(const std::string& path, TopoMap* map) {
   if (size < 16) return Status::DataLoss(path + ": truncated map (header incomplete)");
   std::uint32_t header[2];
   std::memcpy(header, bytes.data() + 8, sizeof(header));
+  if (header[0] < kOldestVersion) {
+    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is not one patrolmap wrote");
+  }
   if (header[0] > kVersion) {
     return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is newer than this patrolmap reads (" +
                             std::to_string(kVersion) + ")");
   }
   *map = TopoMap();
   std::size_t position = 16;
-  bool nodes = false, edges = false;
+  SectionsSeen seen;
   for (std::uint32_t s = 0; s < header[1]; ++s) {
     if (size - position < 20) return Status::DataLoss(path + ": truncated map (section " + std::to_string(s) + " header)");
     const std::string tag(bytes.data() + position, 4);
@@ -375,10 +401,10 @@ Status LoadMap(const std::string& path, TopoMap* map) {
     if (length > size - position) return Status::DataLoss(path + ": truncated map (section " + tag + ")");
     const char* payload = bytes.data() + position;
     if (Checksum(payload, length) != checksum) return Corrupt(path, "checksum of section " + tag);
-    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, tag, payload, length, map, &nodes, &edges));
+    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, tag, payload, length, map, &seen));
     position += length;
   }
-  if (!nodes || !edges) return Corrupt(path, "node or edge section missing");
+  if (!seen.nodes || !seen.edges) return Corrupt(path, "node or edge section missing");
   if (position != size) return Corrupt(path, "trailing bytes");
   return Status::Ok();
 }

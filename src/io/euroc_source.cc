@@ -1,4 +1,6 @@
 // EuRoC/ASL flight-log reader (DESIGN.md "Flight logs").
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include <spdlog/spdlog.h>
@@ -6,6 +8,7 @@
 
 #include "euroc_tables.h"
 #include "image_list_source.h"
+#include "image_times.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/io/yaml_file.h"
@@ -143,6 +146,12 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, &entries));
   PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &speeds));
   if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
+  if (!(info.frame_rate_hz > 0.0 && std::isfinite(info.frame_rate_hz))) {
+    std::vector<TimestampNs> times(entries.size());
+    std::transform(entries.begin(), entries.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
+    info.frame_rate_hz = MedianRate(times);
+  }
+  info.timing = "cam0/data.csv";
   if (!imu.empty() && !info.camera_from_imu) {
     spdlog::warn("{}: imu0 present but cam0/sensor.yaml missing: camera-IMU rotation unknown", log);
   }

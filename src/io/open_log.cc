@@ -4,12 +4,15 @@
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "image_list_source.h"
+#include "image_times.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/readers.h"
 
@@ -28,9 +31,23 @@ bool IsImageFile(const fs::path& path) {
 }
 
 Status CheckFrameRate(const ImageFolderOptions& options) {
-  if (options.frame_rate_hz > 0.0) return Status::Ok();
-  return Status::InvalidArgument("frame rate must be positive, is " +
-                                 std::to_string(options.frame_rate_hz));
+  if (std::isfinite(options.frame_rate_hz) && options.frame_rate_hz >= 0.0 && options.frame_rate_hz <= 10000.0) {
+    return Status::Ok();
+  }
+  return Status::InvalidArgument("frame rate = " + std::to_string(options.frame_rate_hz) +
+                                 ": must be in [0, 10000] Hz (0: from the log)");
+}
+
+// The rate the user gave, else `log_rate` when the log has one, else the assumed rate (LogInfo::timed false).
+double ChooseRate(const ImageFolderOptions& options, double log_rate, LogInfo* info) {
+  if (options.frame_rate_hz > 0.0) {
+    info->timing = "given rate " + std::to_string(options.frame_rate_hz) + " Hz";
+    return options.frame_rate_hz;
+  }
+  if (log_rate > 0.0) return log_rate;
+  info->timed = false;
+  info->timing = "no timestamps";
+  return kAssumedFrameRateHz;
 }
 
 std::vector<ImageEntry> TimestampAtRate(const std::vector<std::string>& paths, double rate_hz) {
@@ -41,10 +58,62 @@ std::vector<ImageEntry> TimestampAtRate(const std::vector<std::string>& paths, d
   return entries;
 }
 
-std::string FormatPattern(const std::string& pattern, int index) {
-  std::vector<char> buffer(pattern.size() + 32);
-  std::snprintf(buffer.data(), buffer.size(), pattern.c_str(), index);
-  return buffer.data();
+// Entries of an image list: at the given rate, else at the list's own times, else at the assumed rate.
+std::vector<ImageEntry> TimedEntries(const std::vector<std::string>& paths, const std::vector<TimestampNs>& times,
+                                     const ImageFolderOptions& options, LogInfo* info) {
+  const double rate = ChooseRate(options, MedianRate(times), info);
+  info->frame_rate_hz = rate;
+  if (options.frame_rate_hz > 0.0 || times.size() != paths.size()) return TimestampAtRate(paths, rate);
+  std::vector<ImageEntry> entries(paths.size());
+  for (std::size_t i = 0; i < paths.size(); ++i) entries[i] = {times[i] - times.front(), paths[i]};
+  return entries;
+}
+
+// A printf pattern with one integer conversion (%d, %i or %u with optional 0 flag and width, e.g.
+// %05d); %% stands for a percent sign. Anything else is refused: the pattern comes from the user.
+struct ImagePattern {
+  std::string prefix, suffix;
+  bool zero_pad = false;
+  int width = 0;
+
+  std::string Format(int index) const {
+    std::string number = std::to_string(index);
+    if (static_cast<int>(number.size()) < width) number.insert(0, width - number.size(), zero_pad ? '0' : ' ');
+    return prefix + number + suffix;
+  }
+};
+
+Status ParsePattern(const std::string& pattern, ImagePattern* parsed) {
+  const auto bad = [&pattern](const std::string& why) {
+    return Status::InvalidArgument(pattern + ": not an image pattern: " + why +
+                                   " (expected one %d, %05d or similar; %% for a percent sign)");
+  };
+  bool found = false;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    std::string& out = found ? parsed->suffix : parsed->prefix;
+    if (pattern[i] != '%') {
+      out += pattern[i];
+      continue;
+    }
+    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    if (found) return bad("more than one conversion");
+    std::size_t j = i + 1;
+    if (j < pattern.size() && pattern[j] == '0') parsed->zero_pad = true, ++j;
+    while (j < pattern.size() && std::isdigit(static_cast<unsigned char>(pattern[j])) && parsed->width < 100) {
+      parsed->width = parsed->width * 10 + (pattern[j++] - '0');
+    }
+    if (j >= pattern.size() || std::string("diu").find(pattern[j]) == std::string::npos || parsed->width > 20) {
+      return bad("unsupported conversion '" + pattern.substr(i, j - i + 1) + "'");
+    }
+    found = true;
+    i = j;
+  }
+  if (!found) return bad("no conversion");
+  return Status::Ok();
 }
 
 // Reads frames from a video or a camera; unreadable frames end the stream (codecs cannot resync). A video's
@@ -110,25 +179,32 @@ Status OpenImageFolder(const std::string& folder, const ImageFolderOptions& opti
   if (names.empty()) return Status::DataLoss(folder + ": folder holds no images (.png, .jpg, ...)");
   NaturalSort(&names);
   for (std::string& name : names) name = (fs::path(folder) / name).string();
-  *source = std::make_unique<ImageListSource>(MakeInfo(folder, "image-folder", options.frame_rate_hz),
-                                              TimestampAtRate(names, options.frame_rate_hz));
+  std::vector<TimestampNs> times;
+  LogInfo info = MakeInfo(folder, "image-folder", 0.0);
+  PATROLMAP_RETURN_IF_ERROR(FindImageTimes(folder, names, &times, &info.timing));
+  if (!times.empty()) info.timing = "times from " + info.timing;
+  std::vector<ImageEntry> entries = TimedEntries(names, times, options, &info);
+  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries));
   return Status::Ok();
 }
 
 Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& options,
                         std::unique_ptr<FrameSource>* source) {
   PATROLMAP_RETURN_IF_ERROR(CheckFrameRate(options));
-  const int first = fs::exists(FormatPattern(pattern, 0)) ? 0 : 1;
+  ImagePattern parsed;
+  PATROLMAP_RETURN_IF_ERROR(ParsePattern(pattern, &parsed));
+  const int first = fs::exists(parsed.Format(0)) ? 0 : 1;
   std::vector<std::string> paths;
-  for (int index = first; fs::exists(FormatPattern(pattern, index)); ++index) {
-    paths.push_back(FormatPattern(pattern, index));
+  for (int index = first; index < std::numeric_limits<int>::max() && fs::exists(parsed.Format(index)); ++index) {
+    paths.push_back(parsed.Format(index));
   }
   if (paths.empty()) {
-    return Status::NotFound(pattern + ": no file matches the pattern (tried " +
-                            FormatPattern(pattern, 0) + " and " + FormatPattern(pattern, 1) + ")");
+    return Status::NotFound(pattern + ": no file matches the pattern (tried " + parsed.Format(0) + " and " +
+                            parsed.Format(1) + ")");
   }
-  *source = std::make_unique<ImageListSource>(MakeInfo(pattern, "image-pattern", options.frame_rate_hz),
-                                              TimestampAtRate(paths, options.frame_rate_hz));
+  LogInfo info = MakeInfo(pattern, "image-pattern", 0.0);
+  std::vector<ImageEntry> entries = TimedEntries(paths, {}, options, &info);
+  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries));
   return Status::Ok();
 }
 
@@ -139,7 +215,9 @@ Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
   cv::VideoCapture capture(path);
   if (!capture.isOpened()) return Status::DataLoss(path + ": not a video OpenCV can decode");
   const double reported_rate = capture.get(cv::CAP_PROP_FPS);
-  LogInfo info = MakeInfo(path, "video", reported_rate > 0.0 ? reported_rate : options.frame_rate_hz);
+  LogInfo info = MakeInfo(path, "video", 0.0);
+  info.timing = "the video's frame rate";
+  info.frame_rate_hz = ChooseRate(options, std::isfinite(reported_rate) ? reported_rate : 0.0, &info);
   const double count = capture.get(cv::CAP_PROP_FRAME_COUNT);
   info.frame_count = count > 0.0 ? static_cast<std::int64_t>(count) : -1;
   *source = std::make_unique<VideoSource>(std::move(info), std::move(capture));
@@ -151,9 +229,21 @@ Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr
   cv::VideoCapture capture(device);
   if (!capture.isOpened()) return Status::NotFound("camera " + std::to_string(device) + ": cannot be opened");
   const double reported_rate = capture.get(cv::CAP_PROP_FPS);
-  LogInfo info = MakeInfo("camera" + std::to_string(device), "camera", reported_rate > 0.0 ? reported_rate : options.frame_rate_hz);
+  LogInfo info = MakeInfo("camera" + std::to_string(device), "camera", 0.0);
+  info.timing = "the camera's clock";
+  info.frame_rate_hz = options.frame_rate_hz > 0.0 ? options.frame_rate_hz
+                       : std::isfinite(reported_rate) && reported_rate > 0.0 ? reported_rate
+                                                                             : kAssumedFrameRateHz;
   *source = std::make_unique<VideoSource>(std::move(info), std::move(capture), true);
   return Status::Ok();
+}
+
+Status CheckLogExists(const std::string& path) {
+  std::error_code error;
+  fs::path place = path;
+  if (path.find('%') != std::string::npos) place = fs::path(path).parent_path();
+  if (place.empty() || fs::exists(place, error)) return Status::Ok();
+  return Status::NotFound(path + ": no such file or folder");
 }
 
 Status OpenLog(const std::string& path, const ImageFolderOptions& options,

@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "patrolmap/core/option_check.h"
 #include "patrolmap/io/yaml_file.h"
 
 namespace patrolmap::pipeline {
@@ -138,10 +139,7 @@ class YamlWriter {
 }  // namespace
 
 bool Config::IsValid(std::string* error) const {
-  if (!(input.frame_rate_hz > 0.0)) {
-    *error = "input.frame_rate_hz must be positive";
-    return false;
-  }
+  if (!OptionCheck(error).InRange("input.frame_rate_hz", input.frame_rate_hz, 0.0, 10000.0).ok()) return false;
   return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error);
 }
 

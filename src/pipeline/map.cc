@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -10,13 +11,13 @@
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/data_files.h"
 
 namespace patrolmap::pipeline {
 namespace {
 
-bool Selected(const KeyFrameSelection& selection, std::int64_t frame, int step) {
-  if (selection.every_frame) return frame % step == 0;
-  return std::binary_search(selection.frames.begin(), selection.frames.end(), frame);
+bool Selected(const KeyFrameSelection& selection, std::int64_t frame) {
+  return selection.every_frame || std::binary_search(selection.frames.begin(), selection.frames.end(), frame);
 }
 
 cv::Mat Thumbnail(const cv::Mat& image) {
@@ -24,6 +25,12 @@ cv::Mat Thumbnail(const cv::Mat& image) {
   const double scale = static_cast<double>(kThumbnailWidth) / image.cols;
   cv::resize(image, thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
   return thumbnail;
+}
+
+std::string Hex(std::uint64_t value) {
+  char text[20];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(value));
+  return text;
 }
 
 }  // namespace
@@ -65,7 +72,6 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
                        place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress) {
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
-  const int step = config.flow.frames.step;
   const double scale = config.flow.frames.scale;
   PlaceStage places(recognizer, result);
   Frame frame;
@@ -73,11 +79,14 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
   std::int64_t next = 0;
   KeyFrameInput input;
   input.key_frame.flight = source->info().flight_id;
+  input.key_frame.timed = source->info().timed;
   YawIntegrator yaw;
-  while ((status = source->Next(Selected(selection, next, step), &frame)).ok()) {
+  std::size_t described = 0;
+  while ((status = source->Next(Selected(selection, next), &frame)).ok()) {
     next = frame.index + 1;
     yaw.Add(frame.imu);
-    if (frame.image.empty() || !Selected(selection, frame.index, step)) continue;
+    if (frame.image.empty() || !Selected(selection, frame.index)) continue;
+    ++described;
     if (scale < 1.0) cv::resize(frame.image, input.key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
     else input.key_frame.image = frame.image;
     input.key_frame.timestamp_ns = frame.timestamp_ns;
@@ -87,15 +96,39 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
     PATROLMAP_RETURN_IF_ERROR(places.Add(input));
     if (progress) progress(frame.index, source->info().frame_count);
   }
-  return status.end_of_stream() ? Status::Ok() : status;
+  if (!status.end_of_stream()) return status;
+  if (selection.every_frame && described == 0) return Status::DataLoss(log + ": no frame could be read");
+  return Status::Ok();
 }
 
-void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer) {
+Status CheckVocabulary(const graph::TopoMap& prior, const std::string& prior_path, const vocab::Vocabulary& vocabulary,
+                       const std::string& vocabulary_path) {
+  const graph::TopoMap::VocabularyTag& tag = prior.vocabulary();
+  if (tag.fingerprint == 0 || tag.fingerprint == vocabulary.Fingerprint()) return Status::Ok();
+  return Status::InvalidArgument(prior_path + " was built with the vocabulary " + tag.name + " (fingerprint " +
+                                 Hex(tag.fingerprint) + "), not with " + vocabulary_path + " (fingerprint " +
+                                 Hex(vocabulary.Fingerprint()) + "): give that vocabulary with --vocabulary");
+}
+
+graph::TopoMap::VocabularyTag TagOf(const vocab::Vocabulary& vocabulary, const std::string& path) {
+  return {vocabulary.Fingerprint(), std::filesystem::path(path).filename().string()};
+}
+
+Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path, const vocab::Vocabulary& vocabulary,
+                      place::PlaceRecognizer* recognizer) {
   PATROLMAP_CHECK(recognizer->node_count() == 0);
   for (int i = 0; i < prior.node_count(); ++i) {
     const graph::NodeData& node = prior.node(i);
-    recognizer->AddDescribedNode({node.flight, node.timestamp_ns, node.keypoints, node.descriptors, node.bow});
+    const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(),
+                                       [&](vocab::WordId word) { return word < static_cast<vocab::WordId>(vocabulary.word_count()); });
+    if (!words_fit || (!node.descriptors.empty() && node.descriptors.cols != vocabulary.dimension())) {
+      return Status::DataLoss(prior_path + ": node " + std::to_string(i) + " was not described with this vocabulary "
+                              "(word ids or descriptor width out of range)");
+    }
+    recognizer->AddDescribedNode(
+        {node.flight, node.timestamp_ns, node.frame_index, node.keypoints, node.descriptors, node.bow});
   }
+  return Status::Ok();
 }
 
 graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
@@ -147,9 +180,12 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
   return WriteFileAtomically(folder + "/loop_closures.csv", closures.str());
 }
 
-Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary) {
-  PATROLMAP_RETURN_IF_ERROR(vocab::Vocabulary::Load(path, vocabulary));
-  if (vocabulary->dimension() != 128) return Status::InvalidArgument(path + ": not a SIFT vocabulary");
+Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary, std::string* loaded) {
+  std::string found = path;
+  if (found.empty()) PATROLMAP_RETURN_IF_ERROR(FindDefaultVocabulary(&found));
+  PATROLMAP_RETURN_IF_ERROR(vocab::Vocabulary::Load(found, vocabulary));
+  if (vocabulary->dimension() != 128) return Status::InvalidArgument(found + ": not a SIFT vocabulary");
+  if (loaded != nullptr) *loaded = found;
   return Status::Ok();
 }
 

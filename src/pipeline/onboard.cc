@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+
+#include "patrolmap/core/option_check.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -10,20 +13,26 @@ using Clock = std::chrono::steady_clock;
 
 double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
+// Processed frames the ring holds: ring_s at the detector's processing rate, at least 1.
+std::size_t RingFrames(const OnboardOptions& options, const flow::FrameTiming& timing) {
+  return static_cast<std::size_t>(std::max(1.0, std::ceil(options.ring_s * timing.processed_rate_hz)));
+}
+
 }  // namespace
 
 bool OnboardOptions::IsValid(std::string* error) const {
-  if (queue_capacity < 1) return *error = "onboard queue capacity must be at least 1", false;
-  if (ring_frames < 1) return *error = "onboard ring must hold at least 1 frame", false;
-  return true;
+  return OptionCheck(error)
+      .InRange("onboard queue (--queue)", queue_capacity, 1, 1000)
+      .AboveAtMost("onboard ring (--ring-s)", ring_s, 0.0, 3600.0)
+      .ok();
 }
 
 OnboardMapper::OnboardMapper(const Config& config, const io::LogInfo& info, place::PlaceRecognizer* recognizer,
                              const OnboardOptions& options)
     : options_(options),
       flight_(info.flight_id),
-      detector_(config.flow, {info.camera, info.camera_from_imu}),
-      ring_(static_cast<std::size_t>(options.ring_frames)),
+      detector_(config.flow, {info.camera, info.camera_from_imu, info.frame_rate_hz}),
+      ring_(RingFrames(options, detector_.timing())),
       places_(recognizer, &places_result_) {
   if (options_.place_worker) worker_ = std::thread(&OnboardMapper::Work, this);
 }

@@ -1,9 +1,12 @@
 #include "patrolmap/place/place_recognizer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
+
+#include "patrolmap/core/option_check.h"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
@@ -70,7 +73,55 @@ void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std:
   }
 }
 
+// log10 of the binomial coefficient C(n, k).
+double LogChoose(int n, int k) {
+  return (std::lgamma(n + 1.0) - std::lgamma(k + 1.0) - std::lgamma(n - k + 1.0)) / std::log(10.0);
+}
+
+// Distance of `point` to the line a x + b y + c = 0 [pixels].
+double LineDistance(const cv::Vec3d& line, const cv::Point2f& point) {
+  const double norm = std::hypot(line[0], line[1]);
+  if (norm <= 0.0) return std::numeric_limits<double>::infinity();
+  return std::abs(line[0] * point.x + line[1] * point.y + line[2]) / norm;
+}
+
 }  // namespace
+
+FeatureExtent ExtentOf(const std::vector<cv::KeyPoint>& keypoints) {
+  if (keypoints.empty()) return {};
+  float min_x = keypoints[0].pt.x, max_x = min_x, min_y = keypoints[0].pt.y, max_y = min_y;
+  for (const cv::KeyPoint& keypoint : keypoints) {
+    min_x = std::min(min_x, keypoint.pt.x), max_x = std::max(max_x, keypoint.pt.x);
+    min_y = std::min(min_y, keypoint.pt.y), max_y = std::max(max_y, keypoint.pt.y);
+  }
+  const double width = std::max(1.0f, max_x - min_x), height = std::max(1.0f, max_y - min_y);
+  return {width * height, std::hypot(width, height)};
+}
+
+double LogNumberOfFalseAlarms(const cv::Matx33d& fundamental, const std::vector<cv::Point2f>& from,
+                              const std::vector<cv::Point2f>& to, const FeatureExtent& from_extent,
+                              const FeatureExtent& to_extent) {
+  constexpr int kSample = 7;       // the 7-point algorithm's minimal sample
+  constexpr double kModels = 3.0;  // it gives up to 3 fundamental matrices
+  const int n = static_cast<int>(from.size());
+  if (n <= kSample + 1 || to.size() != from.size()) return 0.0;
+  std::vector<double> probability(n);
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec3d x1(from[i].x, from[i].y, 1.0), x2(to[i].x, to[i].y, 1.0);
+    const double in_to = LineDistance(fundamental * x1, to[i]) * 2.0 * to_extent.diagonal / to_extent.area;
+    const double in_from = LineDistance(fundamental.t() * x2, from[i]) * 2.0 * from_extent.diagonal / from_extent.area;
+    probability[i] = std::clamp(std::max(in_to, in_from), 1e-300, 1.0);
+  }
+  std::sort(probability.begin(), probability.end());
+  const double log_tests = std::log10(kModels * (n - kSample));
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = kSample + 1; k <= n; ++k) {
+    const double log_nfa =
+        log_tests + LogChoose(n, k) + LogChoose(k, kSample) + (k - kSample) * std::log10(probability[k - 1]);
+    best = std::min(best, log_nfa);
+  }
+  return best;
+}
 
 const char* ToString(FundamentalMethod method) {
   switch (method) {
@@ -90,17 +141,19 @@ bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method) 
 }
 
 bool PlaceOptions::IsValid(std::string* error) const {
-  if (max_features < 8) return *error = "place.max_features must be at least 8", false;
-  if (candidates < 1) return *error = "place.candidates must be at least 1", false;
-  if (!(ratio > 0.0 && ratio <= 1.0)) return *error = "place.ratio must be in (0, 1]", false;
-  if (!(min_matched_fraction >= 0.0 && min_matched_fraction <= 1.0)) {
-    return *error = "place.min_matched_fraction must be in [0, 1]", false;
-  }
-  if (!(inlier_threshold_px > 0.0)) return *error = "place.inlier_threshold_px must be positive", false;
-  if (min_inliers < 8) return *error = "place.min_inliers must be at least 8 (the 8-point algorithm)", false;
-  if (max_topological_gap < 0) return *error = "place.max_topological_gap must not be negative", false;
-  if (direct_index_levels_up < 0) return *error = "place.direct_index_levels_up must not be negative", false;
-  return true;
+  return OptionCheck(error)
+      .InRange("place.max_features", max_features, 8, 100000)
+      .InRange("place.candidates", candidates, 1, 1000)
+      .InRange("place.exclude_recent_s", exclude_recent_s, 0.0, 1e10)
+      .InRange("place.exclude_recent_images", exclude_recent_images, 0, 1000000)
+      .AboveAtMost("place.ratio", ratio, 0.0, 1.0)
+      .InRange("place.min_matched_fraction", min_matched_fraction, 0.0, 1.0)
+      .AboveAtMost("place.inlier_threshold_px", inlier_threshold_px, 0.0, 100.0)
+      .InRange("place.min_inliers", min_inliers, 8, 100000)
+      .InRange("place.max_log_nfa", max_log_nfa, -1000.0, 1000.0)
+      .InRange("place.max_topological_gap", max_topological_gap, 0, 1000000)
+      .InRange("place.direct_index_levels_up", direct_index_levels_up, 0, 32)
+      .ok();
 }
 
 PlaceRecognizer::PlaceRecognizer(const vocab::Vocabulary* vocabulary, const PlaceOptions& options)
@@ -122,13 +175,20 @@ Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_poin
                                      const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
                                      const std::vector<std::uint32_t>* query_groups,
                                      const std::vector<std::uint32_t>* candidate_groups) const {
+  return VerifyPair(options_, query_points, query, candidate_points, candidate, query_groups, candidate_groups);
+}
+
+Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
+                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+                        const std::vector<std::uint32_t>* query_groups,
+                        const std::vector<std::uint32_t>* candidate_groups) {
   Verification verification;
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
   std::vector<std::pair<int, int>> matches;
   if (query_groups != nullptr && candidate_groups != nullptr) {
-    MatchWithinGroups(query, *query_groups, candidate, *candidate_groups, options_.ratio, &matches);
+    MatchWithinGroups(query, *query_groups, candidate, *candidate_groups, options.ratio, &matches);
   } else {
-    MatchAll(query, candidate, options_.ratio, &matches);
+    MatchAll(query, candidate, options.ratio, &matches);
   }
   std::vector<cv::Point2f> from, to;
   for (const auto& [i, j] : matches) {
@@ -137,14 +197,17 @@ Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_poin
   }
   verification.matches = static_cast<int>(from.size());
   verification.matched_fraction = static_cast<double>(from.size()) / std::min(query.rows, candidate.rows);
-  if (verification.matched_fraction < options_.min_matched_fraction || verification.matches < options_.min_inliers) {
+  if (verification.matched_fraction < options.min_matched_fraction || verification.matches < options.min_inliers) {
     return verification;
   }
   std::vector<unsigned char> mask;
-  const cv::Mat f = cv::findFundamentalMat(from, to, MethodFlag(options_.method), options_.inlier_threshold_px, 0.999,
+  const cv::Mat f = cv::findFundamentalMat(from, to, MethodFlag(options.method), options.inlier_threshold_px, 0.999,
                                            2000, mask);
-  verification.inliers = f.empty() ? 0 : cv::countNonZero(mask);
-  verification.accepted = verification.inliers >= options_.min_inliers;
+  if (f.rows < 3 || f.cols != 3) return verification;
+  verification.inliers = cv::countNonZero(mask);
+  verification.log_nfa = LogNumberOfFalseAlarms(cv::Matx33d(f.rowRange(0, 3)), from, to, ExtentOf(query_points),
+                                                ExtentOf(candidate_points));
+  verification.accepted = verification.inliers >= options.min_inliers && verification.log_nfa <= options.max_log_nfa;
   return verification;
 }
 
@@ -152,6 +215,7 @@ bool PlaceRecognizer::Allowed(const KeyFrame& query, int node) const {
   const Node& candidate = nodes_[node];
   if (!Plausible(query, node)) return false;
   if (candidate.flight != query.flight) return true;
+  if (!query.timed) return query.frame_index - candidate.frame_index > options_.exclude_recent_images;
   return NsToSeconds(query.timestamp_ns - candidate.timestamp_ns) >= options_.exclude_recent_s;
 }
 
@@ -165,11 +229,12 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
 
 PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
   const Node& n = nodes_.at(node);
-  return {n.flight, n.timestamp_ns, n.keypoints, n.descriptors, database_.entry(static_cast<vocab::EntryId>(node))};
+  return {n.flight, n.timestamp_ns, n.frame_index, n.keypoints, n.descriptors,
+          database_.entry(static_cast<vocab::EntryId>(node))};
 }
 
 int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
-  Node node{std::move(features.flight), features.timestamp_ns, std::move(features.keypoints),
+  Node node{std::move(features.flight), features.timestamp_ns, features.frame_index, std::move(features.keypoints),
             std::move(features.descriptors), {}};
   if (options_.direct_index_levels_up > 0) {
     // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
@@ -190,7 +255,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   }
   *result = PlaceResult();
   auto start = std::chrono::steady_clock::now();
-  Node node{key_frame.flight, key_frame.timestamp_ns, {}, {}, {}};
+  Node node{key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, {}, {}, {}};
   DescribeFeatures(key_frame.image, options_, &node.keypoints, &node.descriptors);
   vocab::BowVector bow;
   std::vector<vocab::WordId> words;

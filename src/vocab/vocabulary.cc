@@ -1,5 +1,7 @@
 #include "patrolmap/vocab/vocabulary.h"
 
+#include "patrolmap/core/checksum.h"
+
 #include <algorithm>
 #include <cmath>
 #include <deque>
@@ -195,6 +197,15 @@ std::uint32_t Vocabulary::AncestorOf(WordId word, int levels_up) const {
   std::uint32_t node = leaf_[word];
   for (int i = 0; i < levels_up && node != 0; ++i) node = parent_[node];
   return node;
+}
+
+std::uint64_t Vocabulary::Fingerprint() const {
+  const std::int32_t parameters[3] = {branching_, depth_, dimension_};
+  std::uint64_t hash = Checksum(reinterpret_cast<const char*>(parameters), sizeof(parameters));
+  hash = Checksum(reinterpret_cast<const char*>(&scale_), sizeof(scale_), hash);
+  hash = Checksum(reinterpret_cast<const char*>(first_child_.data()), first_child_.size() * sizeof(std::uint32_t), hash);
+  hash = Checksum(reinterpret_cast<const char*>(centres_.data()), centres_.size(), hash);
+  return Checksum(reinterpret_cast<const char*>(idf_.data()), idf_.size() * sizeof(float), hash);
 }
 
 }  // namespace patrolmap::vocab

@@ -11,8 +11,7 @@ int main() {
   patrolmap::pipeline::Config config;
   std::string error;
   if (!config.IsValid(&error) || config.flow.voting.accept != 3) return 1;
-  config.flow.frames.step = 1;
-  patrolmap::flow::KeyLocationDetector detector(config.flow, {});
+  patrolmap::flow::KeyLocationDetector detector(config.flow, {});  // rate unknown: every frame
   patrolmap::flow::DetectorOutput output;
   patrolmap::Frame frame;
   frame.image = cv::Mat(240, 376, CV_8UC1, cv::Scalar(128));

@@ -34,7 +34,8 @@ struct Arguments {
   std::string prior_map;
   std::string out = "patrolmap_onboard";
   std::string config;
-  std::string vocabulary = "vocab/default.pmvoc";
+  std::string vocabulary;  // empty: the default one
+  double fps = 0.0;
   bool fast = false;
   double max_seconds = 0.0;
   pipeline::OnboardOptions options;
@@ -109,17 +110,21 @@ PatrolRecord AppearanceRecord(const io::LogInfo& info, const pipeline::MapResult
 
 Status Run(const Arguments& arguments) {
   pipeline::Config config;
+  if (arguments.source.rfind("camera:", 0) != 0) PATROLMAP_RETURN_IF_ERROR(io::CheckLogExists(arguments.source));
   PATROLMAP_RETURN_IF_ERROR(pipeline::LoadCheckedConfig(arguments.config, &config));
+  if (arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   std::string error;
   if (!arguments.options.IsValid(&error)) return Status::InvalidArgument(error);
   graph::TopoMap prior;
   if (!arguments.prior_map.empty()) PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.prior_map, &prior));
   vocab::Vocabulary vocabulary;
-  PATROLMAP_RETURN_IF_ERROR(pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary));
+  std::string vocabulary_path;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary, &vocabulary_path));
+  PATROLMAP_RETURN_IF_ERROR(pipeline::CheckVocabulary(prior, arguments.prior_map, vocabulary, vocabulary_path));
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(arguments, config, &source));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
-  pipeline::SeedRecognizer(prior, &recognizer);
+  PATROLMAP_RETURN_IF_ERROR(pipeline::SeedRecognizer(prior, arguments.prior_map, vocabulary, &recognizer));
   pipeline::MapResult result;
   Pace pace;
   {
@@ -131,6 +136,7 @@ Status Run(const Arguments& arguments) {
     PATROLMAP_RETURN_IF_ERROR(
         WriteFileAtomically(arguments.out + "/key_locations.csv", pipeline::KeyLocationsCsv(mapper.key_locations())));
     graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+    map.set_vocabulary(pipeline::TagOf(vocabulary, vocabulary_path));
     if (!result.nodes.empty()) map.SetPatrol(AppearanceRecord(source->info(), result));
     PATROLMAP_RETURN_IF_ERROR(pipeline::SaveMapRun(&map, arguments.out));
     PrintSummary(arguments, mapper.stats(), result, pace);
@@ -152,7 +158,9 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", arguments.out, "output folder: map.pmap, nodes.csv, loop_closures.csv, key_locations.csv")
       ->capture_default_str();
   app.add_option("-c,--config", arguments.config, "YAML configuration (see config/default.yaml)");
-  app.add_option("--vocabulary", arguments.vocabulary, "vocabulary file")->capture_default_str();
+  app.add_option("--vocabulary", arguments.vocabulary, "vocabulary file (default: the shipped one)");
+  app.add_option("--fps", arguments.fps, "frame rate of a log without timestamps [Hz] (default: its own times)")
+      ->check(CLI::Range(0.001, 10000.0));
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
   app.add_option("--max-seconds", arguments.max_seconds, "stop after this much of the flight [s]; 0: at its end")
       ->check(CLI::NonNegativeNumber);
@@ -160,8 +168,8 @@ int main(int argc, char** argv) {
                "run place recognition on the frame thread (the map is the same)");
   app.add_option("--queue", arguments.options.queue_capacity, "key frames waiting for place recognition at most")
       ->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--ring", arguments.options.ring_frames, "processed frames kept for key locations confirmed late")
-      ->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--ring-s", arguments.options.ring_s, "seconds of processed frames kept for key locations confirmed late")
+      ->capture_default_str()->check(CLI::Range(0.1, 3600.0));
   app.add_flag("-q,--quiet", quiet, "only print errors");
   app.footer("SIGINT or SIGTERM ends the stream; the map is written as if it had ended, and the exit code is 0.");
   try {

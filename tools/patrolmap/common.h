@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "patrolmap/change/report.h"
@@ -18,6 +19,9 @@ inline int Fail(const Status& status) {
 }
 
 using pipeline::LoadCheckedConfig;
+
+// --fps: the frame rate of image folders, patterns and videos, overriding their own times [Hz].
+void AddFpsOption(CLI::App* app, double* fps);
 
 // Prints one line on what changed between the report's flights (diff and patrol).
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out);

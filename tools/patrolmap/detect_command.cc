@@ -21,6 +21,7 @@ struct DetectArguments {
   std::string out = "patrolmap_out";
   std::string quantity;
   std::string smoothing;
+  double fps = 0.0;
 };
 
 Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config) {
@@ -54,8 +55,10 @@ void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionRes
 
 int RunDetect(const DetectArguments& arguments) {
   pipeline::Config config;
-  Status status = LoadCheckedConfig(arguments.config, &config);
+  Status status = io::CheckLogExists(arguments.log);
+  if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
   if (status.ok()) status = ApplyOverrides(arguments, &config);  // command-line flags win over the file
+  if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   if (!status.ok()) return Fail(status);
   std::unique_ptr<io::FrameSource> source;
   status = io::OpenLog(arguments.log, config.input, &source);
@@ -67,6 +70,9 @@ int RunDetect(const DetectArguments& arguments) {
                                     [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); });
   }
   if (!status.ok()) return Fail(status);
+  for (const std::string& warning : pipeline::DetectionWarnings(source->info(), result, config.flow)) {
+    spdlog::warn("{}", warning);
+  }
   if (config.flow.response.derotate_with_imu && !result.derotated && source->info().has_imu) {
     spdlog::warn("{}: IMU present but camera extrinsics unknown: flow not de-rotated", arguments.log);
   }
@@ -88,6 +94,7 @@ Command AddDetectCommand(CLI::App* app) {
   app->add_option("--response", arguments->quantity,
                   "override flow.response.quantity: length or line_parameter");
   app->add_option("--smoothing", arguments->smoothing, "override flow.smoothing.mode: centered or causal");
+  AddFpsOption(app, &arguments->fps);
   app->footer("Writes OUT/key_locations.csv, OUT/response.csv and OUT/response.svg.");
   return [arguments] { return RunDetect(*arguments); };
 }

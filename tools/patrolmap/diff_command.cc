@@ -41,6 +41,13 @@ int RunDiff(const DiffArguments& arguments) {
 
 }  // namespace
 
+void AddFpsOption(CLI::App* app, double* fps) {
+  app->add_option("--fps", *fps,
+                  "frame rate of an image folder, pattern or video [Hz] (default: from its times: times.txt, "
+                  "numeric file names, the video's rate; else 30 with a warning)")
+      ->check(CLI::Range(0.001, 10000.0));
+}
+
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out) {
   std::printf("changes %s -> %s: %zu places compared, %d with appearance changes", report.prior_flight.c_str(),
               report.current_flight.c_str(), report.places.size(), report.ChangedPlaces());

@@ -20,7 +20,8 @@ struct MapArguments {
   std::string prior_map;  // patrol: the map the flight extends
   std::string out = "patrolmap_map";
   std::string config;
-  std::string vocabulary = "vocab/default.pmvoc";
+  std::string vocabulary;  // empty: the default one (pipeline::FindDefaultVocabulary)
+  double fps = 0.0;        // rate of logs without timestamps (0: their own)
   bool every_frame = false;
 };
 
@@ -30,14 +31,23 @@ Status SelectKeyFrames(const MapArguments& arguments, const std::string& log, co
                        pipeline::KeyFrameSelection* selection) {
   selection->every_frame = arguments.every_frame;
   selection->frames.clear();
-  if (arguments.every_frame) return Status::Ok();
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
+  if (arguments.every_frame) {
+    if (!source->info().timed) {
+      spdlog::warn("{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} "
+                   "before a query are not its candidates", log, config.place.exclude_recent_images);
+    }
+    return Status::Ok();
+  }
   pipeline::DetectionResult detection;
   {
     Progress progress("detect");
     PATROLMAP_RETURN_IF_ERROR(pipeline::RunDetection(source.get(), config.flow, &detection,
                                                      [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
+  }
+  for (const std::string& warning : pipeline::DetectionWarnings(source->info(), detection, config.flow)) {
+    spdlog::warn("{}", warning);
   }
   for (const KeyLocation& node : detection.key_locations) selection->frames.push_back(node.frame_index);
   const bool several = arguments.logs.size() > 1;
@@ -98,12 +108,20 @@ int RunMap(const MapArguments& arguments) {
   vocab::Vocabulary vocabulary;
   pipeline::KeyFrameSelection selection;
   graph::TopoMap prior;
-  Status status = LoadCheckedConfig(arguments.config, &config);
+  Status status;
+  for (const std::string& log : arguments.logs) {
+    if (status.ok()) status = io::CheckLogExists(log);  // a missing log first: it is the likeliest mistake
+  }
+  if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   if (status.ok() && !arguments.prior_map.empty()) status = graph::LoadMap(arguments.prior_map, &prior);
-  if (status.ok()) status = pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary);
+  std::string vocabulary_path;
+  if (status.ok()) status = pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary, &vocabulary_path);
+  if (status.ok()) status = pipeline::CheckVocabulary(prior, arguments.prior_map, vocabulary, vocabulary_path);
   if (!status.ok()) return Fail(status);
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
-  pipeline::SeedRecognizer(prior, &recognizer);
+  status = pipeline::SeedRecognizer(prior, arguments.prior_map, vocabulary, &recognizer);
+  if (!status.ok()) return Fail(status);
   pipeline::MapResult result;
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = SelectKeyFrames(arguments, arguments.logs[i], config, &selection);
@@ -114,6 +132,7 @@ int RunMap(const MapArguments& arguments) {
     }
   }
   graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  map.set_vocabulary(pipeline::TagOf(vocabulary, vocabulary_path));
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = RecordPatrol(arguments.logs[i], config, result, &map);
   }
@@ -134,7 +153,8 @@ Command AddPatrolCommand(CLI::App* app) {
   app->add_option("--map", arguments->prior_map, "the map of earlier flights (map.pmap)")->required();
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
-  app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file")->capture_default_str();
+  app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file (default: the shipped one)");
+  AddFpsOption(app, &arguments->fps);
   app->footer("Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
               "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
               "since the map's last flight to OUT/changes.json and OUT/changes.html (as patrolmap diff).");
@@ -148,10 +168,13 @@ Command AddMapCommand(CLI::App* app) {
       ->required();
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
-  app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file (patrolmap vocab build)")
-      ->capture_default_str();
+  app->add_option("--vocabulary", arguments->vocabulary,
+                  "vocabulary file (patrolmap vocab build; default: the shipped one, found beside the program, in "
+                  "the install prefix or at $PATROLMAP_VOCABULARY)");
+  AddFpsOption(app, &arguments->fps);
   app->add_flag("--every-frame", arguments->every_frame,
-                "make every processed frame a node (image collections; judging place recognition alone)");
+                "make every image a node, without key-location detection (image collections, place recognition "
+                "alone); without timestamps 'recent' is counted in images (place.exclude_recent_images)");
   app->footer("Writes OUT/map.pmap, OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
   return [arguments] { return RunMap(*arguments); };
 }

@@ -22,7 +22,11 @@ namespace patrolmap::flow {
 struct CameraContext {
   std::optional<CameraIntrinsics> camera;         // at the log's native resolution
   std::optional<Eigen::Matrix3d> camera_from_imu; // needed for de-rotation
+  double frame_rate_hz = 0.0;                     // the log's nominal rate [Hz]; 0 when unknown (FrameTiming)
 };
+
+// Frames smaller than this on a side once downscaled carry no usable flow: they are skipped and counted.
+constexpr int kMinProcessedSide = 16;
 
 // What one call produced; the detector appends, the caller clears.
 struct DetectorOutput {
@@ -54,11 +58,15 @@ class KeyLocationDetector {
   // True when flow is de-rotated (option on, IMU extrinsics and intrinsics known).
   bool derotating() const { return derotate_; }
   int processed_frames() const { return processed_frames_; }
+  // Frames due for processing that came without an image or too small to track (kMinProcessedSide).
+  int unusable_frames() const { return unusable_frames_; }
+  const FrameTiming& timing() const { return timing_; }
   // The image the last processed frame was tracked in (at the flow scale); valid until the next Process().
   const cv::Mat& last_image() const { return last_image_; }
 
  private:
   void ProcessSelected(const Frame& frame, DetectorOutput* output);
+  bool Usable(const cv::Mat& image) const;  // grey, large enough, the size of the frames before it
   const cv::Mat& Downscale(const cv::Mat& image);
   void Derotate(TimestampNs timestamp_ns, int image_width);
   double ResponseOf(const Frame& frame, int image_width) const;
@@ -67,6 +75,7 @@ class KeyLocationDetector {
 
   KeyLocationOptions options_;
   CameraContext context_;
+  FrameTiming timing_;
   bool derotate_ = false;
   EdgeFlowTracker tracker_;
   std::optional<HysteresisVoter> voter_;
@@ -75,10 +84,12 @@ class KeyLocationDetector {
 
   int frames_until_next_ = 0;
   int processed_frames_ = 0;
+  int unusable_frames_ = 0;
   std::optional<TimestampNs> previous_processed_ns_;
   std::vector<ImuSample> pending_imu_;
   cv::Mat small_;
   cv::Mat last_image_;
+  cv::Size last_size_;  // of the last processed frame, before downscaling
   std::vector<FlowVector> vectors_;
   std::vector<PolarVector> polar_;
   std::vector<std::uint8_t> accepted_;

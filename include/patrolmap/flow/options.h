@@ -8,10 +8,13 @@
 namespace patrolmap::flow {
 
 // Which frames the stage looks at, and at what size (paper 002 §IV: every 5th
-// frame of a 752x480, 30 fps camera, downscaled to 376x240).
+// frame of a 752x480, 30 fps camera, downscaled to 376x240). The rate is in
+// time, not frames, so a 10 Hz car log, a 20 Hz EuRoC flight and a 30 Hz video
+// behave alike: every step-th frame is processed, step = round(log rate /
+// rate_hz), at least 1 (FrameTiming).
 struct FrameOptions {
-  int step = 5;         // process every step-th frame of the log (1 = every frame)
-  double scale = 0.5;   // resize factor applied before edge detection, in (0, 1]
+  double rate_hz = 6.0;  // processed frames per second (paper: 30 fps / 5) [Hz]
+  double scale = 0.5;    // resize factor applied before edge detection, in [0.05, 1]
 };
 
 // Canny edge pixels that seed the tracker, capped and spread over the image.
@@ -71,9 +74,10 @@ enum class SmoothingMode {
   kCausal,    // onboard: window ends at the sample; delays the signal by (window-1)/2 frames
 };
 
-// Fixed-width window smoothing in time (Table I: 30 processed frames).
+// Fixed-width window smoothing in time (Table I: 30 processed frames, which at
+// the paper's 6 processed frames per second is 5 s).
 struct SmoothingOptions {
-  int window = 30;  // processed frames
+  double window_s = 5.0;  // window width [s]; in processed frames: FrameTiming
   SmoothingMode mode = SmoothingMode::kCentered;
 };
 
@@ -95,6 +99,17 @@ struct KeyLocationOptions {
   // True when every field is in range; otherwise `error` names the first bad field.
   bool IsValid(std::string* error) const;
 };
+
+// The stage's durations in frames for a log of a given rate.
+struct FrameTiming {
+  int step = 5;     // process every step-th frame of the log
+  int window = 30;  // smoothing window [processed frames]
+  double processed_rate_hz = 6.0;
+};
+
+// `frame_rate_hz` is the log's nominal rate; 0 (unknown) processes every frame
+// and takes rate_hz as the rate of those frames.
+FrameTiming ResolveFrameTiming(const KeyLocationOptions& options, double frame_rate_hz);
 
 const char* ToString(ResponseQuantity quantity);
 const char* ToString(SmoothingMode mode);

@@ -23,7 +23,8 @@ namespace patrolmap::flow {
 //    once; the smoothed signal lags the raw one by (W - 1) / 2 samples.
 class WindowSmoother {
  public:
-  explicit WindowSmoother(const SmoothingOptions& options);
+  // `window` in samples (at least 1; FrameTiming converts the option's seconds).
+  WindowSmoother(int window, SmoothingMode mode);
 
   // Adds a sample and appends every sample whose smoothed value is now final.
   void Add(const FlowSample& sample, std::vector<FlowSample>* released);

@@ -73,10 +73,20 @@ class TopoMap {
   const PatrolRecord* Patrol(const std::string& flight) const;  // nullptr when the flight has none
   const std::vector<PatrolRecord>& patrols() const { return patrols_; }
 
+  // The vocabulary the nodes' bag-of-words vectors were made with (Vocabulary::Fingerprint, and the file
+  // name for messages); fingerprint 0 when unknown (maps of format version 2 and older).
+  struct VocabularyTag {
+    std::uint64_t fingerprint = 0;
+    std::string name;
+  };
+  const VocabularyTag& vocabulary() const { return vocabulary_; }
+  void set_vocabulary(VocabularyTag tag) { vocabulary_ = std::move(tag); }
+
  private:
   Graph graph_;
   std::vector<Edge> edge_order_;
   std::vector<PatrolRecord> patrols_;
+  VocabularyTag vocabulary_;
 };
 
 }  // namespace patrolmap::graph

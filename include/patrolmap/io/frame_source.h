@@ -28,6 +28,10 @@ struct LogInfo {
   std::optional<Eigen::Matrix3d> body_from_camera;
   std::int64_t frame_count = -1;             // -1 when unknown (live or some videos)
   double frame_rate_hz = 0.0;                // nominal; 0 when unknown
+  // Whether frame times come from the log or the user (--fps); false when a rate was assumed, so
+  // durations measured in frames are all the log can offer (place.exclude_recent_images).
+  bool timed = true;
+  std::string timing;                        // where the times came from, for messages
   bool has_imu = false;
   bool has_speed = false;
 };

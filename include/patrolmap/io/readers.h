@@ -8,14 +8,20 @@
 
 namespace patrolmap::io {
 
+// Rate taken for a log without timestamps when none is given (with a warning) [Hz].
+constexpr double kAssumedFrameRateHz = 30.0;
+
 struct ImageFolderOptions {
-  // Frame rate assumed for logs without timestamps (image folders, printf
-  // patterns, videos that report none) [Hz].
-  double frame_rate_hz = 30.0;
+  // Frame rate of image folders, printf patterns and videos [Hz] (--fps). 0: from the log's own times
+  // (a times file, the file names, the video's metadata); a log without any is read at
+  // kAssumedFrameRateHz with a warning. A positive rate overrides the log's times.
+  double frame_rate_hz = 0.0;
 };
 
 // Image folder: every .png/.jpg/.jpeg/.bmp/.pgm/.ppm/.tif/.tiff file of a
-// folder, in natural order. Timestamps are index / frame_rate_hz.
+// folder, in natural order. Timestamps from the folder (FindImageTimes in
+// image_times.h: KITTI times.txt, numeric file names) unless frame_rate_hz is
+// set, else index / kAssumedFrameRateHz.
 Status OpenImageFolder(const std::string& folder, const ImageFolderOptions& options,
                        std::unique_ptr<FrameSource>* source);
 
@@ -38,6 +44,10 @@ Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr
 // mav0/ (as EuRoC archives do) is accepted too. The tables are checked when
 // the log is opened: malformed lines and non-monotonic timestamps fail here.
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source);
+
+// Fails with "PATH: no such file or folder" unless `path` exists (a printf pattern: its folder), so a
+// front end can name a missing log before it loads anything else.
+Status CheckLogExists(const std::string& path);
 
 // Picks the reader for `path`: EuRoC when it holds cam0/data.csv (or
 // mav0/cam0/data.csv), a printf pattern when it contains '%', an image folder

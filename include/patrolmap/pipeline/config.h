@@ -27,7 +27,7 @@ template <typename Visitor>
 void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("input.frame_rate_hz", &config->input.frame_rate_hz);
   flow::KeyLocationOptions& flow = config->flow;
-  visitor->Field("flow.frames.step", &flow.frames.step);
+  visitor->Field("flow.frames.rate_hz", &flow.frames.rate_hz);
   visitor->Field("flow.frames.scale", &flow.frames.scale);
   visitor->Field("flow.edges.canny_low", &flow.edges.canny_low);
   visitor->Field("flow.edges.canny_high", &flow.edges.canny_high);
@@ -52,7 +52,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("flow.response.normalise_by_speed", &flow.response.normalise_by_speed);
   visitor->Field("flow.response.reference_speed_mps", &flow.response.reference_speed_mps);
   visitor->Field("flow.response.min_speed_mps", &flow.response.min_speed_mps);
-  visitor->Field("flow.smoothing.window", &flow.smoothing.window);
+  visitor->Field("flow.smoothing.window_s", &flow.smoothing.window_s);
   visitor->Field("flow.smoothing.mode", &flow.smoothing.mode);
   visitor->Field("flow.extrema.min_change", &flow.extrema.min_change);
   visitor->Field("flow.extrema.min_time_s", &flow.extrema.min_time_s);
@@ -61,11 +61,13 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.root_sift", &place.root_sift);
   visitor->Field("place.candidates", &place.candidates);
   visitor->Field("place.exclude_recent_s", &place.exclude_recent_s);
+  visitor->Field("place.exclude_recent_images", &place.exclude_recent_images);
   visitor->Field("place.ratio", &place.ratio);
   visitor->Field("place.min_matched_fraction", &place.min_matched_fraction);
   visitor->Field("place.method", &place.method);
   visitor->Field("place.inlier_threshold_px", &place.inlier_threshold_px);
   visitor->Field("place.min_inliers", &place.min_inliers);
+  visitor->Field("place.max_log_nfa", &place.max_log_nfa);
   visitor->Field("place.accept_best", &place.accept_best);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);

@@ -19,7 +19,15 @@ struct DetectionResult {
   std::vector<io::SkippedFrame> skipped;   // unreadable frames that were passed over
   bool derotated = false;                  // flow was de-rotated with the gyro
   double seconds = 0.0;                    // wall time of the run
+  flow::FrameTiming timing;                // the frame step and smoothing window used for the log's rate
+  int unusable_frames = 0;                 // frames due for processing but too small or without an image
 };
+
+// What a user should know about a detection run, one sentence each: a log without timestamps, a log
+// too short for the smoothing window, a response too flat for any key location, unusable frames. Each
+// names the log and says what to change. Empty when all is well.
+std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const DetectionResult& result,
+                                           const flow::KeyLocationOptions& options);
 
 // Called now and then with (frames read, frames in the log or -1).
 using FrameProgress = std::function<void(std::int64_t, std::int64_t)>;

@@ -98,12 +98,23 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
 graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
                             const graph::TopoMap* prior = nullptr);
 
-// Puts a prior map's nodes (their stored features and BoW vectors) into an
-// empty recognizer, in order, so a later flight is matched against them.
-void SeedRecognizer(const graph::TopoMap& prior, place::PlaceRecognizer* recognizer);
+// Fails naming both files when `prior` records another vocabulary than `vocabulary` (maps that record
+// none pass).
+Status CheckVocabulary(const graph::TopoMap& prior, const std::string& prior_path, const vocab::Vocabulary& vocabulary,
+                       const std::string& vocabulary_path);
 
-// Loads the SIFT vocabulary the place stage needs; fails naming the file when it is not one.
-Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary);
+// What a map records of the vocabulary at `path` (TopoMap::set_vocabulary).
+graph::TopoMap::VocabularyTag TagOf(const vocab::Vocabulary& vocabulary, const std::string& path);
+
+// Puts a prior map's nodes (their stored features and BoW vectors) into an
+// empty recognizer, in order, so a later flight is matched against them. Fails naming the map when a node's
+// words or descriptors do not fit `vocabulary`.
+Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path, const vocab::Vocabulary& vocabulary,
+                      place::PlaceRecognizer* recognizer);
+
+// Loads the SIFT vocabulary the place stage needs (the default one, FindDefaultVocabulary, when `path` is
+// empty); fails naming the file when it is not one. `loaded` (may be null) receives the file's path.
+Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary, std::string* loaded = nullptr);
 
 // The width the key-frame features of `flight` were found at (from its first node), 0 when it has none.
 int FeatureWidth(const MapResult& result, const std::string& flight);

@@ -27,8 +27,10 @@ namespace patrolmap::pipeline {
 struct OnboardOptions {
   bool place_worker = true;  // place recognition on its own thread (false: inline, on the frame thread)
   int queue_capacity = 4;    // key frames waiting for the place stage; when full the frame thread waits
-  int ring_frames = 256;     // processed frames kept for key locations confirmed late (at 30 fps and step
-                             // 1: 8.5 s; about 90 kB each at 376x240)
+  // Time of recently processed frames kept for key locations confirmed late (a key location is confirmed
+  // up to half a smoothing window and an extremum's fall after its frame) [s]. At the default 6 processed
+  // frames per second 40 s is 240 frames, about 90 kB each at 376x240.
+  double ring_s = 40.0;
   bool IsValid(std::string* error) const;
 };
 

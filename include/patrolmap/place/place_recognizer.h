@@ -30,11 +30,19 @@ struct PlaceOptions {
   bool root_sift = true;             // RootSIFT (Arandjelovic and Zisserman) instead of plain SIFT
   int candidates = 3;                // BoW candidates verified per query (paper: n = 3)
   double exclude_recent_s = 20.0;    // nodes of the same flight this recent are not candidates [s]
+  // For logs without timestamps (image collections): nodes of the same flight at most this many images
+  // before the query are not candidates (1: the image just before; 0: none excluded).
+  int exclude_recent_images = 1;
   double ratio = 0.8;                // Lowe's ratio test for descriptor matches
   double min_matched_fraction = 0.1; // matches / features of the smaller frame (paper: 0.5)
   FundamentalMethod method = FundamentalMethod::kUsacMagsac;
   double inlier_threshold_px = 1.5;  // epipolar distance for a RANSAC inlier [pixels]
-  int min_inliers = 50;              // a verified match needs this many inliers (chosen on experiment 3 seed 1: true >= 56, false <= 38)
+  // A verified match needs at least min_inliers inliers and an a-contrario number of false alarms
+  // (LogNumberOfFalseAlarms: how many such fundamental matrices chance alone would give) of at most
+  // 10^max_log_nfa. The NFA scales with the image and the match count, so one setting holds from
+  // 376x240 key frames to megapixel photographs.
+  int min_inliers = 15;
+  double max_log_nfa = -10.0;
   bool accept_best = false;          // verify every candidate and keep the best (paper: the first that passes)
   // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already): a quarter
   // of the memory per node; matching distances are computed from the 8-bit values.
@@ -62,6 +70,7 @@ struct KeyFrame {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
   cv::Mat image;  // CV_8UC1
+  bool timed = true;  // false: the log has no timestamps, "recent" is counted in images
 };
 
 // The outcome of one verification.
@@ -71,8 +80,27 @@ struct Verification {
   int matches = 0;             // ratio-test matches
   double matched_fraction = 0.0;
   int inliers = 0;             // fundamental-matrix inliers
+  double log_nfa = 0.0;        // log10 of the number of false alarms of the fundamental matrix (0 when none fitted)
   bool accepted = false;
 };
+
+// Size of the image a frame's features were found in, as verification measures it: the bounding box of
+// the keypoints (a map file keeps keypoints, not image sizes).
+struct FeatureExtent {
+  double area = 1.0;      // [pixels^2]
+  double diagonal = 1.0;  // [pixels]
+};
+FeatureExtent ExtentOf(const std::vector<cv::KeyPoint>& keypoints);
+
+// The a-contrario test of ORSA / AC-RANSAC (Moisan and Stival 2004; Moisan, Moulon and Monasse 2012) for a
+// fundamental matrix F with x2^T F x1 = 0 over n matches: with the matches sorted by the probability
+// p_i = 2 d_i D / A that a random point lies as close to its epipolar line (d_i the larger of the two
+// images' distances, D and A the image's diagonal and area), returns
+//   min over k > 7 of log10( 3 (n - 7) C(n, k) C(k, 7) p_(k)^(k - 7) ),
+// the expected number of models as good as F among random matches. Below 0 the match is meaningful.
+double LogNumberOfFalseAlarms(const cv::Matx33d& fundamental, const std::vector<cv::Point2f>& from,
+                              const std::vector<cv::Point2f>& to, const FeatureExtent& from_extent,
+                              const FeatureExtent& to_extent);
 
 struct PlaceResult {
   int node = -1;                           // the node the key frame became
@@ -81,6 +109,13 @@ struct PlaceResult {
   std::vector<Verification> candidates;    // every candidate looked at
   double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
 };
+
+// Verifies two described frames: ratio-test matching (within equal direct-index groups when both are given),
+// the matched-fraction rule, a fundamental matrix by `options.method`, and the inlier and a-contrario rules.
+Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
+                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+                        const std::vector<std::uint32_t>* query_groups = nullptr,
+                        const std::vector<std::uint32_t>* candidate_groups = nullptr);
 
 class PlaceRecognizer {
  public:
@@ -97,6 +132,7 @@ class PlaceRecognizer {
   struct NodeFeatures {
     std::string flight;
     TimestampNs timestamp_ns = 0;
+    std::int64_t frame_index = 0;
     std::vector<cv::KeyPoint> keypoints;
     cv::Mat descriptors;
     vocab::BowVector bow;
@@ -117,6 +153,7 @@ class PlaceRecognizer {
   struct Node {
     std::string flight;
     TimestampNs timestamp_ns = 0;
+    std::int64_t frame_index = 0;
     std::vector<cv::KeyPoint> keypoints;
     cv::Mat descriptors;
     std::vector<std::uint32_t> groups;  // direct-index node of each feature (when enabled)

@@ -72,6 +72,9 @@ class Vocabulary {
   int branching() const { return branching_; }
   int depth() const { return depth_; }
   const Array<float>& idf() const { return idf_; }
+  // A checksum of the tree and its weights: two vocabularies quantise alike exactly when they have the
+  // same fingerprint. A map file records it, so a later flight is matched with the same vocabulary.
+  std::uint64_t Fingerprint() const;
   bool empty() const { return idf_.empty(); }
 
   // Versioned binary file (vocabulary_file.cc): magic, version, parameters,
