@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # The paper's Tables II and III in the simulated village, three seeds each (BENCHMARKS.md):
-#   scripts/sim_study.sh [BIN [VOCABULARY [LOGS [OUT]]]]
+#   scripts/sim_study.sh [BIN [VOCABULARY [LOGS [OUT [TABLES]]]]]
 # simulates the logs into LOGS once (double loop and L-shape at 90°, inner loop at 45° and 90°), then
 # runs `detect` + `eval` per flight (Table II) and `map` + `eval` per experiment (Table III: the double
 # loop alone, then the inner loop and the L-shape each mapped after it), and prints one line per run.
+# TABLES ("2 3" by default) chooses which tables to run.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${1:-$root/build/tools/patrolmap}"
 vocabulary="${2:-$root/vocab/default.pmvoc}"
 logs="${3:-/tmp/patrolmap_sim_logs}"
 out="${4:-/tmp/patrolmap_sim_study}"
+tables="${5:-2 3}"
 mkdir -p "$logs" "$out"
 
 simulate() {  # NAME ROUTE MOUNT SEED
@@ -24,8 +26,8 @@ for seed in 1 2 3; do
   simulate "l-$seed" l-shape 90 "$seed"
 done
 
-echo "# Table II: key locations (nodes, expected, found, false, missed)"
-for name in double inner45 l; do
+[[ " $tables " == *" 2 "* ]] && echo "# Table II: key locations (nodes, expected, found, false, missed)"
+[[ " $tables " == *" 2 "* ]] && for name in double inner45 l; do
   for seed in 1 2 3; do
     run="$out/detect-$name-$seed"
     "$bin" --quiet detect "$logs/$name-$seed" --out "$run" >/dev/null
@@ -34,6 +36,7 @@ for name in double inner45 l; do
   done
 done
 
+[[ " $tables " == *" 3 "* ]] || exit 0
 echo "# Table III: loop closures (experiment 1: double loop; 2: + inner loop 90°; 3: + L-shape)"
 echo "# nodes possible found reported false precision recall"
 for seed in 1 2 3; do

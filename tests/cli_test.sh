@@ -101,4 +101,25 @@ expect "vocab build" 0 "words \(k=4, L=2\)" -- \
 expect "vocab build bad k" 1 "branching k must be in" -- \
   "$bin" vocab build "$source_dir/flight_logs/sample" -k 1 --out "$work/bad.pmvoc"
 
+# Real use: run from another folder with the shipped vocabulary found beside the binary's sources; a missing
+# log is named before anything else; a patrol with another vocabulary names both files.
+expect "map from another folder" 0 "1 log\(s\): 3 nodes" -- \
+  bash -c "cd '$work' && '$bin' map '$source_dir/flight_logs/sample' --out '$work/elsewhere'"
+expect "missing log first" 1 "$work/no_log: no such file or folder" -- \
+  "$bin" map "$work/no_log" --vocabulary "$work/nothing.pmvoc" --config "$work/nothing.yaml" --out "$work/m4"
+expect "vocabulary from the environment" 1 "small.pmvoc \(fingerprint" -- \
+  bash -c "PATROLMAP_VOCABULARY='$work/small.pmvoc' '$bin' patrol '$work/second' --map '$work/map/map.pmap' --out '$work/m5'"
+expect "patrol with another vocabulary" 1 "map.pmap was built with the vocabulary default.pmvoc .* not with $work/small.pmvoc" -- \
+  "$bin" patrol "$work/second" --map "$work/map/map.pmap" --vocabulary "$work/small.pmvoc" --out "$work/patrol3"
+mkdir -p "$work/kitti_like/image_0"
+for i in 0 1 2; do cp "$source_dir/flight_logs/sample/cam0/data/"$(ls "$source_dir/flight_logs/sample/cam0/data" | sed -n "$((i + 1))p") \
+  "$work/kitti_like/image_0/$(printf %06d $i).png"; done
+expect "folder without times warns" 0 "no timestamps, so its frames are taken as 30 Hz; give --fps" -- \
+  "$bin" detect "$work/kitti_like/image_0" --out "$work/kl"
+printf '0.0\n0.1\n0.2\n' > "$work/kitti_like/times.txt"
+expect "times.txt read, short log explained" 0 "lasts 0.2 s, less than twice the smoothing window" -- \
+  "$bin" detect "$work/kitti_like/image_0" --out "$work/kl"
+expect "bad option names key, value and range" 1 "flow.voting.max_votes = 300: must be an integer in \[3, 100\]" -- \
+  bash -c "printf 'flow:\n  voting:\n    max_votes: 300\n' > '$work/votes.yaml' && '$bin' detect '$source_dir/flight_logs/sample' --config '$work/votes.yaml' --out '$work/o'"
+
 finish cli

@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "patrolmap/core/checksum.h"
+
 #include "patrolmap/graph/export.h"
 #include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
@@ -196,10 +198,29 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
 }
 
 // A version 1 file (before patrol records): header version 1, three sections, no PTRL.
+// Rewrites the EDGE section of a saved map in the layout of format versions 1 and 2 (edge records without
+// log_nfa), with its checksum.
+void DowngradeEdges(std::string* bytes) {
+  const std::size_t tag = bytes->find("EDGE", 16);
+  ASSERT_NE(tag, std::string::npos);
+  std::uint64_t length = 0;
+  std::memcpy(&length, bytes->data() + tag + 4, 8);
+  const std::string payload = bytes->substr(tag + 20, length);
+  constexpr std::size_t kOld = 29, kNew = 37;  // a, b, kind, bow score, matched fraction, inliers (+ log_nfa)
+  std::string old = payload.substr(0, 4);
+  for (std::size_t at = 4; at + kNew <= payload.size(); at += kNew) old += payload.substr(at, kOld);
+  const std::uint64_t old_length = old.size(), checksum = Checksum(old.data(), old.size());
+  std::string section("EDGE", 4);
+  section.append(reinterpret_cast<const char*>(&old_length), 8);
+  section.append(reinterpret_cast<const char*>(&checksum), 8);
+  bytes->replace(tag, 20 + length, section + old);
+}
+
 TEST(MapFile, VersionOneFilesStillLoad) {
   testing::TempDir dir;
   ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
   std::string bytes = testing::ReadText(dir / "m.pmap");
+  ASSERT_NO_FATAL_FAILURE(DowngradeEdges(&bytes));
   const std::size_t ptrl = bytes.rfind("PTRL");
   ASSERT_NE(ptrl, std::string::npos);
   bytes.resize(ptrl);
@@ -209,7 +230,9 @@ TEST(MapFile, VersionOneFilesStillLoad) {
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v1.pmap", &map).ok()) << LoadMap(dir / "v1.pmap", &map).message();
   EXPECT_EQ(map.node_count(), 7);
+  EXPECT_EQ(map.loop_closure_count(), TwoFlights().loop_closure_count());
   EXPECT_TRUE(map.patrols().empty());
+  EXPECT_EQ(map.vocabulary().fingerprint, 0u);  // unknown: version 1 records no vocabulary
 }
 
 TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {
@@ -267,6 +290,25 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
+
+// A flight id written to close the page's script and run its own: every text format escapes it.
+TEST(Export, HostileFlightIdsAreEscapedInEveryTextFormat) {
+  TopoMap map = TwoFlights();
+  const std::string hostile = "x</script><img src=x onerror=alert(1)>&\xff";
+  for (int i = 0; i < map.node_count(); ++i) map.mutable_node(i).flight = hostile;
+  const std::string html = ToHtml(map);
+  EXPECT_EQ(html.find("<img src=x"), std::string::npos);
+  EXPECT_EQ(CountOf(html, "</script>"), 2u);  // the JSON element's and the script's own, no third
+  EXPECT_NE(html.find("x\\u003c/script\\u003e"), std::string::npos);
+  for (const std::string& text : {ToGraphML(map), ToSvg(map), ToKml(map)}) {
+    EXPECT_EQ(text.find("<img"), std::string::npos);
+    EXPECT_NE(text.find("x&lt;/script&gt;&lt;img"), std::string::npos);
+  }
+  const nlohmann::json json = nlohmann::json::parse(ToJson(map));  // invalid UTF-8 replaced, not thrown
+  EXPECT_EQ(json["nodes"].size(), 7u);
+  map.mutable_node(0).flight = "a\"b";
+  EXPECT_NE(ToDot(map).find("flight=\"a\\\"b\""), std::string::npos);  // DOT strings escape their quotes
+}
 
 TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
   const TopoMap map = TwoFlights();

@@ -72,6 +72,62 @@ TEST(ImageFolder, ReadsInNaturalOrderWithTimestampsFromRate) {
   EXPECT_EQ(frames[2].timestamp_ns, 200000000);
 }
 
+// A folder without times is read at the assumed rate and says so; one given a rate is timed.
+TEST(ImageFolder, WithoutTimesTheRateIsAssumedAndMarked) {
+  TempDir dir;
+  for (int i : {1, 2}) cv::imwrite(dir / (std::to_string(i) + ".png"), TestImage(i));
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {}, &source).ok());
+  EXPECT_FALSE(source->info().timed);
+  EXPECT_DOUBLE_EQ(source->info().frame_rate_hz, kAssumedFrameRateHz);
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0}, &source).ok());
+  EXPECT_TRUE(source->info().timed);
+  EXPECT_DOUBLE_EQ(source->info().frame_rate_hz, 10.0);
+}
+
+// TUM-style names in seconds with a fraction, and EuRoC-style integer nanoseconds, give times and a rate.
+TEST(ImageFolder, NumericFileNamesAreTimes) {
+  TempDir dir;
+  for (const char* name : {"1305031102.175304.png", "1305031102.275304.png", "1305031102.375304.png"}) {
+    cv::imwrite(dir / name, TestImage(1));
+  }
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {}, &source).ok());
+  EXPECT_TRUE(source->info().timed);
+  EXPECT_NEAR(source->info().frame_rate_hz, 10.0, 1e-6);
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[0].timestamp_ns, 0);
+  EXPECT_EQ(frames[2].timestamp_ns, 200000000);
+  TempDir ns;
+  for (long long t : {1403636579763555584LL, 1403636579813555456LL}) cv::imwrite(ns / (std::to_string(t) + ".png"), TestImage(1));
+  ASSERT_TRUE(OpenImageFolder(ns.path(), {}, &source).ok());
+  EXPECT_NEAR(source->info().frame_rate_hz, 20.0, 1e-3);
+  TempDir indices;  // zero-padded frame numbers are indices, not times
+  for (const char* name : {"000000.png", "000001.png"}) cv::imwrite(indices / name, TestImage(1));
+  ASSERT_TRUE(OpenImageFolder(indices.path(), {}, &source).ok());
+  EXPECT_FALSE(source->info().timed);
+}
+
+// KITTI keeps one time in seconds per image in times.txt beside the image folder.
+TEST(ImageFolder, KittiTimesFileInTheParentFolder) {
+  TempDir dir;
+  for (int i = 0; i < 3; ++i) cv::imwrite(dir / cv::format("image_0/%06d.png", i), TestImage(i));
+  std::filesystem::create_directories(dir / "image_0");
+  for (int i = 0; i < 3; ++i) cv::imwrite(dir / cv::format("image_0/%06d.png", i), TestImage(i));
+  WriteText(dir / "times.txt", "0.000000e+00\n1.036000e-01\n2.072000e-01\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir / "image_0", {}, &source).ok());
+  EXPECT_NEAR(source->info().frame_rate_hz, 1.0 / 0.1036, 1e-6);
+  WriteText(dir / "times.txt", "0.0\nsoon\n0.2\n");
+  const Status status = OpenImageFolder(dir / "image_0", {}, &source);
+  EXPECT_NE(status.message().find("times.txt:2: expected a time in seconds, got 'soon'"), std::string::npos)
+      << status.message();
+  WriteText(dir / "times.txt", "0.0\n0.1\n");
+  EXPECT_NE(OpenImageFolder(dir / "image_0", {}, &source).message().find("2 times for 3 images"), std::string::npos);
+}
+
 TEST(ImageFolder, EmptyAndMissingFoldersFailWithTheirName) {
   TempDir dir;
   std::unique_ptr<FrameSource> source;
@@ -93,6 +149,21 @@ TEST(ImagePattern, StartsAtZeroOrOneAndStopsAtTheFirstGap) {
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 3);
   EXPECT_EQ(OpenLog(dir / "g_%03d.png", {}, &source).code(), StatusCode::kNotFound);
+}
+
+// Patterns come from the user: anything but one integer conversion is refused, never passed to printf.
+TEST(ImagePattern, OnlyOneIntegerConversionIsAccepted) {
+  TempDir dir;
+  cv::imwrite(dir / "lit%1.png", TestImage(1));
+  std::unique_ptr<FrameSource> source;
+  for (const char* bad : {"f_%n.png", "f_%s.png", "lit%%.png", "f_%d_%d.png", "f_%999999d.png", "f_%"}) {
+    const Status status = OpenLog(dir / bad, {}, &source);
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument) << bad;
+    EXPECT_NE(status.message().find("not an image pattern"), std::string::npos) << status.message();
+  }
+  ASSERT_TRUE(OpenLog(dir / "lit%%%d.png", {}, &source).ok());  // %% is a percent sign
+  Status end;
+  EXPECT_EQ(ReadAll(source.get(), &end).size(), 1u);
 }
 
 TEST(Video, ReadsGreyFramesAndCountsThem) {
@@ -237,6 +308,47 @@ TEST(Euroc, SkippingDecodeReturnsEmptyImagesButKeepsOrder) {
   ASSERT_TRUE(source->Next(true, &frame).ok());
   EXPECT_EQ(frame.index, 1);
   EXPECT_EQ(frame.image.at<uchar>(0, 0), 20);
+}
+
+TEST(Euroc, SensorYamlOfTheWrongShapeIsRefusedNotThrown) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  std::unique_ptr<FrameSource> source;
+  for (const char* yaml : {"5\n", "- 1\n- 2\n", "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS: 5\n",
+                           "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS:\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, "
+                           "0, 0, 1, 0, 0, 0, 0, 1]\n"}) {
+    WriteText(log + "/cam0/sensor.yaml", yaml);
+    const Status status = OpenLog(log, {}, &source);
+    EXPECT_EQ(status.code(), StatusCode::kDataLoss) << yaml;
+    EXPECT_NE(status.message().find("sensor.yaml"), std::string::npos) << status.message();
+  }
+  std::filesystem::remove(log + "/cam0/sensor.yaml");
+  WriteText(log + "/meta.yaml", "just a scalar\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: expected a map"), std::string::npos);
+}
+
+TEST(Euroc, NonFiniteNumbersInTablesAreRefused) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 2);
+  WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az\n1000000000,0,0,nan,0,0,9.8\n");
+  std::unique_ptr<FrameSource> source;
+  Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("imu0/data.csv:2:"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("not a finite number"), std::string::npos) << status.message();
+  std::filesystem::remove(log + "/imu0/data.csv");
+  WriteText(log + "/gps0/data.csv", "#t,lat,lon,alt\n1000000000,1000,8,400\n");
+  status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("gps0/data.csv:2: latitude must lie in [-90, 90]"), std::string::npos)
+      << status.message();
+}
+
+TEST(FlightId, CharactersThatBreakTablesAreReplaced) {
+  EXPECT_EQ(CleanFlightId("x,y\nz\"w"), "x_y_z_w");
+  EXPECT_EQ(CleanFlightId(""), "flight");
+  EXPECT_EQ(CleanFlightId("x</script>"), "x</script>");  // HTML writers escape it
+  EXPECT_EQ(CleanFlightId(std::string(500, 'a')).size(), kMaxFlightIdLength);
 }
 
 TEST(Euroc, BadSensorYamlNamesTheFile) {

@@ -74,6 +74,40 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   }
 }
 
+// A run's warnings say why nothing was found and what to change.
+TEST(DetectionWarnings, ShortFlatAndUntimedLogsAreExplained) {
+  io::LogInfo info;
+  info.path = "log";
+  info.frame_rate_hz = 30.0;
+  DetectionResult result;
+  for (int i = 0; i < 300; ++i) {  // 50 s at 6 processed frames per second, a constant response
+    FlowSample sample;
+    sample.timestamp_ns = SecondsToNs(i / 6.0);
+    sample.accepted_vectors = 100;
+    sample.raw_response = sample.smoothed_response = 0.05;
+    result.samples.push_back(sample);
+  }
+  const flow::KeyLocationOptions options;
+  std::vector<std::string> warnings = DetectionWarnings(info, result, options);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("log: no key location: the smoothed response varies by 0, less than "
+                             "flow.extrema.min_change = 0.02"), std::string::npos) << warnings[0];
+  for (FlowSample& sample : result.samples) sample.accepted_vectors = 0;
+  warnings = DetectionWarnings(info, result, options);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("no flow vector was accepted"), std::string::npos) << warnings[0];
+  result.samples.resize(20);  // 3.2 s
+  info.timed = false;
+  warnings = DetectionWarnings(info, result, options);
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_NE(warnings[0].find("log: the log has no timestamps, so its frames are taken as 30 Hz"), std::string::npos);
+  EXPECT_NE(warnings[1].find("log: the log lasts 3.17 s, less than twice the smoothing window"), std::string::npos)
+      << warnings[1];
+  EXPECT_NE(warnings[2].find("too short for the smoothing window"), std::string::npos) << warnings[2];
+  result.key_locations.push_back(KeyLocation{});
+  EXPECT_EQ(DetectionWarnings(info, result, options).size(), 2u);  // found one: only the two log warnings
+}
+
 TEST(Config, DefaultFileMirrorsTheOptionsStructsOneToOne) {
   Config loaded;
   loaded.flow.voting.accept = 99;  // must be overwritten by the file

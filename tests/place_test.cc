@@ -181,3 +181,59 @@ TEST(PlaceRecognizer, TopologicallyImplausibleCandidatesAreRejected) {
 
 }  // namespace
 }  // namespace patrolmap::place
+
+namespace patrolmap::place {
+namespace {
+
+// Correspondences of a known two-view geometry: points on a fronto-parallel plane shifted sideways, so
+// x2 = x1 + (d, 0) and F fixes only the rows (y2 = y1).
+void ShiftedPoints(int count, double shift, cv::RNG* rng, std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+  for (int i = 0; i < count; ++i) {
+    const cv::Point2f p(static_cast<float>(rng->uniform(10.0, 630.0)), static_cast<float>(rng->uniform(10.0, 470.0)));
+    from->push_back(p);
+    to->push_back(p + cv::Point2f(static_cast<float>(shift), 0.0f));
+  }
+}
+
+// The a-contrario test (ORSA): a geometry many matches obey exactly is meaningful (log NFA far below 0),
+// random matches are not (above 0), and the same geometry with its error scaled with the image keeps its
+// verdict at any resolution.
+TEST(LogNumberOfFalseAlarms, ExactGeometryIsMeaningfulAndRandomMatchesAreNot) {
+  const cv::Matx33d horizontal_shift(0, 0, 0, 0, 0, -1, 0, 1, 0);  // x2^T F x1 = y1 - y2
+  const FeatureExtent vga{640.0 * 480.0, 800.0};
+  cv::RNG rng(7);
+  std::vector<cv::Point2f> from, to;
+  ShiftedPoints(60, 25.0, &rng, &from, &to);
+  for (cv::Point2f& p : to) p.y += static_cast<float>(rng.gaussian(0.3));  // sub-pixel noise
+  const double exact = LogNumberOfFalseAlarms(horizontal_shift, from, to, vga, vga);
+  EXPECT_LT(exact, -100.0);
+  std::vector<cv::Point2f> random_to;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    random_to.emplace_back(static_cast<float>(rng.uniform(0.0, 640.0)), static_cast<float>(rng.uniform(0.0, 480.0)));
+  }
+  EXPECT_GT(LogNumberOfFalseAlarms(horizontal_shift, from, random_to, vga, vga), 0.0);
+  // Twice the resolution, twice the error in pixels: the same probability per match, the same NFA.
+  std::vector<cv::Point2f> big_from, big_to;
+  for (std::size_t i = 0; i < from.size(); ++i) big_from.push_back(from[i] * 2.0f), big_to.push_back(to[i] * 2.0f);
+  const FeatureExtent big{4.0 * vga.area, 2.0 * vga.diagonal};
+  EXPECT_NEAR(LogNumberOfFalseAlarms(horizontal_shift, big_from, big_to, big, big), exact, 1e-6);
+  // Too few matches to say anything: 0.
+  EXPECT_EQ(LogNumberOfFalseAlarms(horizontal_shift, {from.begin(), from.begin() + 8}, {to.begin(), to.begin() + 8},
+                                   vga, vga),
+            0.0);
+}
+
+TEST(PlaceOptions, OutOfRangeValuesNameKeyValueAndRule) {
+  PlaceOptions options;
+  std::string error;
+  options.max_log_nfa = std::nan("");
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_EQ(error, "place.max_log_nfa = nan: must be a number in [-1000, 1000]");
+  options = PlaceOptions();
+  options.min_inliers = 7;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_EQ(error, "place.min_inliers = 7: must be an integer in [8, 100000]");
+}
+
+}  // namespace
+}  // namespace patrolmap::place

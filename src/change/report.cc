@@ -182,7 +182,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map) {
       {"places", places},
       {"objects", report.objects_compared ? objects : json(nullptr)},
       {"geometry", report.geometry_compared ? GeometryJson(report.geometry) : json(nullptr)}};
-  return document.dump(1) + "\n";
+  return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {

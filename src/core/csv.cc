@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -70,6 +71,7 @@ Status CsvReader::ParseDouble(std::string_view field, const char* column, double
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE) {
     return Error(std::string("column '") + column + "': not a number: '" + text + "'");
   }
+  if (!std::isfinite(*value)) return Error(std::string("column '") + column + "': not a finite number: '" + text + "'");
   return Status::Ok();
 }
 

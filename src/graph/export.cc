@@ -148,7 +148,7 @@ std::string ToJson(const TopoMap& map) {
                                    {"graph", {{"schema", "patrolmap.map/1"}, {"flights", map.Flights()}}},
                                    {"nodes", nodes},
                                    {"links", links}};
-  return document.dump(1) + "\n";
+  return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 bool HasGps(const TopoMap& map) {
@@ -201,7 +201,8 @@ std::string ToGeoJson(const TopoMap& map) {
                         {"properties", {{"kind", "loop_closure"}, {"query_node", e.a}, {"matched_node", e.b},
                                         {"inliers", e.data.inliers}}}});
   }
-  return nlohmann::json({{"type", "FeatureCollection"}, {"features", features}}).dump(1) + "\n";
+  return nlohmann::json({{"type", "FeatureCollection"}, {"features", features}})
+             .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string ToKml(const TopoMap& map) {
@@ -283,6 +284,21 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
 namespace {
 
 
+// JSON to embed in an HTML <script> element: '<', '>' and '&' become their JSON escapes (\u003c ...), so no
+// string from a log can end the element early (a flight id "x</script><img ...>").
+std::string JsonForScript(const nlohmann::json& value) {
+  const std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
+  }
+  return out;
+}
+
 nlohmann::json NodeDetails(const TopoMap& map) {
   nlohmann::json nodes = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
@@ -345,7 +361,7 @@ std::string ToHtml(const TopoMap& map, const SvgTruth* truth) {
       << "<div id='map'>" << svg << "</div>\n<div id='side'><h3>patrolmap</h3><p>" << map.node_count() << " nodes, "
       << map.loop_closure_count() << " loop closures, " << map.Flights().size()
       << " flight(s). Drag to pan, wheel to zoom, click a node.</p><p id='title'></p><img id='thumb' alt=''>"
-      << "<p id='closures'></p></div>\n<script type='application/json' id='nodes'>" << NodeDetails(map).dump()
+      << "<p id='closures'></p></div>\n<script type='application/json' id='nodes'>" << JsonForScript(NodeDetails(map))
       << "</script>\n<script>" << kPageScript << "</script>\n</body></html>\n";
   return out.str();
 }

@@ -125,6 +125,7 @@ std::string EdgeSection(const TopoMap& map) {
     w.Value(e.data.bow_score);
     w.Value(e.data.matched_fraction);
     w.Value(static_cast<std::int32_t>(e.data.inliers));
+    w.Value(e.data.log_nfa);
   }
   return std::move(w.bytes());
 }
@@ -215,6 +216,14 @@ Status Corrupt(const std::string& path, const std::string& what) {
   return Status::DataLoss(path + ": corrupt map (" + what + ")");
 }
 
+// Flight ids as readers keep them (io::CleanFlightId): no control characters, commas or double quotes.
+bool ValidFlightId(const std::string& id) {
+  return !id.empty() && id.size() <= 1000 && std::none_of(id.begin(), id.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u < 0x20 || u == 0x7f || c == ',' || c == '"';
+  });
+}
+
 Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
@@ -229,12 +238,13 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
     if (has_gps) n.gps = Eigen::Vector2d(v[0], v[1]);
     n.layout = Eigen::Vector2d(v[2], v[3]);
     n.heading = v[4];
+    if (!ValidFlightId(n.flight)) return Corrupt(path, "flight id of node " + std::to_string(i));
     map->AddNode(std::move(n));
   }
   return r->failed() || !r->done() ? Corrupt(path, "node section") : Status::Ok();
 }
 
-Status ParseEdges(const std::string& path, Reader* r, TopoMap* map) {
+Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
     const auto a = r->Value<std::uint32_t>(), b = r->Value<std::uint32_t>();
@@ -243,6 +253,7 @@ Status ParseEdges(const std::string& path, Reader* r, TopoMap* map) {
     e.bow_score = r->Value<double>();
     e.matched_fraction = r->Value<double>();
     e.inliers = r->Value<std::int32_t>();
+    if (version >= 3) e.log_nfa = r->Value<double>();
     if (r->failed()) break;
     if (kind > 1 || a >= static_cast<std::uint32_t>(map->node_count()) ||
         b >= static_cast<std::uint32_t>(map->node_count()) || (kind == 1 && a == b)) {
@@ -341,8 +352,8 @@ struct SectionsSeen {
   bool nodes = false, edges = false, features = false, patrols = false, vocabulary = false;
 };
 
-Status ParseSection(const std::string& path, const std::string& tag, const char* payload, std::size_t length,
-                    TopoMap* map, SectionsSeen* seen) {
+Status ParseSection(const std::string& path, std::uint32_t version, const std::string& tag, const char* payload,
+                    std::size_t length, TopoMap* map, SectionsSeen* seen) {
   Reader reader(payload, length);
   const auto once = [&](bool* flag) {
     const bool first = !*flag;
@@ -350,7 +361,7 @@ Status ParseSection(const std::string& path, const std::string& tag, const char*
     return first;
   };
   if (tag == "NODE" && once(&seen->nodes)) return ParseNodes(path, &reader, map);
-  if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, &reader, map);
+  if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, version, &reader, map);
   if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, &reader, map);
   if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, &reader, map);
   if (tag == "VOCB" && once(&seen->vocabulary)) return ParseVocabulary(path, &reader, map);
@@ -401,7 +412,7 @@ Status LoadMap(const std::string& path, TopoMap* map) {
     if (length > size - position) return Status::DataLoss(path + ": truncated map (section " + tag + ")");
     const char* payload = bytes.data() + position;
     if (Checksum(payload, length) != checksum) return Corrupt(path, "checksum of section " + tag);
-    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, tag, payload, length, map, &seen));
+    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, header[0], tag, payload, length, map, &seen));
     position += length;
   }
   if (!seen.nodes || !seen.edges) return Corrupt(path, "node or edge section missing");

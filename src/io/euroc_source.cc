@@ -67,8 +67,12 @@ Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* 
 Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen::Matrix3d* rotation) {
   rotation->setIdentity();
   if (!root["T_BS"]) return Status::Ok();
+  if (!root["T_BS"].IsMap()) return Status::DataLoss(path + ": 'T_BS' must be a map with 'data'");
   std::vector<double> data;
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["T_BS"]["data"], "T_BS.data", 16, &data));
+  if (!std::all_of(data.begin(), data.end(), [](double v) { return std::isfinite(v); })) {
+    return Status::DataLoss(path + ": 'T_BS.data' holds a value that is not a finite number");
+  }
   for (int row = 0; row < 3; ++row) {
     for (int col = 0; col < 3; ++col) (*rotation)(row, col) = data[row * 4 + col];
   }
@@ -77,7 +81,7 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
 
 Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d* body_from_camera) {
   YAML::Node root;
-  PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(path, &root));
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
   std::vector<double> intrinsics, resolution;
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
@@ -91,8 +95,8 @@ Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d*
 
 Status ReadMeta(const std::string& path, LogInfo* info) {
   YAML::Node root;
-  PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(path, &root));
-  if (root["flight_id"]) info->flight_id = root["flight_id"].as<std::string>("");
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
+  if (root["flight_id"]) info->flight_id = CleanFlightId(root["flight_id"].as<std::string>(""));
   if (root["frame_rate_hz"]) info->frame_rate_hz = root["frame_rate_hz"].as<double>(0.0);
   return Status::Ok();
 }
@@ -111,7 +115,7 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
     Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();
     if (fs::exists(log + "/imu0/sensor.yaml")) {
       YAML::Node root;
-      PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(log + "/imu0/sensor.yaml", &root));
+      PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(log + "/imu0/sensor.yaml", &root));
       PATROLMAP_RETURN_IF_ERROR(ReadBodyFromSensor(log + "/imu0/sensor.yaml", root, &body_from_imu));
     }
     if (has_camera_yaml) info->camera_from_imu = body_from_camera.transpose() * body_from_imu;
@@ -124,7 +128,11 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
 // gps0/data.csv: timestamp, latitude [deg], longitude [deg], altitude [m].
 Status ReadGpsTable(const std::string& path, std::vector<GpsSample>* samples) {
   const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, GpsSample* sample) {
-    return ParseVector(csv, fields, 1, "latitude, longitude, altitude", &sample->position);
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "latitude, longitude, altitude", &sample->position));
+    if (std::abs(sample->position.x()) > 90.0 || std::abs(sample->position.y()) > 180.0) {
+      return csv.Error("latitude must lie in [-90, 90] and longitude in [-180, 180] degrees");
+    }
+    return Status::Ok();
   };
   return ReadTimedTable(path, 4, parse, samples);
 }
@@ -139,6 +147,7 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   info.kind = "euroc";
   info.flight_id = fs::path(folder).lexically_normal().filename().string();
   if (info.flight_id.empty()) info.flight_id = fs::path(folder).parent_path().filename().string();
+  info.flight_id = CleanFlightId(info.flight_id);
   std::vector<ImageEntry> entries;
   std::vector<ImuSample> imu;
   std::vector<SpeedSample> speeds;

@@ -4,25 +4,34 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 namespace fs = std::filesystem;
 
 namespace patrolmap::io {
 namespace {
 
-// Seconds in a decimal time with a fraction, or in a long integer by its size.
-bool ParseTime(const std::string& text, double* seconds) {
-  if (text.empty() || text.size() > 24 || std::count(text.begin(), text.end(), '.') > 1) return false;
+// The time a file stem names, exactly in nanoseconds: decimal seconds with a fraction, or an integer of
+// at least 10 digits read as seconds, milliseconds, microseconds or nanoseconds by its length.
+bool ParseTime(const std::string& text, TimestampNs* ns) {
   const std::size_t dot = text.find('.');
-  const std::string digits = dot == std::string::npos ? text : text.substr(0, dot) + text.substr(dot + 1);
-  if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) {
-    return false;
+  const std::string whole = text.substr(0, dot);
+  const std::string fraction = dot == std::string::npos ? "" : text.substr(dot + 1);
+  const auto digits = [](const std::string& part) {
+    return std::all_of(part.begin(), part.end(), [](unsigned char c) { return std::isdigit(c); });
+  };
+  if (whole.empty() || whole.size() > 19 || !digits(whole) || !digits(fraction)) return false;
+  if (dot != std::string::npos) {
+    if (fraction.empty() || whole.size() > 11) return false;
+    const std::string nanos = (fraction + "000000000").substr(0, 9);
+    *ns = std::stoll(whole) * 1000000000LL + std::stoll(nanos);
+    return true;
   }
-  const double value = std::stod(text);
-  if (dot != std::string::npos) return *seconds = value, true;
-  if (text.size() < 10 || text[0] == '0') return false;  // frame numbers such as 000123, not times
-  const double divisor = text.size() >= 18 ? 1e9 : text.size() >= 15 ? 1e6 : text.size() >= 12 ? 1e3 : 1.0;
-  *seconds = value / divisor;
+  if (whole.size() < 10 || whole[0] == '0') return false;  // frame numbers such as 000123, not times
+  const long long value = std::stoll(whole);
+  const long long factor = whole.size() >= 18 ? 1 : whole.size() >= 15 ? 1000 : whole.size() >= 12 ? 1000000 : 1000000000;
+  if (factor > 1 && value > std::numeric_limits<long long>::max() / factor) return false;
+  *ns = value * factor;
   return true;
 }
 
@@ -56,9 +65,9 @@ Status ReadTimesFile(const std::string& path, std::size_t expected, std::vector<
 
 bool TimesFromNames(const std::vector<std::string>& paths, std::vector<TimestampNs>* times) {
   for (const std::string& path : paths) {
-    double seconds = 0.0;
-    if (!ParseTime(fs::path(path).stem().string(), &seconds)) return false;
-    times->push_back(SecondsToNs(seconds));
+    TimestampNs ns = 0;
+    if (!ParseTime(fs::path(path).stem().string(), &ns)) return false;
+    times->push_back(ns);
   }
   return Increasing(*times);
 }

@@ -159,7 +159,7 @@ LogInfo MakeInfo(const std::string& path, const char* kind, double frame_rate_hz
   LogInfo info;
   info.path = path;
   info.kind = kind;
-  info.flight_id = fs::path(path).lexically_normal().filename().string();
+  info.flight_id = CleanFlightId(fs::path(path).lexically_normal().filename().string());
   info.frame_rate_hz = frame_rate_hz;
   return info;
 }

@@ -23,7 +23,7 @@ Status ReadPoseTable(const std::string& path, const Eigen::Matrix3d& body_from_c
     double q[4];
     for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[4 + i], "q_RS", &q[i]));
     const Eigen::Quaterniond body(q[0], q[1], q[2], q[3]);
-    if (std::abs(body.norm() - 1.0) > 1e-3) return csv.Error("q_RS is not a unit quaternion");
+    if (!(std::abs(body.norm() - 1.0) <= 1e-3)) return csv.Error("q_RS is not a unit quaternion");
     pose->rotation = (body.normalized() * camera_rotation).normalized();
     return Status::Ok();
   };

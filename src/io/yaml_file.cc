@@ -22,4 +22,11 @@ Status LoadYamlFile(const std::string& path, YAML::Node* root) {
   return Status::Ok();
 }
 
+Status LoadYamlMap(const std::string& path, YAML::Node* root) {
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlFile(path, root));
+  if (root->IsNull()) *root = YAML::Node(YAML::NodeType::Map);  // an empty file: no keys
+  if (!root->IsMap()) return Status::DataLoss(path + ": expected a map of keys at the top level");
+  return Status::Ok();
+}
+
 }  // namespace patrolmap::io

@@ -154,7 +154,7 @@ graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognize
   for (const MapLoopClosure& closure : result.loop_closures) {
     const place::Verification& v = closure.verification;
     map.AddEdge(closure.query_node, closure.matched_node,
-                {graph::EdgeKind::kLoopClosure, v.bow_score, v.matched_fraction, v.inliers});
+                {graph::EdgeKind::kLoopClosure, v.bow_score, v.matched_fraction, v.inliers, v.log_nfa});
   }
   return map;
 }
@@ -167,13 +167,13 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
     const graph::NodeData& n = map.node(i);
     nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.keypoints.size() << "\n";
   }
-  closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers\n";
+  closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers,log_nfa\n";
   char line[256];
   for (const graph::TopoMap::Edge& e : map.Edges()) {
     if (e.data.kind != graph::EdgeKind::kLoopClosure) continue;
-    std::snprintf(line, sizeof(line), "%d,%d,%lld,%lld,%.4f,%.4f,%d\n", e.a, e.b,
+    std::snprintf(line, sizeof(line), "%d,%d,%lld,%lld,%.4f,%.4f,%d,%.1f\n", e.a, e.b,
                   static_cast<long long>(map.node(e.a).frame_index), static_cast<long long>(map.node(e.b).frame_index),
-                  e.data.bow_score, e.data.matched_fraction, e.data.inliers);
+                  e.data.bow_score, e.data.matched_fraction, e.data.inliers, e.data.log_nfa);
     closures << line;
   }
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/nodes.csv", nodes.str()));

@@ -1,8 +1,12 @@
 // patrolmap vocab build INPUTS... --out FILE [-k K] [-L L] [--every N] [--seed S]
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "commands.h"
@@ -22,6 +26,32 @@ struct VocabArguments {
   int every = 15;
   vocab::VocabularyOptions options;
 };
+
+// Photographs given one by one (any size) are described at this width, about that of key frames at the
+// flow stage's scale [pixels].
+constexpr int kPhotoWidth = 640;
+
+bool IsPhotograph(const std::string& input) {
+  static const std::vector<std::string> kExtensions = {".jpg", ".jpeg", ".png", ".webp", ".bmp", ".tif", ".tiff"};
+  std::string extension = std::filesystem::path(input).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return std::filesystem::is_regular_file(input) &&
+         std::find(kExtensions.begin(), kExtensions.end(), extension) != kExtensions.end();
+}
+
+// Features of one photograph at kPhotoWidth.
+Status CollectPhotograph(const std::string& input, const pipeline::Config& config, std::vector<cv::Mat>* images) {
+  const cv::Mat image = cv::imread(input, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) return Status::DataLoss(input + ": not an image OpenCV can read");
+  cv::Mat small;
+  const double scale = static_cast<double>(kPhotoWidth) / image.cols;
+  cv::resize(image, small, cv::Size(), scale, scale, scale < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+  images->push_back(descriptors);
+  return Status::Ok();
+}
 
 // Features of every `every`-th frame of a log, at the flow stage's scale.
 Status CollectFeatures(const std::string& input, const VocabArguments& arguments, const pipeline::Config& config,
@@ -51,7 +81,9 @@ int RunBuild(const VocabArguments& arguments) {
   Status status = LoadCheckedConfig(arguments.config, &config);
   std::vector<cv::Mat> images;
   for (std::size_t i = 0; status.ok() && i < arguments.inputs.size(); ++i) {
-    status = CollectFeatures(arguments.inputs[i], arguments, config, &images);
+    const std::string& input = arguments.inputs[i];
+    status = IsPhotograph(input) ? CollectPhotograph(input, config, &images)
+                                 : CollectFeatures(input, arguments, config, &images);
   }
   std::size_t descriptors = 0;
   for (const cv::Mat& image : images) descriptors += image.rows;
@@ -74,7 +106,10 @@ Command AddVocabCommand(CLI::App* app) {
   auto arguments = std::make_shared<VocabArguments>();
   app->require_subcommand(1);
   CLI::App* build = app->add_subcommand("build", "train a vocabulary tree on the SIFT features of logs or image folders");
-  build->add_option("inputs", arguments->inputs, "logs, image folders, patterns or videos")->required();
+  build->add_option("inputs", arguments->inputs,
+                    "logs, image folders, patterns or videos (every n-th frame), or single photographs (each "
+                    "described at " + std::to_string(kPhotoWidth) + " pixels wide)")
+      ->required();
   build->add_option("-o,--out", arguments->out, "vocabulary file to write")->required();
   build->add_option("-c,--config", arguments->config, "YAML configuration (features: place.*, scale: flow.frames.scale)");
   build->add_option("-k,--branching", arguments->options.branching, "children per node")->capture_default_str();

@@ -40,6 +40,7 @@ struct EdgeData {
   double bow_score = 0.0;        // loop closures: verification scores
   double matched_fraction = 0.0;
   int inliers = 0;
+  double log_nfa = 0.0;          // a-contrario number of false alarms, log10 (map format 3 on; 0 before)
 };
 
 class TopoMap {

@@ -14,6 +14,14 @@
 
 namespace patrolmap::io {
 
+// Longest flight id kept [bytes].
+constexpr std::size_t kMaxFlightIdLength = 200;
+
+// A flight id as the map and its tables keep it: control characters, commas and double quotes (which
+// would break a CSV row) become '_', at most kMaxFlightIdLength bytes, never empty; a warning names any
+// change. HTML, XML and JSON writers escape the rest.
+std::string CleanFlightId(const std::string& raw);
+
 // What a reader knows about a log before reading frames.
 struct LogInfo {
   std::string path;

@@ -13,4 +13,8 @@ namespace patrolmap::io {
 // sensor.yaml files, and not valid YAML) is ignored.
 Status LoadYamlFile(const std::string& path, YAML::Node* root);
 
+// As LoadYamlFile, for files that must hold a map of keys (sensor.yaml, meta.yaml): anything else at the
+// top level fails naming the file; an empty file is an empty map.
+Status LoadYamlMap(const std::string& path, YAML::Node* root);
+
 }  // namespace patrolmap::io

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Rebuilds the shipped vocabulary (vocab/default.pmvoc) reproducibly, as vocab/README.md describes:
+#   scripts/build_vocabulary.sh [OUT]
+# Installs the Debian packages whose photographs it trains on, simulates two training flights through
+# villages that evaluation never uses, and runs `patrolmap vocab build` over both.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:-$root/vocab/default.pmvoc}"
+bin="$root/build/tools/patrolmap"
+work="${TMPDIR:-/tmp}/patrolmap_vocabulary"
+packages=(mate-backgrounds lomiri-wallpapers-16.04 opencv-doc)
+missing=()
+for package in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if ((${#missing[@]})); then
+  sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+mkdir -p "$work"
+[[ -f "$work/inner101/cam0/data.csv" ]] || "$bin" --quiet simulate --route inner-loop --seed 101 --out "$work/inner101"
+[[ -f "$work/l102/cam0/data.csv" ]] || "$bin" --quiet simulate --route l-shape --seed 102 --out "$work/l102"
+
+# Photographs (vocab/README.md credits each): nature photographs of MATE's backgrounds, the photographs
+# of Ubuntu's 16.04 wallpaper contest, and the photographs among OpenCV's sample data. The image pairs
+# that evaluation uses (aero, graf, leuven, aloe) are left out.
+mate=/usr/share/backgrounds/mate/nature
+photos=(
+  "$mate"/{Aqua,Blinds,Dune,FreshFlower,Garden,GreenMeadow,LadyBird,RainDrops,Storm,TwoWings,Wood,YellowFlower}.jpg
+  /usr/share/backgrounds/{Bridge_by_Sander_Klootwijk,Dragonfly_by_Bolly,Kleiber_by_Lukas_Baubkus}.jpg
+  /usr/share/backgrounds/{Picture_0B_by_freespace,Picture_1A_by_freespace,Wine_by_Jakkub_Mede}.jpg
+  /usr/share/backgrounds/{aitzgorri,friends,life,picosdeeuropa,sunset}_by_Aitzol_Berasategi.jpg
+  /usr/share/backgrounds/{free,greentock}_by_Peter_Nerlich.jpg
+  /usr/share/backgrounds/seeding_by_Clements_Engelhardt.jpg
+)
+opencv=/usr/share/doc/opencv-doc/examples/data
+for name in building.jpg home.jpg box.png box_in_scene.png stuff.jpg fruits.jpg baboon.jpg messi5.jpg \
+    butterfly.jpg orange.jpg apple.jpg basketball1.png squirrel_cls.jpg HappyFish.jpg licenseplate_motion.jpg \
+    rubberwhale1.png smarties.png; do
+  photos+=("$opencv/$name")
+done
+"$bin" vocab build "$work/inner101" "$work/l102" "${photos[@]}" -k 10 -L 4 --seed 1 --out "$out"
