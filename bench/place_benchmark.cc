@@ -84,6 +84,24 @@ void BM_KeyFrameVerification(benchmark::State& state) {
 }
 BENCHMARK(BM_KeyFrameVerification)->Arg(376)->Arg(752)->Unit(benchmark::kMillisecond);
 
+// The a-contrario test alone, for 300 matches of which 250 obey the geometry.
+void BM_LogNumberOfFalseAlarms(benchmark::State& state) {
+  const cv::Matx33d horizontal_shift(0, 0, 0, 0, 0, -1, 0, 1, 0);
+  cv::RNG rng(3);
+  std::vector<cv::Point2f> from, to;
+  for (int i = 0; i < 300; ++i) {
+    const cv::Point2f p(static_cast<float>(rng.uniform(0.0, 376.0)), static_cast<float>(rng.uniform(0.0, 240.0)));
+    from.push_back(p);
+    to.push_back(i < 250 ? p + cv::Point2f(10.0f, static_cast<float>(rng.gaussian(0.5)))
+                         : cv::Point2f(static_cast<float>(rng.uniform(0.0, 376.0)), static_cast<float>(rng.uniform(0.0, 240.0))));
+  }
+  const place::FeatureExtent extent{376.0 * 240.0, 446.0};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(place::LogNumberOfFalseAlarms(horizontal_shift, from, to, extent, extent));
+  }
+}
+BENCHMARK(BM_LogNumberOfFalseAlarms)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();
