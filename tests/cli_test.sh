@@ -111,6 +111,17 @@ expect "vocabulary from the environment" 1 "small.pmvoc \(fingerprint" -- \
   bash -c "PATROLMAP_VOCABULARY='$work/small.pmvoc' '$bin' patrol '$work/second' --map '$work/map/map.pmap' --out '$work/m5'"
 expect "patrol with another vocabulary" 1 "map.pmap was built with the vocabulary default.pmvoc .* not with $work/small.pmvoc" -- \
   "$bin" patrol "$work/second" --map "$work/map/map.pmap" --vocabulary "$work/small.pmvoc" --out "$work/patrol3"
+# Outputs never destroy inputs; a killed run's temporary is cleaned up by the next one.
+cp "$work/map/map.pmap" "$work/keep.pmap"
+expect "export over its map" 1 "keep.pmap would replace .*keep.pmap \(the map\)" -- \
+  "$bin" export "$work/keep.pmap" --format json --out "$work/./keep.pmap"
+check "map untouched by the refused export" cmp -s "$work/map/map.pmap" "$work/keep.pmap"
+expect "patrol into the prior's folder" 1 "would replace .*map.pmap \(the prior map\)" -- \
+  "$bin" patrol "$work/second" --map "$work/map/map.pmap" --out "$work/map"
+check "prior untouched by the refused patrol" cmp -s "$work/map/map.pmap" "$work/keep.pmap"
+touch "$work/elsewhere/map.pmap.tmp.999999999"
+"$bin" -q map "$source_dir/flight_logs/sample" --out "$work/elsewhere" >/dev/null
+check "stale temporary removed" test ! -e "$work/elsewhere/map.pmap.tmp.999999999"
 mkdir -p "$work/kitti_like/image_0"
 for i in 0 1 2; do cp "$source_dir/flight_logs/sample/cam0/data/"$(ls "$source_dir/flight_logs/sample/cam0/data" | sed -n "$((i + 1))p") \
   "$work/kitti_like/image_0/$(printf %06d $i).png"; done

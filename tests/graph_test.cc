@@ -2,6 +2,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -195,6 +196,31 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
             std::string::npos);
   TopoMap map;
   EXPECT_EQ(LoadMap(dir_ / "missing.pmap", &map).code(), StatusCode::kNotFound);
+}
+
+// Files with good checksums whose content no patrolmap writes: each is refused naming what is wrong.
+TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
+  const auto refused = [this](const TopoMap& map, const std::string& what) {
+    EXPECT_TRUE(SaveMap(map, dir_ / "bad.pmap").ok());
+    const std::string message = LoadBytes(testing::ReadText(dir_ / "bad.pmap"));
+    EXPECT_NE(message.find("x.pmap: corrupt map (" + what), std::string::npos) << message;
+  };
+  TopoMap narrow = TwoFlights();
+  narrow.mutable_node(2).descriptors = cv::Mat(5, 32, CV_32FC1, cv::Scalar(0.5));
+  refused(narrow, "features of node 2");
+  TopoMap blank = TwoFlights();
+  blank.mutable_node(1).thumbnail = cv::Mat();
+  refused(blank, "thumbnail of node 1");
+  TopoMap newline = TwoFlights();
+  newline.mutable_node(0).flight = "a,\nb";
+  refused(newline, "flight id of node 0");
+  TopoMap nan_weight = TwoFlights();
+  nan_weight.mutable_node(3).bow.weights[0] = std::nanf("");
+  refused(nan_weight, "features of node 3");
+  std::string version_zero = bytes_;
+  const std::uint32_t zero = 0;
+  std::memcpy(version_zero.data() + 8, &zero, 4);
+  EXPECT_NE(LoadBytes(version_zero).find("version 0 is not one patrolmap wrote"), std::string::npos);
 }
 
 // A version 1 file (before patrol records): header version 1, three sections, no PTRL.

@@ -1,6 +1,7 @@
 #include "patrolmap/graph/map_file.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@ namespace {
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 constexpr std::uint32_t kVersion = 3;  // 2: PTRL section (patrol records); 3: VOCB section (vocabulary)
 constexpr std::uint32_t kOldestVersion = 1;
+constexpr int kDescriptorWidth = 128;  // SIFT
 
 class Writer {
  public:
@@ -63,10 +65,12 @@ class Reader {
   cv::Mat Mat() {
     const int type = Value<std::int32_t>(), rows = Value<std::int32_t>(), cols = Value<std::int32_t>();
     if (failed_ || rows < 0 || cols < 0 || (type != CV_8UC1 && type != CV_32FC1)) return Fail(), cv::Mat();
+    // The bytes must be in the file before anything is allocated (a header may claim 2^31 x 2^31).
+    const std::size_t bytes = static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols) * (type == CV_8UC1 ? 1 : 4);
+    if (bytes > size_ - position_) return Fail(), cv::Mat();
     cv::Mat mat(rows, cols, type);
-    const std::size_t bytes = mat.total() * mat.elemSize();
     if (!Take(bytes)) return cv::Mat();
-    std::memcpy(mat.data, data_ + position_ - bytes, bytes);
+    if (bytes > 0) std::memcpy(mat.data, data_ + position_ - bytes, bytes);
     return mat;
   }
   template <typename T>
@@ -74,7 +78,7 @@ class Reader {
     const std::uint32_t count = Value<std::uint32_t>();
     if (!Take(static_cast<std::size_t>(count) * sizeof(T))) return {};
     std::vector<T> values(count);
-    std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
+    if (count > 0) std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
     return values;
   }
   bool failed() const { return failed_; }
@@ -239,6 +243,10 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
     n.layout = Eigen::Vector2d(v[2], v[3]);
     n.heading = v[4];
     if (!ValidFlightId(n.flight)) return Corrupt(path, "flight id of node " + std::to_string(i));
+    if (!r->failed() && (n.thumbnail.empty() || n.thumbnail.type() != CV_8UC1 || n.thumbnail.cols > 4096 ||
+                         n.thumbnail.rows > 4096)) {
+      return Corrupt(path, "thumbnail of node " + std::to_string(i));
+    }
     map->AddNode(std::move(n));
   }
   return r->failed() || !r->done() ? Corrupt(path, "node section") : Status::Ok();
@@ -256,7 +264,7 @@ Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, Top
     if (version >= 3) e.log_nfa = r->Value<double>();
     if (r->failed()) break;
     if (kind > 1 || a >= static_cast<std::uint32_t>(map->node_count()) ||
-        b >= static_cast<std::uint32_t>(map->node_count()) || (kind == 1 && a == b)) {
+        b >= static_cast<std::uint32_t>(map->node_count()) || a == b) {
       return Corrupt(path, "edge " + std::to_string(i));
     }
     e.kind = static_cast<EdgeKind>(kind);
@@ -276,7 +284,9 @@ Status ParseFeatures(const std::string& path, Reader* r, TopoMap* map) {
     n.bow.words = r->Vector<vocab::WordId>();
     n.bow.weights = r->Vector<float>();
     if (n.bow.words.size() != n.bow.weights.size() ||
-        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.keypoints.size())) {
+        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.keypoints.size()) ||
+        (!n.descriptors.empty() && n.descriptors.cols != kDescriptorWidth) ||
+        !std::all_of(n.bow.weights.begin(), n.bow.weights.end(), [](float w) { return std::isfinite(w); })) {
       return Corrupt(path, "features of node " + std::to_string(i));
     }
   }

@@ -9,6 +9,7 @@
 //             centres u8[n * dimension], idf f32[w], leaf u32[w]
 //   u64       checksum of everything from the version to the last array,
 //             chained section by section (so loading reads each byte once)
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -97,7 +98,8 @@ struct VocabularyFile {
     const std::size_t nodes = v.first_child_.size(), words = v.idf_.size();
     for (std::size_t n = 0; n < nodes; ++n) {
       const bool leaf = v.child_count_[n] == 0;
-      if (!leaf && (v.first_child_[n] <= n || v.first_child_[n] + v.child_count_[n] > nodes)) {
+      const std::uint64_t end = static_cast<std::uint64_t>(v.first_child_[n]) + v.child_count_[n];  // no 32-bit wrap
+      if (!leaf && (v.first_child_[n] <= n || end > nodes)) {
         return Status::DataLoss(path + ": corrupt vocabulary (child link of node " + std::to_string(n) + ")");
       }
       if (leaf != (v.word_[n] >= 0) || (leaf && static_cast<std::size_t>(v.word_[n]) >= words)) {
@@ -108,6 +110,10 @@ struct VocabularyFile {
     for (std::uint32_t leaf : v.leaf_) {
       if (leaf >= nodes) return Status::DataLoss(path + ": corrupt vocabulary (leaf link)");
     }
+    for (float idf : v.idf_) {
+      if (!std::isfinite(idf) || idf < 0.0f) return Status::DataLoss(path + ": corrupt vocabulary (word weight)");
+    }
+    if (!std::isfinite(v.scale_) || !(v.scale_ > 0.0f)) return Status::DataLoss(path + ": corrupt vocabulary (scale)");
     return Status::Ok();
   }
 

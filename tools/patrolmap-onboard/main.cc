@@ -116,7 +116,10 @@ Status Run(const Arguments& arguments) {
   std::string error;
   if (!arguments.options.IsValid(&error)) return Status::InvalidArgument(error);
   graph::TopoMap prior;
-  if (!arguments.prior_map.empty()) PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.prior_map, &prior));
+  if (!arguments.prior_map.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(arguments.out + "/map.pmap", arguments.prior_map, "prior map"));
+    PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.prior_map, &prior));
+  }
   vocab::Vocabulary vocabulary;
   std::string vocabulary_path;
   PATROLMAP_RETURN_IF_ERROR(pipeline::LoadSiftVocabulary(arguments.vocabulary, &vocabulary, &vocabulary_path));

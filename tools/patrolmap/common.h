@@ -20,6 +20,9 @@ inline int Fail(const Status& status) {
 
 using pipeline::LoadCheckedConfig;
 
+// A command-line number check that, unlike CLI::Range, also refuses NaN and infinity.
+CLI::Validator FiniteRange(double low, double high);
+
 // --fps: the frame rate of image folders, patterns and videos, overriding their own times [Hz].
 void AddFpsOption(CLI::App* app, double* fps);
 

@@ -342,26 +342,26 @@ Command AddEvalCommand(CLI::App* app) {
   app->add_flag("--json", arguments->json, "print JSON (schema patrolmap.eval/1) instead of tables");
   app->add_flag("-v,--verbose", arguments->verbose, "list every expected key-location span and its match");
   app->add_option("--tolerance", arguments->key_locations.tolerance_s, "key locations: slack around each span [s]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(FiniteRange(0.0, 3600.0))
       ->capture_default_str();
   app->add_option("--min-span", arguments->key_locations.min_span_s,
                   "key locations: passages and facades shorter than this merge into their neighbours [s]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(FiniteRange(0.0, 3600.0))
       ->capture_default_str();
   app->add_option("--radius", arguments->loop_closures.radius_m, "loop closures: same place within this distance [m]")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteRange(1e-3, 1e6))
       ->capture_default_str();
   app->add_option("--max-heading", arguments->loop_closures.max_heading_deg,
                   "loop closures: and this heading difference [deg]")
-      ->check(CLI::Range(0.0, 180.0))
+      ->check(FiniteRange(0.0, 180.0))
       ->capture_default_str();
   app->add_option("--min-gap", arguments->loop_closures.min_gap_s,
                   "loop closures: nodes of one flight closer in time are neighbours [s]")
-      ->check(CLI::NonNegativeNumber)
+      ->check(FiniteRange(0.0, 1e6))
       ->capture_default_str();
   app->add_option("--change-distance", arguments->changes.distance_m,
                   "changes: a reported object is a hit within this distance of a true one of its state and label [m]")
-      ->check(CLI::PositiveNumber)
+      ->check(FiniteRange(1e-3, 1e6))
       ->capture_default_str();
   app->add_option("--min-detections", arguments->changes.min_detections,
                   "changes: true objects the detector reported fewer times in a flight do not count")

@@ -64,7 +64,8 @@ std::string Picture(const graph::TopoMap& map, const ExportArguments& arguments,
 
 int RunExport(const ExportArguments& arguments) {
   graph::TopoMap map;
-  Status status = graph::LoadMap(arguments.map, &map);
+  Status status = arguments.out.empty() ? Status::Ok() : RefuseOverwritingInput(arguments.out, arguments.map, "map");
+  if (status.ok()) status = graph::LoadMap(arguments.map, &map);
   if (!status.ok()) return Fail(status);
   const bool geographic = arguments.format == "geojson" || arguments.format == "kml";
   if (geographic && !graph::HasGps(map)) {

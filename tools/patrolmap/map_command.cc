@@ -6,9 +6,10 @@
 
 #include "commands.h"
 #include "common.h"
-#include "patrolmap/pipeline/detect.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/change.h"
+#include "patrolmap/pipeline/detect.h"
 #include "patrolmap/pipeline/map.h"
 #include "progress.h"
 
@@ -112,6 +113,9 @@ int RunMap(const MapArguments& arguments) {
   for (const std::string& log : arguments.logs) {
     if (status.ok()) status = io::CheckLogExists(log);  // a missing log first: it is the likeliest mistake
   }
+  if (status.ok() && !arguments.prior_map.empty()) {
+    status = RefuseOverwritingInput(arguments.out + "/map.pmap", arguments.prior_map, "prior map");
+  }
   if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
   if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   if (status.ok() && !arguments.prior_map.empty()) status = graph::LoadMap(arguments.prior_map, &prior);
@@ -136,11 +140,12 @@ int RunMap(const MapArguments& arguments) {
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
     status = RecordPatrol(arguments.logs[i], config, result, &map);
   }
+  // The change report first: the map file, which may replace an earlier one, is written last, once
+  // everything else has succeeded.
+  if (status.ok() && !arguments.prior_map.empty()) status = ReportChanges(prior, map, config, arguments.out);
   if (status.ok()) status = pipeline::SaveMapRun(&map, arguments.out);
   if (!status.ok()) return Fail(status);
   PrintSummary(arguments, result);
-  if (!arguments.prior_map.empty()) status = ReportChanges(prior, map, config, arguments.out);
-  if (!status.ok()) return Fail(status);
   return 0;
 }
 

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "common.h"
 #include "patrolmap/sim/flight.h"
 #include "patrolmap/sim/route.h"
 #include "patrolmap/sim/village.h"
@@ -196,7 +197,7 @@ Command AddSimulateCommand(CLI::App* app) {
       ->check(CLI::Range(20.0, 90.0))
       ->capture_default_str();
   app->add_option("--speed", arguments->speed_mps, "mean speed [m/s] (default: street 2.5, village 1.3)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteRange(0.1, 50.0));
   app->add_flag("--plain-lighting", arguments->plain_lighting,
                 "no sun shading, exposure change or sensor noise (default: drawn from the seed)");
   AddRouteOptions(app, &arguments->flight);
