@@ -16,6 +16,21 @@
 namespace patrolmap::change {
 namespace {
 
+// Paper 004's occupancy: a voxel is occupied when most rays that reached it ended there, and (against a
+// single stray return) at least two did. Seen 1, 2 and 3 times.
+TEST(EvidenceGrid, AVoxelIsOccupiedFromTwoHitsThatOutnumberThePasses) {
+  VoxelEvidence voxel;
+  EXPECT_FALSE(IsOccupied(nullptr));
+  voxel.hits = 1;
+  EXPECT_FALSE(IsOccupied(&voxel));  // one hit: a stray return
+  voxel.hits = 2;
+  EXPECT_TRUE(IsOccupied(&voxel));
+  voxel.passes = 2;
+  EXPECT_FALSE(IsOccupied(&voxel));  // as many rays passed as ended
+  voxel.hits = 3;
+  EXPECT_TRUE(IsOccupied(&voxel));
+}
+
 const VoxelEvidence* At(const EvidenceGridData& grid, int x, int y, int z) {
   return FindVoxel(grid, Eigen::Vector3i(x, y, z));
 }

@@ -165,6 +165,22 @@ TEST(ExtremumDetector, ChangesSmallerThanTheThresholdAreNotNodes) {
   EXPECT_EQ(events[1].frame_index, 100);
 }
 
+// Table I's minimum change, exactly: a peak is confirmed once the signal has fallen the whole minimum
+// change below it (0.02), not before (a fall of 0.015 held for 20 s confirms nothing).
+TEST(ExtremumDetector, APeakIsConfirmedOnlyAfterTheWholeMinimumChange) {
+  std::vector<double> values = {0.0, 0.05, 0.1};  // rising: the trend is set, 0.1 is the candidate peak
+  values.insert(values.end(), 20, 0.085);         // 0.015 below the peak
+  EXPECT_TRUE(Extrema(values, 1.0, {0.02, 0.0}).empty());
+  values.push_back(0.0801);  // 0.0199 below
+  EXPECT_TRUE(Extrema(values, 1.0, {0.02, 0.0}).empty());
+  values.push_back(0.08);  // the full 0.02
+  const std::vector<KeyLocation> events = Extrema(values, 1.0, {0.02, 0.0});
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].kind, ExtremumKind::kPeak);
+  EXPECT_EQ(events[0].frame_index, 2);  // the peak's own sample, confirmed 22 samples later
+  EXPECT_DOUBLE_EQ(events[0].response, 0.1);
+}
+
 TEST(ExtremumDetector, NodesCloserThanTheMinimumTimeAreDropped) {
   // Peak at 1 s, valley at 2 s, peak at 6 s, valley at 7 s (1 Hz samples).
   const std::vector<double> values = {0.0, 0.1, 0.0, 0.05, 0.08, 0.09, 0.1, 0.0, 0.1};

@@ -393,6 +393,22 @@ TopoMap SquareLoop(LayoutInput* input) {
   return map;
 }
 
+// The odometry residual by hand: a at (1, 2) facing +y, b 3 units ahead of it and turned by 0.2 rad. Seen
+// from a, b lies at (3, 0); against a step of (3, 0.5) and a turn of 0.1 the residual is (0, -0.5, w 0.1).
+TEST(Layout, OdometryResidualIsTheStepSeenFromTheFirstPoseLessTheMeasuredStep) {
+  const double a[3] = {1.0, 2.0, M_PI / 2}, b[3] = {1.0, 5.0, M_PI / 2 + 0.2};
+  double residual[3];
+  OdometryResidual(a, b, Eigen::Vector2d(3.0, 0.5), 0.1, 10.0, residual, nullptr, nullptr);
+  EXPECT_NEAR(residual[0], 0.0, 1e-12);
+  EXPECT_NEAR(residual[1], -0.5, 1e-12);
+  EXPECT_NEAR(residual[2], 10.0 * 0.1, 1e-12);
+  const double left[3] = {0.0, 2.0, M_PI / 2};  // one unit to a's left (a faces +y, so left is -x)
+  OdometryResidual(a, left, Eigen::Vector2d(0.0, 0.0), 0.0, 1.0, residual, nullptr, nullptr);
+  EXPECT_NEAR(residual[0], 0.0, 1e-12);
+  EXPECT_NEAR(residual[1], 1.0, 1e-12);
+  EXPECT_NEAR(residual[2], 0.0, 1e-12);
+}
+
 TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
   LayoutInput input;
   TopoMap open = SquareLoop(&input);

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -86,6 +87,27 @@ TEST(Vocabulary, TreeOnKnownClustersGivesOneWordPerBlob) {
   EXPECT_GE(distinct.size(), 12u);       // most blobs get a word of their own ...
   EXPECT_LE(pairs.size(), distinct.size() + 2);  // ... and a blob hardly ever splits
   for (float idf : vocabulary.idf()) EXPECT_GE(idf, 0.0f);
+}
+
+// IDF is log(N / n_i) (paper 002 §III-B, Nister and Stewenius): N = 16 training images (one blob each),
+// n_i the images whose descriptors fall in word i, counted here by quantising each image.
+TEST(Vocabulary, IdfIsTheLogOfImagesOverImagesHoldingTheWord) {
+  std::vector<int> labels;
+  cv::Mat points;
+  const Vocabulary vocabulary = TrainOnBlobs(1, &labels, &points);
+  std::vector<int> holders(vocabulary.word_count(), 0);
+  for (int image = 0; image < 16; ++image) {
+    std::vector<WordId> words;
+    vocabulary.Quantize(points.rowRange(image * 40, image * 40 + 40), &words);
+    for (WordId word : std::set<WordId>(words.begin(), words.end())) ++holders[word];
+  }
+  int checked = 0;
+  for (int word = 0; word < vocabulary.word_count(); ++word) {
+    if (holders[word] == 0) continue;
+    EXPECT_NEAR(vocabulary.idf()[word], std::log(16.0 / holders[word]), 1e-5) << "word " << word;
+    ++checked;
+  }
+  EXPECT_GE(checked, 12);
 }
 
 TEST(Vocabulary, TrainingIsDeterministicForASeed) {
@@ -198,6 +220,24 @@ TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
   EXPECT_EQ(results[0].entry, 1u);
   database.Query(query, 1, {}, &results);
   EXPECT_EQ(results.size(), 1u);
+}
+
+// The L1 score by hand for unequal weights, where only the |q - d| term tells a partial from a full match:
+// q = (3/4, 1/4), d = (1/4, 3/4) over words 0 and 1; score = sum (q + d - |q - d|) / 2 = 1/4 + 1/4.
+TEST(Database, L1ScoreCountsOnlyTheSharedPartOfEachWeight) {
+  const std::vector<float> idf(4, 1.0f);
+  BowVector entry, query, other;
+  MakeBowVector({0, 1, 1, 1}, idf.data(), &entry);
+  MakeBowVector({0, 0, 0, 1}, idf.data(), &query);
+  MakeBowVector({2, 3}, idf.data(), &other);
+  ASSERT_EQ(entry.weights, (std::vector<float>{0.25f, 0.75f}));
+  Database database(4);
+  database.Add(entry), database.Add(other);
+  std::vector<QueryResult> results;
+  database.Query(query, 3, {}, &results);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_NEAR(results[0].score, 0.5, 1e-6);
+  EXPECT_NEAR(L1Score(query, entry), 0.5, 1e-6);
 }
 
 }  // namespace

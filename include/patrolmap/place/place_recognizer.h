@@ -42,7 +42,7 @@ struct PlaceOptions {
   // 10^max_log_nfa. The NFA scales with the image and the match count, so one setting holds from
   // 376x240 key frames to megapixel photographs.
   int min_inliers = 15;
-  double max_log_nfa = -30.0;  // simulated village, seeds 1-2: true closures <= -48.8, false ones >= -17.2
+  double max_log_nfa = -30.0;  // BENCHMARKS.md: closures far from their place >= -17.2, true ones down to -30.1
   bool accept_best = false;          // verify every candidate and keep the best (paper: the first that passes)
   // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already): a quarter
   // of the memory per node; matching distances are computed from the 8-bit values.
