@@ -37,15 +37,25 @@ std::vector<int> VoteSequence(HysteresisVoter* voter, const std::vector<std::vec
   return passed;
 }
 
+// Table I's hysteresis, cell by cell (paper 002 §III-A): a cell is accepted once its vote reaches 3 and
+// dropped when it falls under 2; a vector passes when the frames before it have accepted its cell.
 TEST(HysteresisVoter, AcceptsAfterThreeVotesAndDropsUnderTwo) {
   const VotingOptions options;  // accept 3, reject 2 (Table I)
   const PolarVector v = ToPolar({{100.0f, 50.0f}, {-8.0f, 0.0f}});
   HysteresisVoter voter(options, 376, 240);
-  // present x3, absent x2 (vote 3 -> 1: dropped), present (vote 2 < accept: not yet back).
-  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {}, {}, {v}, {v}}), (std::vector<int>{0, 0, 1, -1, -1, 0, 1}));
+  // Votes after each frame: 1, 2, 3 (accepted), 4th frame passes; absent twice: 2 (kept), 1 (dropped);
+  // present: not accepted before, vote 2; present: vote 3, accepted again; present: passes.
+  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {v}, {}, {}, {v}, {v}, {v}}),
+            (std::vector<int>{0, 0, 0, 1, -1, -1, 0, 0, 1}));
   voter.Reset();
-  // present x3, absent once (vote 2: still accepted), present.
-  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {}, {v}}), (std::vector<int>{0, 0, 1, -1, 1}));
+  // The hysteresis itself: absent once, the vote falls to 2 -- under accept, not under reject -- and the
+  // cell's vectors pass again at once. Without it (dropping under accept) the 5th frame would not pass.
+  EXPECT_EQ(VoteSequence(&voter, {{v}, {v}, {v}, {}, {v}}), (std::vector<int>{0, 0, 0, -1, 1}));
+  // With reject = accept there is no band: the same sequence drops the cell on the miss.
+  VotingOptions no_band = options;
+  no_band.reject = 3;
+  HysteresisVoter plain(no_band, 376, 240);
+  EXPECT_EQ(VoteSequence(&plain, {{v}, {v}, {v}, {}, {v}}), (std::vector<int>{0, 0, 0, -1, 0}));
 }
 
 TEST(HysteresisVoter, RandomDirectionsAreNeverAccepted) {

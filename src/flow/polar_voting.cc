@@ -52,13 +52,15 @@ int HysteresisVoter::Vote(const std::vector<PolarVector>& vectors, std::vector<s
     cells_[i] = CellOf(vectors[i]);
     observed_[cells_[i]] = 1;
   }
-  UpdateCells();
+  // A vector passes when the earlier frames have accepted its cell: present over several consecutive frames,
+  // and not yet discarded (its vote has not fallen under `reject` since). Then this frame votes.
   accepted->resize(vectors.size());
   int count = 0;
   for (std::size_t i = 0; i < vectors.size(); ++i) {
     (*accepted)[i] = accepted_[cells_[i]];
     count += (*accepted)[i];
   }
+  UpdateCells();
   return count;
 }
 

@@ -29,10 +29,14 @@ struct PolarVector {
 
 PolarVector ToPolar(const FlowVector& vector);
 
-// Votes for (theta, r) cells over consecutive frames. Each frame a cell that
-// holds at least one vector gains a vote (up to max_votes), every other cell
-// loses one. A cell becomes accepted when its vote reaches `accept` and stays
-// accepted until its vote falls under `reject`. Vectors in accepted cells pass.
+// Votes for (theta, r) cells over consecutive frames (paper 002 §III-A: "only flow vectors present over
+// several consecutive frames are accepted ... discarded again once [not] observed in a few frames and
+// [the] vote falls under the minimum hysteresis threshold"). Each frame a cell that holds at least one
+// vector gains a vote (up to max_votes), every other cell loses one. A cell becomes accepted when its
+// vote reaches `accept` and stays accepted until its vote falls under `reject`. A vector passes when its
+// cell was accepted by the frames before it, so with Table I's accept 3 / reject 2 a cell seen in 3
+// frames passes its vectors from the 4th on, and a cell missed in one frame (vote 3 -> 2, still
+// accepted) passes them again at once, while one missed twice (vote 1) must earn its votes anew.
 class HysteresisVoter {
  public:
   // `image_width` and `image_height` fix the r range [pixels].
