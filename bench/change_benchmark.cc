@@ -58,7 +58,8 @@ std::size_t SouthObject(const std::vector<sim::WorldObject>& objects) {
   std::size_t best = 0;
   for (std::size_t i = 0; i < objects.size(); ++i) {
     if (objects[i].centre.y() < 0.0 &&
-        (objects[best].centre.y() >= 0.0 || std::abs(objects[i].centre.x() - 20) < std::abs(objects[best].centre.x() - 20))) {
+        (objects[best].centre.y() >= 0.0 ||
+         std::abs(objects[i].centre.x() - 20) < std::abs(objects[best].centre.x() - 20))) {
       best = i;
     }
   }

@@ -36,7 +36,8 @@ const std::vector<cv::Mat>& StreetPair(int width) {
 const vocab::Vocabulary& ShippedVocabulary() {
   static vocab::Vocabulary vocabulary;
   if (vocabulary.empty()) {
-    const Status status = vocab::Vocabulary::Load(std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc", &vocabulary);
+    const Status status =
+        vocab::Vocabulary::Load(std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc", &vocabulary);
     if (!status.ok()) std::fprintf(stderr, "%s\n", status.message().c_str());
   }
   return vocabulary;
@@ -93,7 +94,8 @@ void BM_LogNumberOfFalseAlarms(benchmark::State& state) {
     const cv::Point2f p(static_cast<float>(rng.uniform(0.0, 376.0)), static_cast<float>(rng.uniform(0.0, 240.0)));
     from.push_back(p);
     to.push_back(i < 250 ? p + cv::Point2f(10.0f, static_cast<float>(rng.gaussian(0.5)))
-                         : cv::Point2f(static_cast<float>(rng.uniform(0.0, 376.0)), static_cast<float>(rng.uniform(0.0, 240.0))));
+                         : cv::Point2f(static_cast<float>(rng.uniform(0.0, 376.0)),
+                                       static_cast<float>(rng.uniform(0.0, 240.0))));
   }
   const place::FeatureExtent extent{376.0 * 240.0, 446.0};
   for (auto _ : state) {

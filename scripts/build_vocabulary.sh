@@ -8,17 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:-$root/vocab/default.pmvoc}"
 bin="$root/build/tools/patrolmap"
 work="${TMPDIR:-/tmp}/patrolmap_vocabulary"
-packages=(mate-backgrounds lomiri-wallpapers-16.04 opencv-doc)
-missing=()
-for package in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
-done
-if ((${#missing[@]})); then
-  sudo=""
-  [[ $(id -u) -eq 0 ]] || sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
-fi
+"$root/scripts/install_deps.sh" mate-backgrounds lomiri-wallpapers-16.04 opencv-doc
 mkdir -p "$work"
 [[ -f "$work/inner101/cam0/data.csv" ]] || "$bin" --quiet simulate --route inner-loop --seed 101 --out "$work/inner101"
 [[ -f "$work/l102/cam0/data.csv" ]] || "$bin" --quiet simulate --route l-shape --seed 102 --out "$work/l102"

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <map>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -48,9 +48,10 @@ TEST(EvidenceGrid, RayPassesVoxelsBeforeItsEndAndHitsTheLast) {
   EXPECT_EQ(At(data, 5, 0, 0)->passes, 0);
   EXPECT_EQ(At(data, 3, 0, 0)->hits, 0);  // the second ray ended without a return
   EXPECT_EQ(At(data, 0, 1, 0), nullptr);
-  EXPECT_TRUE(std::is_sorted(data.voxels.begin(), data.voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
-    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
-  }));
+  EXPECT_TRUE(
+      std::is_sorted(data.voxels.begin(), data.voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
+        return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+      }));
 }
 
 TEST(EvidenceGrid, DiagonalRayVisitsAConnectedChainOfVoxels) {
@@ -110,8 +111,8 @@ EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<i
   EvidenceGridData grid;
   grid.voxel_size = 0.2;
   for (const auto& [v, counts] : cells) {
-    grid.voxels.push_back({v.x(), v.y(), v.z(), static_cast<std::uint16_t>(counts.first),
-                           static_cast<std::uint16_t>(counts.second)});
+    grid.voxels.push_back(
+        {v.x(), v.y(), v.z(), static_cast<std::uint16_t>(counts.first), static_cast<std::uint16_t>(counts.second)});
   }
   std::sort(grid.voxels.begin(), grid.voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
@@ -184,8 +185,8 @@ std::vector<Eigen::Vector3f> BoxPoints(const Eigen::Vector3f& centre, float size
   for (int i = 0; i <= n; ++i) {
     for (int j = 0; j <= n; ++j) {
       const float a = -size / 2 + i * spacing, b = -size / 2 + j * spacing;
-      for (const Eigen::Vector3f& p : {Eigen::Vector3f(-size / 2, a, b), Eigen::Vector3f(a, -size / 2, b),
-                                       Eigen::Vector3f(a, b, size / 2)}) {
+      for (const Eigen::Vector3f& p :
+           {Eigen::Vector3f(-size / 2, a, b), Eigen::Vector3f(a, -size / 2, b), Eigen::Vector3f(a, b, size / 2)}) {
         points.push_back(centre + p);
       }
     }
@@ -216,7 +217,8 @@ TEST(Registration, RecoversTheRotationOfAMovedObject) {
   }
   const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   std::vector<Eigen::Vector3f> after;
-  for (const Eigen::Vector3f& p : before) after.push_back((rotation * p.cast<double>()).cast<float>() + Eigen::Vector3f(5, 1, 0));
+  for (const Eigen::Vector3f& p : before)
+    after.push_back((rotation * p.cast<double>()).cast<float>() + Eigen::Vector3f(5, 1, 0));
   const Eigen::Matrix3d found = RegisterRotation(before, after);
   EXPECT_LT((found - rotation).norm(), 1e-6);
   EXPECT_TRUE(RegisterRotation({}, after).isIdentity());
@@ -227,7 +229,8 @@ ObjectObservation Detection(const std::string& label, double confidence, const C
   ObjectObservation o;
   o.label = label;
   o.confidence = confidence;
-  const Eigen::Vector3d c = pose.ToCamera(world) + noise * Eigen::Vector3d(rng->gaussian(1), rng->gaussian(1), rng->gaussian(1));
+  const Eigen::Vector3d c =
+      pose.ToCamera(world) + noise * Eigen::Vector3d(rng->gaussian(1), rng->gaussian(1), rng->gaussian(1));
   o.centroid_camera = c;
   const double u = kCamera.fx * c.x() / c.z() + kCamera.cx, v = kCamera.fy * c.y() / c.z() + kCamera.cy;
   const double half = kCamera.fx * 0.5 / c.z();
@@ -242,8 +245,9 @@ TEST(ObjectMap, DetectionsBecomeObjectsWithAccumulatedLabels) {
   const Eigen::Vector3d crate(10, 0.5, 0.5), barrel(12, -1.0, 0.5), ghost(9, 2.0, 0.5);
   for (int frame = 0; frame < 12; ++frame) {
     const CameraPoseSample pose = LookingAlongX(Eigen::Vector3d(0.2 * frame, 0, 1.5));
-    std::vector<ObjectObservation> detections = {Detection("crate", 0.8, pose, crate, 0.1, &rng),
-                                                 Detection(frame % 4 == 0 ? "barrel" : "crate", 0.6, pose, barrel, 0.1, &rng)};
+    std::vector<ObjectObservation> detections = {
+        Detection("crate", 0.8, pose, crate, 0.1, &rng),
+        Detection(frame % 4 == 0 ? "barrel" : "crate", 0.6, pose, barrel, 0.1, &rng)};
     if (frame == 5) detections.push_back(Detection("crate", 0.9, pose, ghost, 0.1, &rng));  // one false detection
     mapper.AddFrame(detections, pose, cv::Mat(), cv::Mat());
   }
@@ -312,15 +316,16 @@ TEST(ObjectStates, PersistentMovedRemovedNewAndUnobserved) {
                                      {"vehicle", {12, 2, 0.75}},
                                      {"barrel", {9, -1, 0.5}},
                                      {"crate", {-20, 0, 0.5}}});  // behind every view
-  const PatrolRecord current = Patrol({{"crate", {10.2, 0.1, 0.5}}, {"vehicle", {12, -1.5, 0.75}}, {"barrel", {14, 1, 0.5}}});
+  const PatrolRecord current =
+      Patrol({{"crate", {10.2, 0.1, 0.5}}, {"vehicle", {12, -1.5, 0.75}}, {"barrel", {14, 1, 0.5}}});
   ObjectDiffOptions options;
   options.max_move_m = 4.0;
   const std::vector<ObjectChange> changes = DiffObjects(prior, current, options);
   std::map<std::string, int> counts;
   for (const ObjectChange& c : changes) ++counts[ToString(c.state)];
   EXPECT_EQ(counts["persistent"], 1);
-  EXPECT_EQ(counts["moved"], 1);       // the vehicle, 3.5 m
-  EXPECT_EQ(counts["removed"], 1);     // the barrel at (9, -1): the barrel at (14, 1) is 5.4 m away, beyond max_move
+  EXPECT_EQ(counts["moved"], 1);    // the vehicle, 3.5 m
+  EXPECT_EQ(counts["removed"], 1);  // the barrel at (9, -1): the barrel at (14, 1) is 5.4 m away, beyond max_move
   EXPECT_EQ(counts["new"], 1);
   EXPECT_EQ(counts["unobserved"], 1);  // the crate behind the flight
   for (const ObjectChange& c : changes) {
@@ -367,7 +372,8 @@ TEST(ObjectStates, AViewCoversAnObjectWithHalfItsBoxInTheImage) {
   EXPECT_NEAR(VisibleFraction(patrol.objects[0], kCamera, view), 1.0, 1e-9);
   // Centred on the image's right edge (u = 64 at 10 m is y = -8.125): about half of it inside.
   EXPECT_NEAR(VisibleFraction(patrol.objects[1], kCamera, view), 0.5, 0.05);
-  EXPECT_EQ(VisibleFraction(patrol.objects[0], kCamera, LookingAlongX(Eigen::Vector3d(10.2, 0, 0.5))), 0.0);  // inside it
+  EXPECT_EQ(VisibleFraction(patrol.objects[0], kCamera, LookingAlongX(Eigen::Vector3d(10.2, 0, 0.5))),
+            0.0);  // inside it
 }
 
 TEST(ObjectStates, RemovedNeedsTheDetectionsTheCurrentViewsWouldHaveGiven) {
@@ -495,7 +501,8 @@ cv::Mat Scene(int seed) {
   image.setTo(120);
   for (int i = 0; i < 90; ++i) {
     const cv::Point a(rng.uniform(0, 160), rng.uniform(0, 120));
-    cv::rectangle(image, a, a + cv::Point(rng.uniform(3, 18), rng.uniform(3, 18)), cv::Scalar(rng.uniform(0, 255)), cv::FILLED);
+    cv::rectangle(image, a, a + cv::Point(rng.uniform(3, 18), rng.uniform(3, 18)), cv::Scalar(rng.uniform(0, 255)),
+                  cv::FILLED);
   }
   cv::GaussianBlur(image, image, cv::Size(3, 3), 0.7);
   return image;

@@ -47,7 +47,8 @@ TEST(ExpectedSpans, RunsOfOneKindCountOnce) {
 
 TEST(ExpectedSpans, ASlitShorterThanTheMinimumJoinsItsNeighbours) {
   // Facade, a 1 s slit at 20-21 s, facade, a passage 30-40 s.
-  const std::vector<TruthEdge> edges = {Edge(5, false), Edge(20, true), Edge(21, false), Edge(30, true), Edge(40, false)};
+  const std::vector<TruthEdge> edges = {Edge(5, false), Edge(20, true), Edge(21, false), Edge(30, true),
+                                        Edge(40, false)};
   const std::vector<ExpectedSpan> spans = ExpectedSpans(edges, 2.0);
   ASSERT_EQ(spans.size(), 4u);
   EXPECT_DOUBLE_EQ(spans[1].start_s, 5.0);  // one facade from 5 to 30 s
@@ -59,11 +60,11 @@ TEST(ScoreKeyLocations, CountsTrueFalseAndMissed) {
   const std::vector<TruthEdge> edges = {Edge(10, true), Edge(20, false), Edge(30, true), Edge(40, false)};
   // Required: valley [10,20], peak [20,30], valley [30,40].
   const std::vector<KeyLocation> detected = {
-      Node(15, kValley),   // true
-      Node(16, kValley),   // second in the same span: false
-      Node(25, kValley),   // wrong kind for a facade: false
-      Node(40.8, kValley), // inside the tolerance of [30, 40]: true
-      Node(50, kPeak),     // optional span after the last edge: true, never missed
+      Node(15, kValley),    // true
+      Node(16, kValley),    // second in the same span: false
+      Node(25, kValley),    // wrong kind for a facade: false
+      Node(40.8, kValley),  // inside the tolerance of [30, 40]: true
+      Node(50, kPeak),      // optional span after the last edge: true, never missed
   };
   const KeyLocationScore score = ScoreKeyLocations(detected, edges, {1.0, 2.0});
   EXPECT_EQ(score.detected, 5);
@@ -119,17 +120,15 @@ namespace {
 NodeRecord NodeAt(int node, const char* flight, double t) { return {node, flight, SecondsToNs(t), node * 10}; }
 
 TEST(ScoreLoopClosures, CountsPossibleFoundAndFalse) {
-  const std::vector<NodeRecord> nodes = {
-      NodeAt(0, "A", 0),  NodeAt(1, "A", 10), NodeAt(6, "A", 12), NodeAt(2, "A", 40),
-      NodeAt(3, "A", 50), NodeAt(4, "B", 5),  NodeAt(5, "B", 30)};
-  const std::vector<Place> places = {
-      {0, 0, 0},       // 0
-      {20, 0, 0},      // 1
-      {20.2, 0, 0},    // 6: same place as 1 but 2 s later: a neighbour, not a loop closure
-      {1, 1, 0.1},     // 2: back at 0 after 40 s: possible
-      {20.5, 0, 2.0},  // 3: at 1's position looking elsewhere: not the same place
-      {19, 1, 0.1},    // 4: flight B at 1's place: possible
-      {100, 100, 0}};  // 5: nowhere seen before
+  const std::vector<NodeRecord> nodes = {NodeAt(0, "A", 0),  NodeAt(1, "A", 10), NodeAt(6, "A", 12), NodeAt(2, "A", 40),
+                                         NodeAt(3, "A", 50), NodeAt(4, "B", 5),  NodeAt(5, "B", 30)};
+  const std::vector<Place> places = {{0, 0, 0},     // 0
+                                     {20, 0, 0},    // 1
+                                     {20.2, 0, 0},  // 6: same place as 1 but 2 s later: a neighbour, not a loop closure
+                                     {1, 1, 0.1},   // 2: back at 0 after 40 s: possible
+                                     {20.5, 0, 2.0},  // 3: at 1's position looking elsewhere: not the same place
+                                     {19, 1, 0.1},    // 4: flight B at 1's place: possible
+                                     {100, 100, 0}};  // 5: nowhere seen before
   const std::vector<LoopClosureRecord> closures = {{2, 0}, {4, 1}, {5, 0}, {3, 1}};
   const LoopClosureScore score = ScoreLoopClosures(nodes, places, closures);
   EXPECT_EQ(score.nodes, 7);
@@ -149,8 +148,9 @@ TEST(ScoreLoopClosures, CountsPossibleFoundAndFalse) {
 TEST(ReadFiles, NodesClosuresAndPlaces) {
   testing::TempDir dir;
   testing::WriteText(dir / "nodes.csv", "node,flight,timestamp_ns,frame_index\n0,f1,100,3\n1,f2,200,7\n");
-  testing::WriteText(dir / "loop_closures.csv",
-                     "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers\n1,0,7,3,0.4,0.6,80\n");
+  testing::WriteText(
+      dir / "loop_closures.csv",
+      "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers\n1,0,7,3,0.4,0.6,80\n");
   testing::WriteText(dir / "log/groundtruth/places.csv", "#t,frame,x,y,z,yaw\n0,0,1,2,3,0.5\n33,1,2,2,3,0.5\n");
   std::vector<NodeRecord> nodes;
   std::vector<LoopClosureRecord> closures;
@@ -167,7 +167,6 @@ TEST(ReadFiles, NodesClosuresAndPlaces) {
   EXPECT_NE(ReadNodesCsv(dir / "nodes.csv", &nodes).message().find("nodes.csv:1: header must start with 'node'"),
             std::string::npos);
 }
-
 
 TruthObject Truth(int id, const char* label, double x, double y, int detections) {
   TruthObject o;
@@ -188,9 +187,9 @@ TEST(ChangeScore, ObjectStatesPerStateWithOptionalSightings) {
   // after (removed as a patrol can know it).
   const auto at = [](double x) { return Eigen::Vector3d(x, 0.1, 0.5); };
   const std::vector<ReportedObject> reported = {
-      {"persistent", "crate", at(0), at(0)},  {"moved", "crate", at(5), at(8.3)}, {"removed", "barrel", at(9), {}},
-      {"new", "crate", {}, at(20.2)},          {"new", "crate", {}, at(12)},      {"removed", "vehicle", at(30), {}},
-      {"new", "barrel", {}, at(40)},           {"unobserved", "crate", at(50), {}}};
+      {"persistent", "crate", at(0), at(0)}, {"moved", "crate", at(5), at(8.3)}, {"removed", "barrel", at(9), {}},
+      {"new", "crate", {}, at(20.2)},        {"new", "crate", {}, at(12)},       {"removed", "vehicle", at(30), {}},
+      {"new", "barrel", {}, at(40)},         {"unobserved", "crate", at(50), {}}};
   const ObjectChangeScore score = ScoreObjectChanges(reported, before, after, ChangeScoreOptions{});
   EXPECT_EQ(score.by_state.at("persistent").true_positives, 1);
   EXPECT_EQ(score.by_state.at("moved").true_positives, 1);
@@ -219,11 +218,11 @@ TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
   const auto add = [](EvidenceGridData* g, int x, int y, int z, int hits, int passes) {
     g->voxels.push_back({x, y, z, static_cast<std::uint16_t>(hits), static_cast<std::uint16_t>(passes)});
   };
-  add(&a, 4, 5, 2, 9, 0), add(&b, 4, 5, 2, 0, 9);    // inside the crate's face: core, reported
-  add(&a, 5, 5, 2, 9, 0), add(&b, 5, 5, 2, 0, 9);    // core, missed
-  add(&a, 7, 5, 2, 5, 5), add(&b, 7, 5, 2, 0, 9);    // centre 1.4: 0.1 m outside the face, band, reported
-  add(&a, 9, 5, 2, 0, 9), add(&b, 9, 5, 2, 0, 9);    // free in both, reported: false
-  add(&a, 12, 5, 2, 9, 0);                            // not observed in the second flight: never counted
+  add(&a, 4, 5, 2, 9, 0), add(&b, 4, 5, 2, 0, 9);  // inside the crate's face: core, reported
+  add(&a, 5, 5, 2, 9, 0), add(&b, 5, 5, 2, 0, 9);  // core, missed
+  add(&a, 7, 5, 2, 5, 5), add(&b, 7, 5, 2, 0, 9);  // centre 1.4: 0.1 m outside the face, band, reported
+  add(&a, 9, 5, 2, 0, 9), add(&b, 9, 5, 2, 0, 9);  // free in both, reported: false
+  add(&a, 12, 5, 2, 9, 0);                         // not observed in the second flight: never counted
   const std::vector<Eigen::Vector3i> changed = {{4, 5, 2}, {7, 5, 2}, {9, 5, 2}, {12, 5, 2}};
   const GeometryScore score = ScoreGeometry(changed, a, b, before, after, ChangeScoreOptions{});
   EXPECT_EQ(score.observed_voxels, 4);
@@ -243,7 +242,8 @@ TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
   const CameraIntrinsics camera{100, 100, 80, 50, 160, 100};
   std::vector<TruthObject> before = {Truth(1, "crate", 10, 0, 10), Truth(2, "crate", 10, 3, 10),
                                      Truth(3, "crate", 10, -3, 10), Truth(4, "crate", -10, 0, 10)};
-  std::vector<TruthObject> after = {Truth(1, "crate", 10, 0, 10), Truth(3, "crate", 12, -3, 10), Truth(5, "crate", 8, 2, 10)};
+  std::vector<TruthObject> after = {Truth(1, "crate", 10, 0, 10), Truth(3, "crate", 12, -3, 10),
+                                    Truth(5, "crate", 8, 2, 10)};
   for (auto* objects : {&before, &after}) {
     for (TruthObject& o : *objects) o.seen_ns = {1'000'000'000};
   }
@@ -254,7 +254,7 @@ TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
   const std::vector<cv::Rect2d> prior = VisibleChangeBoxes(before, after, 1'000'000'000, pose, camera, options);
   ASSERT_EQ(prior.size(), 2u);
   EXPECT_NEAR(prior[0].x + prior[0].width / 2, 80 - 100 * 3.0 / 10, 3);  // world +y is image left
-  EXPECT_NEAR(prior[0].width, 100 * (3.5 / 9.5 - 2.5 / 10.5), 1e-6);    // from its near left to its far right edge
+  EXPECT_NEAR(prior[0].width, 100 * (3.5 / 9.5 - 2.5 / 10.5), 1e-6);     // from its near left to its far right edge
   const std::vector<cv::Rect2d> current = VisibleChangeBoxes(after, before, 1'000'000'000, pose, camera, options);
   ASSERT_EQ(current.size(), 1u);  // crate 3 at its new place
   // One region on crate 2's old place, one on crate 3's new place, one on the unchanged crate 1.

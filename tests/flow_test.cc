@@ -1,8 +1,8 @@
 #include <cmath>
 #include <numeric>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/flow/edge_flow.h"
@@ -66,8 +66,8 @@ TEST(HysteresisVoter, RandomDirectionsAreNeverAccepted) {
   for (int frame = 0; frame < 50; ++frame) {
     std::vector<PolarVector> vectors;
     for (int i = 0; i < 5; ++i) {
-      vectors.push_back(ToPolar({{rng.uniform(0.f, 376.f), rng.uniform(0.f, 240.f)},
-                                 {rng.uniform(-5.f, 5.f), rng.uniform(-5.f, 5.f)}}));
+      vectors.push_back(ToPolar(
+          {{rng.uniform(0.f, 376.f), rng.uniform(0.f, 240.f)}, {rng.uniform(-5.f, 5.f), rng.uniform(-5.f, 5.f)}}));
     }
     total += voter.Vote(vectors, &accepted);
   }
@@ -298,14 +298,14 @@ TEST(Gyro, IntegratesAConstantRate) {
     sample.gyro = Eigen::Vector3d(0.0, 0.0, 0.5);
     samples.push_back(sample);
   }
-  const Eigen::Matrix3d rotation =
-      IntegrateGyro(samples, 0, SecondsToNs(0.2), Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d rotation = IntegrateGyro(samples, 0, SecondsToNs(0.2), Eigen::Matrix3d::Identity());
   const Eigen::AngleAxisd angle_axis(rotation);
   EXPECT_NEAR(angle_axis.angle(), 0.1, 1e-9);
   EXPECT_NEAR(angle_axis.axis().z(), 1.0, 1e-9);
   // Only (start, end] counts.
-  EXPECT_NEAR(Eigen::AngleAxisd(IntegrateGyro(samples, SecondsToNs(0.1), SecondsToNs(0.2),
-                                               Eigen::Matrix3d::Identity())).angle(), 0.05, 1e-9);
+  EXPECT_NEAR(Eigen::AngleAxisd(IntegrateGyro(samples, SecondsToNs(0.1), SecondsToNs(0.2), Eigen::Matrix3d::Identity()))
+                  .angle(),
+              0.05, 1e-9);
 }
 
 TEST(Derotation, RemovesFlowOfAPureRotation) {
@@ -362,7 +362,7 @@ TEST(FrameTiming, DurationsInSecondsGiveTheFramesOfEachRate) {
   EXPECT_EQ(kitti.window, 25);  // 5 s at 5 processed frames per second
   const FrameTiming euroc = ResolveFrameTiming(options, 20.0);
   EXPECT_EQ(euroc.step, 3);
-  EXPECT_EQ(euroc.window, 33);  // 5 s at 6.67 per second
+  EXPECT_EQ(euroc.window, 33);                                // 5 s at 6.67 per second
   const FrameTiming slow = ResolveFrameTiming(options, 1.0);  // a 1 Hz image collection: every image
   EXPECT_EQ(slow.step, 1);
   EXPECT_EQ(slow.window, 5);

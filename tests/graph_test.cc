@@ -265,11 +265,11 @@ TEST(MapFile, FailedSaveLeavesThePreviousMapIntact) {
   testing::TempDir dir;
   ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
   const std::string before = testing::ReadText(dir / "m.pmap");
-  std::filesystem::create_directory(dir / "m.pmap.tmp." + std::to_string(::getpid()));  // the temporary cannot be created
+  std::filesystem::create_directory(dir / "m.pmap.tmp." +
+                                    std::to_string(::getpid()));  // the temporary cannot be created
   EXPECT_FALSE(SaveMap(TopoMap(), dir / "m.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "m.pmap"), before);
 }
-
 
 // A big map with `nodes` nodes of 200 features each (about 50 KB a node on disk).
 TopoMap BigMap(int nodes) {
@@ -316,7 +316,6 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
-
 // A flight id written to close the page's script and run its own: every text format escapes it.
 TEST(Export, HostileFlightIdsAreEscapedInEveryTextFormat) {
   TopoMap map = TwoFlights();
@@ -354,7 +353,6 @@ TEST(Export, GraphMLKeepsFullPrecisionAndJsonIsNodeLink) {
   EXPECT_TRUE(json["nodes"][0]["gps"].is_null());
   EXPECT_EQ(CountOf(ToDot(map), "style=dashed"), 3u);
 }
-
 
 TEST(Layout, OdometryJacobianMatchesNumericDifferentiation) {
   const double a[3] = {1.2, -0.7, 0.9}, b[3] = {3.1, 0.4, 1.7};
@@ -420,7 +418,7 @@ TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
   closed.AddEdge(25, 5, {EdgeKind::kLoopClosure, 0.1, 0.2, 50});  // false: opposite sides, 10 m apart
   ASSERT_TRUE(LayoutMap(input, {}, &closed).ok());
   EXPECT_LT((closed.node(40).layout - closed.node(0).layout).norm(), 0.3 * gap);
-  EXPECT_GT((closed.node(25).layout - closed.node(5).layout).norm(), 6.0);  // the robust loss keeps them apart
+  EXPECT_GT((closed.node(25).layout - closed.node(5).layout).norm(), 6.0);          // the robust loss keeps them apart
   EXPECT_NEAR((closed.node(10).layout - closed.node(0).layout).norm(), 10.0, 1.5);  // sides keep their length
 }
 
@@ -445,7 +443,6 @@ TEST(Layout, AFirstNodeWithoutEdgesIsLaidOutToo) {
   ASSERT_TRUE(LayoutMap(input, {}, &map).ok());
   EXPECT_NEAR((map.node(2).layout - map.node(1).layout).norm(), 1.0, 1e-6);
 }
-
 
 TEST(Export, SvgColoursLoopClosuresByTruth) {
   const TopoMap map = TwoFlights();

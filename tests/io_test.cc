@@ -101,7 +101,8 @@ TEST(ImageFolder, NumericFileNamesAreTimes) {
   EXPECT_EQ(frames[0].timestamp_ns, 0);
   EXPECT_EQ(frames[2].timestamp_ns, 200000000);
   TempDir ns;
-  for (long long t : {1403636579763555584LL, 1403636579813555456LL}) cv::imwrite(ns / (std::to_string(t) + ".png"), TestImage(1));
+  for (long long t : {1403636579763555584LL, 1403636579813555456LL})
+    cv::imwrite(ns / (std::to_string(t) + ".png"), TestImage(1));
   ASSERT_TRUE(OpenImageFolder(ns.path(), {}, &source).ok());
   EXPECT_NEAR(source->info().frame_rate_hz, 20.0, 1e-3);
   TempDir indices;  // zero-padded frame numbers are indices, not times
@@ -259,8 +260,7 @@ TEST(Euroc, MissingColumnIsAnError) {
 TEST(Euroc, NonMonotonicTimestampsAreRejected) {
   TempDir dir;
   const Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n3000,b.png\n2000,c.png\n");
-  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (3000)"),
-            std::string::npos)
+  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (3000)"), std::string::npos)
       << status.message();
 }
 
@@ -282,8 +282,8 @@ TEST(Euroc, UnreadableImageInTheMiddleIsCountedAndSkipped) {
   TempDir dir;
   const std::string log = dir / "flight";
   MakeEurocLog(log, 5);
-  WriteText(log + "/cam0/data/1100000000.png", "truncated png");           // frame 2 corrupt
-  std::filesystem::remove(log + "/cam0/data/1150000000.png");              // frame 3 missing
+  WriteText(log + "/cam0/data/1100000000.png", "truncated png");  // frame 2 corrupt
+  std::filesystem::remove(log + "/cam0/data/1150000000.png");     // frame 3 missing
   std::unique_ptr<FrameSource> source;
   ASSERT_TRUE(OpenLog(log, {}, &source).ok());
   Status end;
@@ -396,7 +396,8 @@ TEST(Euroc, GpsIsInterpolatedAtFrameTimes) {
   EXPECT_NEAR(frames[1].gps->y(), 8.0002, 1e-12);
   EXPECT_NEAR(frames[1].gps->z(), 505.0, 1e-9);
   WriteText(log + "/gps0/data.csv", "1000000000,47.0,8.0\n");
-  EXPECT_NE(OpenLog(log, {}, &source).message().find("gps0/data.csv:1: expected at least 4 columns"), std::string::npos);
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("gps0/data.csv:1: expected at least 4 columns"),
+            std::string::npos);
 }
 
 TEST(PatrolSensors, PosesDetectionsAndDepthOfALog) {
@@ -410,8 +411,8 @@ TEST(PatrolSensors, PosesDetectionsAndDepthOfALog) {
   // Body yawed by 90 degrees (facing +y) at the first row, moving 1 m along +y by the second.
   const double h = std::sqrt(0.5);
   WriteText(log + "/state_groundtruth_estimate0/data.csv",
-            "1000000000,0,0,2," + std::to_string(h) + ",0,0," + std::to_string(h) + ",0,0,0\n" +
-            "1100000000,0,1,2," + std::to_string(h) + ",0,0," + std::to_string(h) + ",0,0,0\n");
+            "1000000000,0,0,2," + std::to_string(h) + ",0,0," + std::to_string(h) + ",0,0,0\n" + "1100000000,0,1,2," +
+                std::to_string(h) + ",0,0," + std::to_string(h) + ",0,0,0\n");
   WriteText(log + "/objects0/data.csv",
             "#t,label,confidence,x0,y0,x1,y1,x,y,z\n1000000000,crate,0.8,1,2,11,12,0.5,0.25,6\n"
             "1000000000,barrel,0.6,20,2,25,9\n1050000000,crate,0.7,2,2,12,12,0.5,0.25,5.5\n");

@@ -4,8 +4,8 @@
 #include <set>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/imgproc.hpp>
 
 #include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/flow/key_location_detector.h"
@@ -24,9 +24,12 @@ const std::string kDefaultConfig = std::string(PATROLMAP_SOURCE_DIR) + "/config/
 
 void FlattenKeys(const YAML::Node& node, const std::string& prefix, std::set<std::string>* keys) {
   for (const auto& item : node) {
-    const std::string path = prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
-    if (item.second.IsMap()) FlattenKeys(item.second, path, keys);
-    else keys->insert(path);
+    const std::string path =
+        prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
+    if (item.second.IsMap())
+      FlattenKeys(item.second, path, keys);
+    else
+      keys->insert(path);
   }
 }
 
@@ -91,7 +94,9 @@ TEST(DetectionWarnings, ShortFlatAndUntimedLogsAreExplained) {
   std::vector<std::string> warnings = DetectionWarnings(info, result, options);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("log: no key location: the smoothed response varies by 0, less than "
-                             "flow.extrema.min_change = 0.02"), std::string::npos) << warnings[0];
+                             "flow.extrema.min_change = 0.02"),
+            std::string::npos)
+      << warnings[0];
   for (FlowSample& sample : result.samples) sample.accepted_vectors = 0;
   warnings = DetectionWarnings(info, result, options);
   ASSERT_EQ(warnings.size(), 1u);
@@ -170,7 +175,8 @@ flow::DetectorOutput RunOnFlight(const sim::SimulatedFlight& flight, const flow:
     frame.index = i;
     frame.timestamp_ns = sim::FrameTimestamp(flight, i);
     frame.imu.clear();
-    while (next_imu < imu.size() && imu[next_imu].timestamp_ns <= frame.timestamp_ns) frame.imu.push_back(imu[next_imu++]);
+    while (next_imu < imu.size() && imu[next_imu].timestamp_ns <= frame.timestamp_ns)
+      frame.imu.push_back(imu[next_imu++]);
     frame.speed_mps = flight.trajectory(i / flight.frame_rate_hz).velocity.norm();
     frame.image.release();
     if (detector.NeedsImage()) {
@@ -239,7 +245,7 @@ TEST(DetectEndToEnd, GyroDerotationRemovesTheFlowOfAYawingHover) {
   const double derotated = MeanRawResponse(RunOnFlight(flight, options));
   options.response.derotate_with_imu = false;
   const double raw = MeanRawResponse(RunOnFlight(flight, options));
-  EXPECT_GT(raw, 0.1);              // rotation alone: ~0.22 image widths per second
+  EXPECT_GT(raw, 0.1);               // rotation alone: ~0.22 image widths per second
   EXPECT_LT(derotated, 0.05 * raw);  // measured: 3 % of it remains
 }
 
@@ -385,9 +391,9 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
   ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, vocabulary).ok());
 }
 
-// Every processed frame (every 5th) of both flights is a node. Mapped together, and as a patrol against flight 1's saved
-// map: the results must agree exactly. Loop closures of the second flight against the first are scored
-// against the simulator's places.
+// Every processed frame (every 5th) of both flights is a node. Mapped together, and as a patrol against flight 1's
+// saved map: the results must agree exactly. Loop closures of the second flight against the first are scored against
+// the simulator's places.
 TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   testing::TempDir dir;
   Config config;
@@ -413,7 +419,8 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   ASSERT_TRUE(eval::ReadLoopClosuresCsv(dir / "run/loop_closures.csv", &closures).ok());
   std::vector<eval::Place> places;
   std::map<std::string, std::vector<eval::Place>> by_flight;
-  for (const char* flight : {"street-1", "street-2"}) ASSERT_TRUE(eval::ReadPlaces(dir / flight, &by_flight[flight]).ok());
+  for (const char* flight : {"street-1", "street-2"})
+    ASSERT_TRUE(eval::ReadPlaces(dir / flight, &by_flight[flight]).ok());
   for (const eval::NodeRecord& node : nodes) places.push_back(by_flight[node.flight][node.frame_index]);
   const eval::LoopClosureScore score = eval::ScoreLoopClosures(nodes, places, closures);
   EXPECT_EQ(score.nodes, 68);

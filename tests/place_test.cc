@@ -1,8 +1,8 @@
 #include <filesystem>
 #include <random>
 
-#include <Eigen/Core>
 #include <gtest/gtest.h>
+#include <Eigen/Core>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -44,8 +44,10 @@ TEST(Verify, SyntheticTwoViewGeometryWithOutliers) {
   for (int i = 0; i < 300; ++i) {
     const Eigen::Vector3d p(4.0 * u(rng), 3.0 * u(rng), 8.0 + 4.0 * u(rng));
     const Eigen::Vector3d q = Eigen::Vector3d(p.x() - 0.8, p.y() - 0.1, p.z() - 0.3);  // camera moved right
-    a.emplace_back(float(f * p.x() / p.z() + cx + pixel_noise(rng)), float(f * p.y() / p.z() + cy + pixel_noise(rng)), 5.f);
-    b.emplace_back(float(f * q.x() / q.z() + cx + pixel_noise(rng)), float(f * q.y() / q.z() + cy + pixel_noise(rng)), 5.f);
+    a.emplace_back(float(f * p.x() / p.z() + cx + pixel_noise(rng)), float(f * p.y() / p.z() + cy + pixel_noise(rng)),
+                   5.f);
+    b.emplace_back(float(f * q.x() / q.z() + cx + pixel_noise(rng)), float(f * q.y() / q.z() + cy + pixel_noise(rng)),
+                   5.f);
     cv::Mat row(1, 128, CV_32F);
     cv::randu(row, 0, 255);
     da.push_back(row);
@@ -109,7 +111,8 @@ TEST(PlaceRecognizer, RealRevisitsAreFoundAndOthersNot) {
   if (!std::filesystem::exists(kShared + "/dbow2_demo/image0.png")) GTEST_SKIP() << "shared data not present";
   std::vector<cv::Mat> images;
   for (int i = 0; i < 4; ++i) images.push_back(cv::imread(kShared + cv::format("/dbow2_demo/image%d.png", i), 0));
-  for (int i = 0; i < 4; ++i) images.push_back(cv::imread(kShared + cv::format("/euroc_revisit_pairs/left_img_%d.png", i), 0));
+  for (int i = 0; i < 4; ++i)
+    images.push_back(cv::imread(kShared + cv::format("/euroc_revisit_pairs/left_img_%d.png", i), 0));
   PlaceOptions options;
   options.exclude_recent_s = 0.0;
   const vocab::Vocabulary vocabulary = VocabularyFor(images, options);
@@ -117,8 +120,10 @@ TEST(PlaceRecognizer, RealRevisitsAreFoundAndOthersNot) {
   const std::vector<int> expected_match = {-1, -1, -1, 1, -1, 4, -1, 6};  // per image: the earlier node it revisits
   for (std::size_t i = 0; i < images.size(); ++i) {
     PlaceResult result;
-    ASSERT_TRUE(recognizer.AddKeyFrame({i < 4 ? "dbow2" : "euroc", SecondsToNs(i), static_cast<std::int64_t>(i), images[i]},
-                                       &result).ok());
+    ASSERT_TRUE(
+        recognizer
+            .AddKeyFrame({i < 4 ? "dbow2" : "euroc", SecondsToNs(i), static_cast<std::int64_t>(i), images[i]}, &result)
+            .ok());
     EXPECT_EQ(result.node, static_cast<int>(i));
     EXPECT_EQ(result.match ? result.match->node : -1, expected_match[i]) << "image " << i;
   }
@@ -138,7 +143,7 @@ TEST(PlaceRecognizer, RecentNodesOfTheSameFlightAreNotCandidates) {
   EXPECT_FALSE(result.match.has_value());  // 5 s later in the same flight: a neighbour, not a candidate
   EXPECT_TRUE(result.candidates.empty());
   ASSERT_TRUE(recognizer.AddKeyFrame({"a", SecondsToNs(30), 2, three}, &result).ok());
-  ASSERT_TRUE(result.match.has_value());   // 30 s later both earlier nodes are candidates and verify
+  ASSERT_TRUE(result.match.has_value());  // 30 s later both earlier nodes are candidates and verify
   EXPECT_LE(result.match->node, 1);
   EXPECT_EQ(result.candidates.size(), 1u);  // the first verified candidate ends the search (paper)
   EXPECT_EQ(recognizer.node_count(), 3);
@@ -187,7 +192,8 @@ namespace {
 
 // Correspondences of a known two-view geometry: points on a fronto-parallel plane shifted sideways, so
 // x2 = x1 + (d, 0) and F fixes only the rows (y2 = y1).
-void ShiftedPoints(int count, double shift, cv::RNG* rng, std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+void ShiftedPoints(int count, double shift, cv::RNG* rng, std::vector<cv::Point2f>* from,
+                   std::vector<cv::Point2f>* to) {
   for (int i = 0; i < count; ++i) {
     const cv::Point2f p(static_cast<float>(rng->uniform(10.0, 630.0)), static_cast<float>(rng->uniform(10.0, 470.0)));
     from->push_back(p);

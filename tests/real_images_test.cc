@@ -4,9 +4,9 @@
 #include <fstream>
 #include <sstream>
 
+#include <gtest/gtest.h>
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -56,8 +56,8 @@ double Sampson(const Eigen::Matrix3d& f, const cv::Point2f& a, const cv::Point2f
   const Eigen::Vector3d x1(a.x, a.y, 1.0), x2(b.x, b.y, 1.0);
   const Eigen::Vector3d fx1 = f * x1, ftx2 = f.transpose() * x2;
   const double residual = x2.dot(fx1);
-  return std::abs(residual) / std::sqrt(fx1.x() * fx1.x() + fx1.y() * fx1.y() + ftx2.x() * ftx2.x() +
-                                        ftx2.y() * ftx2.y());
+  return std::abs(residual) /
+         std::sqrt(fx1.x() * fx1.x() + fx1.y() * fx1.y() + ftx2.x() * ftx2.x() + ftx2.y() * ftx2.y());
 }
 
 // Sampson distances [pixels] of the edge flow tracked over the 51 KITTI frames, measured against
@@ -82,7 +82,9 @@ std::vector<double> KittiEpipolarErrors(const TrackerOptions& options) {
   return errors;
 }
 
-double Quantile(const std::vector<double>& sorted, double q) { return sorted[static_cast<std::size_t>(q * sorted.size())]; }
+double Quantile(const std::vector<double>& sorted, double q) {
+  return sorted[static_cast<std::size_t>(q * sorted.size())];
+}
 
 // A car driving a rural road: most tracks are exact; occluding contours and foliage give a tail of wrong
 // ones, which the forward-backward check removes.

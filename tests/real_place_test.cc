@@ -146,8 +146,10 @@ TEST(RealPairs, KittiFramesNearEachOtherVerify) {
   }
   // Pairs farther apart still share much of the view of a forward camera (the road ahead): those that
   // verify are overlapping views, not false matches, and are only counted.
-  std::printf("KITTI: %d same-place pairs, %d verified (50-inlier rule %d); %d pairs farther apart, %d verified "
-              "(50-inlier rule %d)\n", same, found, found_fifty, other, false_accepts, false_fifty);
+  std::printf(
+      "KITTI: %d same-place pairs, %d verified (50-inlier rule %d); %d pairs farther apart, %d verified "
+      "(50-inlier rule %d)\n",
+      same, found, found_fifty, other, false_accepts, false_fifty);
   EXPECT_GE(found, same * 9 / 10);
 }
 
@@ -173,16 +175,20 @@ TEST(RealPairs, KittiRetrievalWithTheShippedVocabularyIsPrecise) {
     ASSERT_FALSE(image.empty());
     cv::resize(image, scaled, cv::Size(), flow::FrameOptions().scale, flow::FrameOptions().scale, cv::INTER_AREA);
     PlaceResult result;
-    ASSERT_TRUE(recognizer.AddKeyFrame({"kitti", SecondsToNs(j / kRateHz), static_cast<std::int64_t>(j), scaled}, &result).ok());
+    ASSERT_TRUE(
+        recognizer.AddKeyFrame({"kitti", SecondsToNs(j / kRateHz), static_cast<std::int64_t>(j), scaled}, &result)
+            .ok());
     bool can_be_found = false;
-    for (std::size_t i = 0; i + kMinGapFrames <= j; ++i) can_be_found |= cv::norm(centres[i] - centres[j]) <= kSamePlaceM;
+    for (std::size_t i = 0; i + kMinGapFrames <= j; ++i)
+      can_be_found |= cv::norm(centres[i] - centres[j]) <= kSamePlaceM;
     findable += can_be_found;
     if (!result.match) continue;
     ++closures;
     const double distance = cv::norm(centres[result.match->node] - centres[j]);
     true_closures += distance <= kSamePlaceM;
     near_misses += distance > kSamePlaceM && distance <= 2.0 * kSamePlaceM;
-    if (distance > kSamePlaceM) std::printf("frame %zu closed to frame %d, %.1f m away\n", j, result.match->node, distance);
+    if (distance > kSamePlaceM)
+      std::printf("frame %zu closed to frame %d, %.1f m away\n", j, result.match->node, distance);
   }
   std::printf("KITTI retrieval: %d queries could be found, %d loop closures, %d of them true\n", findable, closures,
               true_closures);

@@ -121,12 +121,12 @@ TEST(Detector, SeesAnObjectInFrontAndNotOneBehindAWall) {
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found[0].truth_id, 7);
   EXPECT_EQ(found[0].label, ObjectLabel::kCrate);
-  EXPECT_NEAR(found[0].centroid.z(), 6.0, 1e-9);   // depth
-  EXPECT_NEAR(found[0].centroid.x(), 1.0, 1e-9);   // right of the axis
-  EXPECT_NEAR(found[0].centroid.y(), 2.5, 1e-9);   // 2.5 m below the camera
+  EXPECT_NEAR(found[0].centroid.z(), 6.0, 1e-9);  // depth
+  EXPECT_NEAR(found[0].centroid.x(), 1.0, 1e-9);  // right of the axis
+  EXPECT_NEAR(found[0].centroid.y(), 2.5, 1e-9);  // 2.5 m below the camera
   EXPECT_NEAR(found[0].box.x + found[0].box.width / 2, 375.5 + 458.0 / 6.0, 12.0);
   const CameraPose looking_south{Eigen::Vector3d(0.0, 0.0, 3.0), -M_PI / 2};
-  EXPECT_TRUE(DetectObjects({crate}, scene, camera, looking_south, options, 1).empty());  // behind the camera
+  EXPECT_TRUE(DetectObjects({crate}, scene, camera, looking_south, options, 1).empty());   // behind the camera
   scene.walls.push_back({Eigen::Vector2d(-5.0, 3.0), Eigen::Vector2d(5.0, 3.0), 8.0, 0});  // a building in between
   EXPECT_TRUE(DetectObjects({crate}, scene, camera, looking_north, options, 1).empty());
 }
@@ -139,10 +139,10 @@ TEST(Renderer, DepthImageHoldsWallGroundAndSkyDepths) {
   Renderer renderer(&scene, camera);
   cv::Mat depth;
   renderer.RenderDepth({Eigen::Vector3d(0.0, 0.0, 3.0), M_PI / 2}, &depth);
-  EXPECT_EQ(depth.at<std::uint16_t>(240, 376), 10000);                    // the wall, 10 m away
+  EXPECT_EQ(depth.at<std::uint16_t>(240, 376), 10000);                        // the wall, 10 m away
   const int ground_row = static_cast<int>(std::lround(239.5 + 458.0 * 0.5));  // 3 m down at 6 m
   EXPECT_NEAR(depth.at<std::uint16_t>(ground_row, 376), 6000, 15);
-  EXPECT_EQ(depth.at<std::uint16_t>(0, 376), 0);                          // sky above the 5 m wall
+  EXPECT_EQ(depth.at<std::uint16_t>(0, 376), 0);  // sky above the 5 m wall
 }
 
 TEST(EurocWriter, SameOptionsGiveTheSameLogByteForByte) {
@@ -203,7 +203,7 @@ TEST(EurocWriter, MotionBlurSmearsAlongTheMotion) {
     ASSERT_TRUE(WriteEurocLog(flight, log, options).ok());
     statistics[blurred] = MiddleFrameStatistics(log);
   }
-  EXPECT_LT(statistics[1].first, 0.7 * statistics[0].first);   // much less horizontal detail
+  EXPECT_LT(statistics[1].first, 0.7 * statistics[0].first);     // much less horizontal detail
   EXPECT_NEAR(statistics[1].second, statistics[0].second, 2.0);  // same brightness
 }
 

@@ -84,7 +84,7 @@ TEST(Vocabulary, TreeOnKnownClustersGivesOneWordPerBlob) {
   std::set<std::pair<int, WordId>> pairs;
   std::set<WordId> distinct(words.begin(), words.end());
   for (std::size_t i = 0; i < words.size(); ++i) pairs.insert({labels[i], words[i]});
-  EXPECT_GE(distinct.size(), 12u);       // most blobs get a word of their own ...
+  EXPECT_GE(distinct.size(), 12u);               // most blobs get a word of their own ...
   EXPECT_LE(pairs.size(), distinct.size() + 2);  // ... and a blob hardly ever splits
   for (float idf : vocabulary.idf()) EXPECT_GE(idf, 0.0f);
 }
@@ -124,7 +124,8 @@ TEST(Vocabulary, BadTrainingInputIsRefused) {
   EXPECT_EQ(Vocabulary::Train({}, VocabularyOptions{}, &vocabulary).code(), StatusCode::kInvalidArgument);
   VocabularyOptions options;
   options.branching = 1;
-  EXPECT_EQ(Vocabulary::Train({cv::Mat::ones(3, 4, CV_32F)}, options, &vocabulary).code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(Vocabulary::Train({cv::Mat::ones(3, 4, CV_32F)}, options, &vocabulary).code(),
+            StatusCode::kInvalidArgument);
   EXPECT_EQ(Vocabulary::Train({cv::Mat::ones(3, 4, CV_8U)}, VocabularyOptions{}, &vocabulary).code(),
             StatusCode::kInvalidArgument);
 }
@@ -215,7 +216,8 @@ TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
   EXPECT_EQ(results[1].entry, 1u);
   EXPECT_NEAR(results[1].score, 0.5, 1e-6);
   EXPECT_NEAR(results[1].score, L1Score(query, b), 1e-6);
-  database.Query(query, 3, [](EntryId entry) { return entry != 0; }, &results);
+  database.Query(
+      query, 3, [](EntryId entry) { return entry != 0; }, &results);
   ASSERT_EQ(results.size(), 1u);
   EXPECT_EQ(results[0].entry, 1u);
   database.Query(query, 1, {}, &results);

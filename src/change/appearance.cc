@@ -83,16 +83,20 @@ cv::Mat BestOverShifts(const cv::Mat& a, const cv::Mat& b, int radius, bool larg
       const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
       cv::warpAffine(b, shifted, m, b.size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
       const cv::Mat value = measure(a, shifted);
-      if (best.empty()) best = value.clone();
-      else best = larger_is_better ? cv::max(best, value) : cv::min(best, value);
+      if (best.empty())
+        best = value.clone();
+      else
+        best = larger_is_better ? cv::max(best, value) : cv::min(best, value);
     }
   }
   return best;
 }
 
 cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const cv::Size& prior_size) {
-  std::vector<cv::Point2f> corners = {box.tl(), {static_cast<float>(box.br().x), static_cast<float>(box.y)},
-                                      box.br(), {static_cast<float>(box.x), static_cast<float>(box.br().y)}};
+  std::vector<cv::Point2f> corners = {box.tl(),
+                                      {static_cast<float>(box.br().x), static_cast<float>(box.y)},
+                                      box.br(),
+                                      {static_cast<float>(box.x), static_cast<float>(box.br().y)}};
   std::vector<cv::Point2f> mapped;
   cv::perspectiveTransform(corners, mapped, current_from_prior.inv());
   return cv::boundingRect(mapped) & cv::Rect(0, 0, prior_size.width, prior_size.height);
@@ -103,7 +107,8 @@ cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const 
 // showed a little further on (parallax off the registered plane).
 double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv::Rect& box, int radius) {
   const cv::Rect image(0, 0, current.cols, current.rows);
-  const cv::Rect search = cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) & image;
+  const cv::Rect search =
+      cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) & image;
   if (box.width < 3 || box.height < 3 || search.width < box.width || search.height < box.height) return 0.0;
   cv::Mat scores;
   cv::matchTemplate(prior(search), current(box), scores, cv::TM_CCOEFF_NORMED);

@@ -90,7 +90,10 @@ void MergeOverlapping(double tolerance, std::vector<Region>* regions) {
         Region& ra = (*regions)[a];
         Region& rb = (*regions)[b];
         if (!ra.alive || !rb.alive || !Overlap(ra.data, rb.data, tolerance)) continue;
-        if (ra.data.voxels >= rb.data.voxels) Absorb(&ra, &rb); else Absorb(&rb, &ra);
+        if (ra.data.voxels >= rb.data.voxels)
+          Absorb(&ra, &rb);
+        else
+          Absorb(&rb, &ra);
         merged = true;
       }
     }
@@ -186,7 +189,8 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
 
 void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose) {
   constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
-  const int step = std::max(1, static_cast<int>(std::lround(static_cast<double>(depth_m.cols) / options_.rays_per_row)));
+  const int step =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(depth_m.cols) / options_.rays_per_row)));
   for (int y = step / 2; y < depth_m.rows; y += step) {
     const float* row = depth_m.ptr<float>(y);
     for (int x = step / 2; x < depth_m.cols; x += step) {

@@ -12,10 +12,10 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kPairDistance = 0.25;      // point-pair test between patrols [m]
+constexpr double kPairDistance = 0.25;  // point-pair test between patrols [m]
 constexpr double kMinPairFraction = 0.5;
 constexpr double kMovedPairDistance = 0.15;  // point-pair test of a moved object's shape [m]
-constexpr double kMinClearance = 1.0;       // voxels this close to an object do not hide it, nor within its half size [m]
+constexpr double kMinClearance = 1.0;  // voxels this close to an object do not hide it, nor within its half size [m]
 
 bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
   return IsOccupied(FindVoxel(grid, VoxelIndex(point, grid.voxel_size)));
@@ -33,7 +33,8 @@ bool Hidden(const EvidenceGridData& grid, const Eigen::Vector3d& from, const Eig
     const Eigen::Vector3d point = from + s * direction;
     if (!Occupied(grid, point)) continue;
     const bool inside = std::any_of(see_through.begin(), see_through.end(), [&point](const MapObject* o) {
-      return (point.array() >= o->box_min.array() - kBoxMargin).all() && (point.array() <= o->box_max.array() + kBoxMargin).all();
+      return (point.array() >= o->box_min.array() - kBoxMargin).all() &&
+             (point.array() <= o->box_max.array() + kBoxMargin).all();
     });
     if (!inside) return true;
   }
@@ -77,7 +78,8 @@ Eigen::Vector3d MeanOf(const std::vector<Eigen::Vector3f>& points) {
 Eigen::Matrix3d SignedAxes(const std::vector<Eigen::Vector3f>& points) {
   const Eigen::Vector3d mean = MeanOf(points);
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Eigen::Vector3f& p : points) covariance += (p.cast<double>() - mean) * (p.cast<double>() - mean).transpose();
+  for (const Eigen::Vector3f& p : points)
+    covariance += (p.cast<double>() - mean) * (p.cast<double>() - mean).transpose();
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance, Eigen::ComputeFullU);
   Eigen::Matrix3d axes = svd.matrixU();
   for (int k = 0; k < 3; ++k) {
@@ -149,7 +151,8 @@ bool ParseObjectState(const std::string& text, ObjectState* state) {
   return false;
 }
 
-Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before, const std::vector<Eigen::Vector3f>& after) {
+Eigen::Matrix3d RegisterRotation(const std::vector<Eigen::Vector3f>& before,
+                                 const std::vector<Eigen::Vector3f>& after) {
   if (before.size() < 10 || after.size() < 10) return Eigen::Matrix3d::Identity();
   Eigen::Matrix3d rotation = SignedAxes(after) * SignedAxes(before).transpose();
   if (rotation.determinant() < 0) {  // a reflection: flip the least certain axis
@@ -192,15 +195,22 @@ struct Matching {
   const std::vector<MapObject>& p;
   const std::vector<MapObject>& c;
   std::vector<bool> prior_used, current_used;
-  std::vector<int> views;         // covering views of each prior object (those not persistent) ...
-  std::vector<double> expected;   // ... and the detections they would have given
+  std::vector<int> views;                      // covering views of each prior object (those not persistent) ...
+  std::vector<double> expected;                // ... and the detections they would have given
   std::vector<double> prior_top, current_top;  // 95th percentile of the points' height; 0 without points
   std::vector<std::pair<int, int>> movable;    // (prior, current) pairs that may be one object moved
 };
 
 Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
-  Matching m{prior.objects, current.objects, std::vector<bool>(prior.objects.size(), false),
-             std::vector<bool>(current.objects.size(), false), {}, {}, {}, {}, {}};
+  Matching m{prior.objects,
+             current.objects,
+             std::vector<bool>(prior.objects.size(), false),
+             std::vector<bool>(current.objects.size(), false),
+             {},
+             {},
+             {},
+             {},
+             {}};
   for (const MapObject& o : m.p) m.prior_top.push_back(PointQuantile(o.points, 2, 0.95));
   for (const MapObject& o : m.c) m.current_top.push_back(PointQuantile(o.points, 2, 0.95));
   return m;
@@ -217,7 +227,8 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
       // Paper 000's point-pair test, from the object seen less (a partial view lies on the fuller one).
       const bool b_smaller = b.points.size() <= a.points.size();
       if (!a.points.empty() && !b.points.empty() &&
-          PairFraction(b_smaller ? b.points : a.points, b_smaller ? a.points : b.points, kPairDistance) < kMinPairFraction) {
+          PairFraction(b_smaller ? b.points : a.points, b_smaller ? a.points : b.points, kPairDistance) <
+              kMinPairFraction) {
         continue;
       }
       close.push_back({static_cast<int>(i), static_cast<int>(j), distance});
@@ -227,7 +238,8 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
   for (const Pair& pair : persistent) {
     const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
     if (!a.confirmed && !b.confirmed) continue;
-    const double confidence = std::min(a.confidence, b.confidence) * (1.0 - pair.cost / (2.0 * options.match_distance_m));
+    const double confidence =
+        std::min(a.confidence, b.confidence) * (1.0 - pair.cost / (2.0 * options.match_distance_m));
     changes->push_back(MakeChange(ObjectState::kPersistent, &a, &b, confidence));
   }
 }
@@ -284,7 +296,8 @@ std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matchin
     return *hi - *lo > 1e-12 ? (values[k] - *lo) / (*hi - *lo) : 0.0;
   };
   for (std::size_t k = 0; k < candidates.size(); ++k) {
-    candidates[k].cost = options.physical_weight * normalise(physical, k) + options.appearance_weight * normalise(appearance, k);
+    candidates[k].cost =
+        options.physical_weight * normalise(physical, k) + options.appearance_weight * normalise(appearance, k);
   }
   return candidates;
 }
@@ -294,8 +307,9 @@ void MatchMoved(const ObjectDiffOptions& options, Matching* m, std::vector<Objec
   AssignGreedy(MoveCandidates(options, *m), &m->prior_used, &m->current_used, &moved);
   for (const Pair& pair : moved) {
     const MapObject &a = m->p[pair.prior], &b = m->c[pair.current];
-    ObjectChange change = MakeChange(ObjectState::kMoved, &a, &b, std::min(a.confidence, b.confidence) * (1.0 - 0.5 * pair.cost),
-                                     m->views[pair.prior]);
+    ObjectChange change =
+        MakeChange(ObjectState::kMoved, &a, &b, std::min(a.confidence, b.confidence) * (1.0 - 0.5 * pair.cost),
+                   m->views[pair.prior]);
     change.expected_detections = m->expected[pair.prior];
     change.weighted_distance = pair.cost;
     change.rotation = RegisterRotation(a.points, b.points);
@@ -317,8 +331,8 @@ std::vector<ObjectChange> DiffObjects(const PatrolRecord& prior, const PatrolRec
     // The chance that the object, still in place, would have been detected: 1 - exp(-expected detections).
     const bool seen = m.expected[i] >= options.min_expected_detections;
     const double confidence = m.p[i].confidence * (seen ? 1.0 - std::exp(-m.expected[i]) : 1.0);
-    ObjectChange change = MakeChange(seen ? ObjectState::kRemoved : ObjectState::kUnobserved, &m.p[i], nullptr,
-                                     confidence, m.views[i]);
+    ObjectChange change =
+        MakeChange(seen ? ObjectState::kRemoved : ObjectState::kUnobserved, &m.p[i], nullptr, confidence, m.views[i]);
     change.expected_detections = m.expected[i];
     changes.push_back(change);
   }

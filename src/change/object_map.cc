@@ -17,7 +17,9 @@ struct PointCloud {
   std::size_t kdtree_get_point_count() const { return points->size(); }
   float kdtree_get_pt(std::size_t i, std::size_t axis) const { return (*points)[i][static_cast<int>(axis)]; }
   template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
 };
 using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointCloud>, PointCloud, 3>;
 
@@ -107,7 +109,9 @@ void VoxelFilter(double voxel, std::vector<Eigen::Vector3f>* points) {
   std::unordered_set<std::uint64_t> occupied;
   occupied.reserve(points->size());
   const auto key = [voxel](const Eigen::Vector3f& p) {
-    const auto cell = [voxel](float v) { return static_cast<std::uint64_t>(std::floor(v / voxel) + (1 << 20)) & 0x1fffff; };
+    const auto cell = [voxel](float v) {
+      return static_cast<std::uint64_t>(std::floor(v / voxel) + (1 << 20)) & 0x1fffff;
+    };
     return cell(p.x()) << 42 | cell(p.y()) << 21 | cell(p.z());
   };
   const auto end = std::remove_if(points->begin(), points->end(),
@@ -198,20 +202,22 @@ bool ObjectMapper::Measure(const ObjectObservation& detection, const CameraPoseS
   double z = detection.centroid_camera ? detection.centroid_camera->z() : 0.0;
   if (!detection.centroid_camera && has_depth) z = CentralDepth(depth_m, box);
   if (!(z > 0.0) || z > options_.max_range_m) return false;
-  const Eigen::Vector3d in_camera =
-      detection.centroid_camera ? *detection.centroid_camera
-                                : Eigen::Vector3d((box.x + box.width / 2.0 - camera_.cx) / camera_.fx * z,
-                                                  (box.y + box.height / 2.0 - camera_.cy) / camera_.fy * z, z);
+  const Eigen::Vector3d in_camera = detection.centroid_camera
+                                        ? *detection.centroid_camera
+                                        : Eigen::Vector3d((box.x + box.width / 2.0 - camera_.cx) / camera_.fx * z,
+                                                          (box.y + box.height / 2.0 - camera_.cy) / camera_.fy * z, z);
   measured->centroid = pose.ToWorld(in_camera);
   measured->size = Eigen::Vector2d(box.width * z / camera_.fx, box.height * z / camera_.fy);
   measured->points.clear();
   // The object's points: depth pixels within its half size of the 3D centroid's depth, or without a
   // centroid within segment_depth_m of its visible surface (the box centre's median depth).
   const double half_size = 0.5 * std::max(measured->size.x(), measured->size.y());
-  const double reach = detection.centroid_camera ? std::max(options_.segment_depth_m, half_size) : options_.segment_depth_m;
+  const double reach =
+      detection.centroid_camera ? std::max(options_.segment_depth_m, half_size) : options_.segment_depth_m;
   const double surface = detection.centroid_camera ? in_camera.z() : (has_depth ? CentralDepth(depth_m, box) : 0.0);
   if (has_depth && surface > 0.0) {
-    const int step = std::max(1, static_cast<int>(std::sqrt(box.area() / static_cast<double>(options_.max_segment_samples))));
+    const int step =
+        std::max(1, static_cast<int>(std::sqrt(box.area() / static_cast<double>(options_.max_segment_samples))));
     for (int y = box.y; y < box.br().y; y += step) {
       const float* row = depth_m.ptr<float>(y);
       for (int x = box.x; x < box.br().x; x += step) {
@@ -248,8 +254,8 @@ double ObjectMapper::SurfaceAgreement(const MapObject& object, const cv::Rect2d&
   return seen > 0 ? static_cast<double>(agree) / seen : 0.0;
 }
 
-int ObjectMapper::Associate(const ObjectObservation& detection, const Measured& measured,
-                            const CameraPoseSample& pose, const cv::Mat& depth_m) const {
+int ObjectMapper::Associate(const ObjectObservation& detection, const Measured& measured, const CameraPoseSample& pose,
+                            const cv::Mat& depth_m) const {
   int best = -1;
   double best_score = 0.0;
   for (std::size_t i = 0; i < objects_.size(); ++i) {

@@ -60,8 +60,9 @@ void CheckGrid(const EvidenceGridOptions& g, OptionCheck* check) {
 }
 
 void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
-  check->Holds("change.geometry.min_occupancy_change", g.min_occupancy_change,
-               g.min_occupancy_change > 0.0 && g.min_occupancy_change < 1.0, "must be a number in (0, 1)")
+  check
+      ->Holds("change.geometry.min_occupancy_change", g.min_occupancy_change,
+              g.min_occupancy_change > 0.0 && g.min_occupancy_change < 1.0, "must be a number in (0, 1)")
       .InRange("change.geometry.max_free_occupancy", g.max_free_occupancy, 0.0, 1.0)
       .InRange("change.geometry.min_observations", g.min_observations, 1, 1000000)
       .InRange("change.geometry.surface_tolerance_voxels", g.surface_tolerance_voxels, 0, 10)

@@ -24,8 +24,11 @@ json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
   const AppearanceChange& a = place.appearance;
   json regions = json::array();
   for (const AppearanceRegion& r : a.regions) {
-    regions.push_back({{"current_box", Box(r.current_box)}, {"prior_box", Box(r.prior_box)}, {"area_px", r.area_px},
-                       {"score", r.score}, {"prior_features", r.prior_features},
+    regions.push_back({{"current_box", Box(r.current_box)},
+                       {"prior_box", Box(r.prior_box)},
+                       {"area_px", r.area_px},
+                       {"score", r.score},
+                       {"prior_features", r.prior_features},
                        {"unmatched_prior_features", r.unmatched_prior_features},
                        {"current_features", r.current_features},
                        {"unmatched_current_features", r.unmatched_current_features}});
@@ -44,9 +47,12 @@ json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
 }
 
 json ObjectJson(const ObjectChange& o) {
-  json object = {{"state", ToString(o.state)},     {"label", o.label},
-                 {"confidence", o.confidence},     {"prior_id", o.prior_id},
-                 {"current_id", o.current_id},     {"covering_views", o.covering_views},
+  json object = {{"state", ToString(o.state)},
+                 {"label", o.label},
+                 {"confidence", o.confidence},
+                 {"prior_id", o.prior_id},
+                 {"current_id", o.current_id},
+                 {"covering_views", o.covering_views},
                  {"expected_detections", o.expected_detections},
                  {"before", o.before ? Vector(*o.before) : json(nullptr)},
                  {"after", o.after ? Vector(*o.after) : json(nullptr)}};
@@ -60,8 +66,13 @@ json ObjectJson(const ObjectChange& o) {
 json GeometryJson(const GeometryChange& g) {
   json regions = json::array();
   for (const GeometryRegion& r : g.regions) {
-    regions.push_back({{"centroid", Vector(r.centroid)}, {"box_min", Vector(r.box_min)}, {"box_max", Vector(r.box_max)},
-                       {"voxels", r.voxels}, {"appeared", r.appeared}, {"vanished", r.vanished}, {"score", r.score}});
+    regions.push_back({{"centroid", Vector(r.centroid)},
+                       {"box_min", Vector(r.box_min)},
+                       {"box_max", Vector(r.box_max)},
+                       {"voxels", r.voxels},
+                       {"appeared", r.appeared},
+                       {"vanished", r.vanished},
+                       {"score", r.score}});
   }
   return {{"voxel_size", g.voxel_size},
           {"compared_voxels", g.compared_voxels},
@@ -149,8 +160,8 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map) {
 }  // namespace
 
 int ChangeReport::ChangedPlaces() const {
-  return static_cast<int>(std::count_if(places.begin(), places.end(),
-                                        [](const PlaceChange& p) { return !p.appearance.regions.empty(); }));
+  return static_cast<int>(
+      std::count_if(places.begin(), places.end(), [](const PlaceChange& p) { return !p.appearance.regions.empty(); }));
 }
 
 int ChangeReport::ObjectsIn(ObjectState state) const {
@@ -177,7 +188,8 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map) {
         {"objects", report.objects_compared ? counts : json(nullptr)},
         {"geometry_regions", report.geometry_compared ? json(report.geometry.regions.size()) : json(nullptr)}}},
       {"timing_s",
-       {{"appearance", report.seconds_appearance}, {"objects", report.seconds_objects},
+       {{"appearance", report.seconds_appearance},
+        {"objects", report.seconds_objects},
         {"geometry", report.seconds_geometry}}},
       {"places", places},
       {"objects", report.objects_compared ? objects : json(nullptr)},
@@ -187,8 +199,8 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map) {
 
 std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
   std::ostringstream html;
-  const std::string title = "Changes from " + graph::EscapeXml(report.prior_flight) + " to " +
-                            graph::EscapeXml(report.current_flight);
+  const std::string title =
+      "Changes from " + graph::EscapeXml(report.prior_flight) + " to " + graph::EscapeXml(report.current_flight);
   html << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << title
        << "</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
           "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}img{margin:4px;border:1px solid #888}"
@@ -222,7 +234,8 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
     html << "<div class='place'><p>node " << place.prior_node << " (frame " << map.node(place.prior_node).frame_index
          << ") &rarr; node " << place.current_node << " (frame " << map.node(place.current_node).frame_index << "), "
          << place.appearance.regions.size() << " region(s), best score " << Number(place.appearance.regions[0].score)
-         << "</p><img alt='prior' src='" << graph::PngDataUri(Outlined(map.node(place.prior_node).thumbnail, prior_boxes))
+         << "</p><img alt='prior' src='"
+         << graph::PngDataUri(Outlined(map.node(place.prior_node).thumbnail, prior_boxes))
          << "'><img alt='current' src='"
          << graph::PngDataUri(Outlined(map.node(place.current_node).thumbnail, current_boxes)) << "'></div>\n";
   }

@@ -76,7 +76,9 @@ double ChangeDistance(const ReportedObject& r, const TruthChange& t) {
   return distance;
 }
 
-double Ratio(int numerator, int denominator) { return denominator > 0 ? static_cast<double>(numerator) / denominator : 0.0; }
+double Ratio(int numerator, int denominator) {
+  return denominator > 0 ? static_cast<double>(numerator) / denominator : 0.0;
+}
 
 }  // namespace
 
@@ -136,8 +138,9 @@ double GeometryScore::Iou() const {
   return Ratio(voxels.true_positives, voxels.true_positives + voxels.false_positives + voxels.false_negatives);
 }
 
-ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported, const std::vector<TruthObject>& before,
-                                     const std::vector<TruthObject>& after, const ChangeScoreOptions& options) {
+ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported,
+                                     const std::vector<TruthObject>& before, const std::vector<TruthObject>& after,
+                                     const ChangeScoreOptions& options) {
   ObjectChangeScore score;
   const std::vector<TruthChange> truth = TruthChanges(before, after, options.min_detections);
   for (const char* state : {"persistent", "new", "removed", "moved"}) {
@@ -157,7 +160,8 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
         if (d <= options.distance_m) candidates.push_back({d, r, t});
       }
     }
-    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
     std::vector<bool> r_used(reported.size()), t_used(truth.size());
     Counts& counts = score.by_state[state];
     int optional_matches = 0;
@@ -262,7 +266,8 @@ void KeepInOverlap(const Eigen::Matrix3d& to_other, int width, int height, std::
 double AppearanceScore::Precision() const { return Ratio(regions_on_change, regions); }
 double AppearanceScore::Recall() const { return Ratio(changes_found, changes); }
 
-AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth, const std::vector<std::vector<RegionBoxes>>& regions,
+AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
+                                const std::vector<std::vector<RegionBoxes>>& regions,
                                 const ChangeScoreOptions& options) {
   AppearanceScore score;
   for (std::size_t p = 0; p < truth.size() && p < regions.size(); ++p) {
@@ -272,15 +277,16 @@ AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth, const std:
     };
     for (const RegionBoxes& r : regions[p]) {
       ++score.regions;
-      const bool hit = std::any_of(t.prior.begin(), t.prior.end(), [&](const cv::Rect2d& b) { return on(r, b, true); }) ||
-                       std::any_of(t.current.begin(), t.current.end(), [&](const cv::Rect2d& b) { return on(r, b, false); });
+      const bool hit =
+          std::any_of(t.prior.begin(), t.prior.end(), [&](const cv::Rect2d& b) { return on(r, b, true); }) ||
+          std::any_of(t.current.begin(), t.current.end(), [&](const cv::Rect2d& b) { return on(r, b, false); });
       score.regions_on_change += hit;
     }
     for (const bool prior : {true, false}) {
       for (const cv::Rect2d& box : prior ? t.prior : t.current) {
         ++score.changes;
-        score.changes_found += std::any_of(regions[p].begin(), regions[p].end(),
-                                           [&](const RegionBoxes& r) { return on(r, box, prior); });
+        score.changes_found +=
+            std::any_of(regions[p].begin(), regions[p].end(), [&](const RegionBoxes& r) { return on(r, box, prior); });
       }
     }
   }

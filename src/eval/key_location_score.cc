@@ -10,9 +10,7 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-ExtremumKind KindAfter(const TruthEdge& edge) {
-  return edge.opening ? ExtremumKind::kValley : ExtremumKind::kPeak;
-}
+ExtremumKind KindAfter(const TruthEdge& edge) { return edge.opening ? ExtremumKind::kValley : ExtremumKind::kPeak; }
 
 double Centre(const ExpectedSpan& span) {
   if (std::isinf(span.start_s)) return span.end_s;
@@ -47,7 +45,8 @@ std::vector<TruthEdge> MergeShortSpans(std::vector<TruthEdge> edges, double min_
   while (edges.size() >= 2) {
     std::size_t shortest = 0;
     for (std::size_t i = 1; i + 1 < edges.size(); ++i) {
-      if (edges[i + 1].timestamp_ns - edges[i].timestamp_ns < edges[shortest + 1].timestamp_ns - edges[shortest].timestamp_ns) {
+      if (edges[i + 1].timestamp_ns - edges[i].timestamp_ns <
+          edges[shortest + 1].timestamp_ns - edges[shortest].timestamp_ns) {
         shortest = i;
       }
     }
@@ -66,8 +65,8 @@ std::vector<ExpectedSpan> ExpectedSpans(const std::vector<TruthEdge>& raw_edges,
   const ExtremumKind before_first = edges.front().opening ? ExtremumKind::kPeak : ExtremumKind::kValley;
   spans.push_back({-kInfinity, NsToSeconds(edges.front().timestamp_ns), before_first, false});
   for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
-    spans.push_back({NsToSeconds(edges[i].timestamp_ns), NsToSeconds(edges[i + 1].timestamp_ns), KindAfter(edges[i]),
-                     true});
+    spans.push_back(
+        {NsToSeconds(edges[i].timestamp_ns), NsToSeconds(edges[i + 1].timestamp_ns), KindAfter(edges[i]), true});
   }
   spans.push_back({NsToSeconds(edges.back().timestamp_ns), kInfinity, KindAfter(edges.back()), false});
   return spans;

@@ -75,7 +75,8 @@ LoopClosureScore ScoreLoopClosures(const std::vector<NodeRecord>& nodes, const s
 }
 
 Status ReadPlaces(const std::string& log, std::vector<Place>* places_by_frame) {
-  const auto parse = [places_by_frame](const CsvReader& csv, const std::vector<std::string_view>& fields, Place* place) {
+  const auto parse = [places_by_frame](const CsvReader& csv, const std::vector<std::string_view>& fields,
+                                       Place* place) {
     if (fields.size() < 6) return csv.Error("expected 6 columns");
     std::int64_t frame = 0;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[1], "frame_index", &frame));

@@ -14,8 +14,7 @@ float Median(std::vector<float>* values) {
   return (*values)[values->size() / 2];
 }
 
-void SelectInCell(const cv::Mat& edges, const cv::Rect& cell, int quota,
-                  std::vector<cv::Point2f>* points) {
+void SelectInCell(const cv::Mat& edges, const cv::Rect& cell, int quota, std::vector<cv::Point2f>* points) {
   const int count = cv::countNonZero(edges(cell));
   if (count == 0 || quota <= 0) return;
   const int stride = std::max(1, count / quota);
@@ -68,8 +67,8 @@ void EdgeFlowTracker::Reset() {
 int EdgeFlowTracker::CellOf(const cv::Point2f& point, const cv::Size& size) const {
   const int column = std::clamp(static_cast<int>(point.x * edge_options_.grid_columns / size.width), 0,
                                 edge_options_.grid_columns - 1);
-  const int row = std::clamp(static_cast<int>(point.y * edge_options_.grid_rows / size.height), 0,
-                             edge_options_.grid_rows - 1);
+  const int row =
+      std::clamp(static_cast<int>(point.y * edge_options_.grid_rows / size.height), 0, edge_options_.grid_rows - 1);
   return row * edge_options_.grid_columns + column;
 }
 
@@ -105,12 +104,12 @@ void EdgeFlowTracker::Track(const cv::Mat& image, std::vector<FlowVector>* vecto
   cv::buildOpticalFlowPyramid(image, current_pyramid_, window, tracker_options_.pyramid_levels);
   last_point_count_ = static_cast<int>(previous_points_.size());
   if (!previous_points_.empty()) {
-    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                    tracker_options_.max_iterations, tracker_options_.epsilon);
+    const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, tracker_options_.max_iterations,
+                                    tracker_options_.epsilon);
     const bool predict = tracker_options_.predict_from_previous && has_prediction_;
     if (predict) PredictPositions(image.size());
-    cv::calcOpticalFlowPyrLK(previous_pyramid_, current_pyramid_, previous_points_, tracked_points_,
-                             track_status_, track_errors_, window, tracker_options_.pyramid_levels, criteria,
+    cv::calcOpticalFlowPyrLK(previous_pyramid_, current_pyramid_, previous_points_, tracked_points_, track_status_,
+                             track_errors_, window, tracker_options_.pyramid_levels, criteria,
                              predict ? cv::OPTFLOW_USE_INITIAL_FLOW : 0, tracker_options_.min_eigen_threshold);
     if (tracker_options_.max_forward_backward_px > 0.0) CheckForwardBackward(criteria);
     for (std::size_t i = 0; i < previous_points_.size(); ++i) {
@@ -138,8 +137,8 @@ void EdgeFlowTracker::CheckForwardBackward(const cv::TermCriteria& criteria) {
   }
 }
 
-Eigen::Matrix3d IntegrateGyro(const std::vector<ImuSample>& samples, TimestampNs start_ns,
-                              TimestampNs end_ns, const Eigen::Matrix3d& camera_from_imu) {
+Eigen::Matrix3d IntegrateGyro(const std::vector<ImuSample>& samples, TimestampNs start_ns, TimestampNs end_ns,
+                              const Eigen::Matrix3d& camera_from_imu) {
   Eigen::Matrix3d earlier_from_later = Eigen::Matrix3d::Identity();
   TimestampNs previous_ns = start_ns;
   for (const ImuSample& sample : samples) {

@@ -36,8 +36,11 @@ bool CheckedOptions(const KeyLocationOptions& options) {
 }  // namespace
 
 KeyLocationDetector::KeyLocationDetector(const KeyLocationOptions& options, const CameraContext& context)
-    : options_(options), context_(context), timing_(ResolveFrameTiming(options, context.frame_rate_hz)),
-      tracker_(options.edges, options.tracker), smoother_(timing_.window, options.smoothing.mode),
+    : options_(options),
+      context_(context),
+      timing_(ResolveFrameTiming(options, context.frame_rate_hz)),
+      tracker_(options.edges, options.tracker),
+      smoother_(timing_.window, options.smoothing.mode),
       extrema_(options.extrema) {
   PATROLMAP_CHECK(CheckedOptions(options));
   derotate_ = options.response.derotate_with_imu && context.camera && context.camera_from_imu;

@@ -73,21 +73,25 @@ const char* ToString(ResponseQuantity quantity) {
   return quantity == ResponseQuantity::kLength ? "length" : "line_parameter";
 }
 
-const char* ToString(SmoothingMode mode) {
-  return mode == SmoothingMode::kCentered ? "centered" : "causal";
-}
+const char* ToString(SmoothingMode mode) { return mode == SmoothingMode::kCentered ? "centered" : "causal"; }
 
 bool ParseResponseQuantity(const std::string& text, ResponseQuantity* quantity) {
-  if (text == "length") *quantity = ResponseQuantity::kLength;
-  else if (text == "line_parameter") *quantity = ResponseQuantity::kLineParameter;
-  else return false;
+  if (text == "length")
+    *quantity = ResponseQuantity::kLength;
+  else if (text == "line_parameter")
+    *quantity = ResponseQuantity::kLineParameter;
+  else
+    return false;
   return true;
 }
 
 bool ParseSmoothingMode(const std::string& text, SmoothingMode* mode) {
-  if (text == "centered") *mode = SmoothingMode::kCentered;
-  else if (text == "causal") *mode = SmoothingMode::kCausal;
-  else return false;
+  if (text == "centered")
+    *mode = SmoothingMode::kCentered;
+  else if (text == "causal")
+    *mode = SmoothingMode::kCausal;
+  else
+    return false;
   return true;
 }
 

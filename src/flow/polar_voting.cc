@@ -15,8 +15,7 @@ PolarVector ToPolar(const FlowVector& vector) {
   return polar;
 }
 
-HysteresisVoter::HysteresisVoter(const VotingOptions& options, int image_width, int image_height)
-    : options_(options) {
+HysteresisVoter::HysteresisVoter(const VotingOptions& options, int image_width, int image_height) : options_(options) {
   PATROLMAP_CHECK(image_width > 0 && image_height > 0);
   PATROLMAP_CHECK(options.max_votes <= 255);
   // |r| never exceeds the distance of the far image corner from the origin.
@@ -70,8 +69,10 @@ void HysteresisVoter::UpdateCells() {
     int vote = votes_[cell] + (observed_[cell] ? 1 : -1);
     vote = std::clamp(vote, 0, ceiling);
     votes_[cell] = static_cast<std::uint8_t>(vote);
-    if (!accepted_[cell] && vote >= options_.accept) accepted_[cell] = 1;
-    else if (accepted_[cell] && vote < options_.reject) accepted_[cell] = 0;
+    if (!accepted_[cell] && vote >= options_.accept)
+      accepted_[cell] = 1;
+    else if (accepted_[cell] && vote < options_.reject)
+      accepted_[cell] = 0;
   }
 }
 

@@ -83,9 +83,12 @@ void ExtremumDetector::Add(const FlowSample& sample, std::vector<KeyLocation>* e
   const double candidate = candidate_.smoothed_response;
   switch (trend_) {
     case Trend::kUnknown:
-      if (value >= candidate + change) trend_ = Trend::kRising;
-      else if (value <= candidate - change) trend_ = Trend::kFalling;
-      else return;
+      if (value >= candidate + change)
+        trend_ = Trend::kRising;
+      else if (value <= candidate - change)
+        trend_ = Trend::kFalling;
+      else
+        return;
       candidate_ = sample;
       return;
     case Trend::kRising:

@@ -16,7 +16,6 @@ std::string Precise(double value) {
   return buffer;
 }
 
-
 }  // namespace
 
 std::string EscapeXml(const std::string& text) {
@@ -37,8 +36,8 @@ std::string Base64(const std::vector<unsigned char>& bytes) {
   static const char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const unsigned value = (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) |
-                           (i + 2 < bytes.size() ? bytes[i + 2] : 0);
+    const unsigned value =
+        (bytes[i] << 16) | ((i + 1 < bytes.size() ? bytes[i + 1] : 0) << 8) | (i + 2 < bytes.size() ? bytes[i + 2] : 0);
     out += kAlphabet[(value >> 18) & 63];
     out += kAlphabet[(value >> 12) & 63];
     out += i + 1 < bytes.size() ? kAlphabet[(value >> 6) & 63] : '=';
@@ -65,11 +64,16 @@ std::string EscapeDot(const std::string& text) {
 }
 
 void GraphMLKeys(std::ostringstream* out) {
-  const char* keys[][4] = {{"flight", "node", "string", "flight"},       {"time", "node", "long", "timestamp_ns"},
-                           {"frame", "node", "long", "frame_index"},     {"lat", "node", "double", "latitude"},
-                           {"lon", "node", "double", "longitude"},       {"x", "node", "double", "x"},
-                           {"y", "node", "double", "y"},                 {"kind", "edge", "string", "kind"},
-                           {"bow", "edge", "double", "bow_score"},       {"frac", "edge", "double", "matched_fraction"},
+  const char* keys[][4] = {{"flight", "node", "string", "flight"},
+                           {"time", "node", "long", "timestamp_ns"},
+                           {"frame", "node", "long", "frame_index"},
+                           {"lat", "node", "double", "latitude"},
+                           {"lon", "node", "double", "longitude"},
+                           {"x", "node", "double", "x"},
+                           {"y", "node", "double", "y"},
+                           {"kind", "edge", "string", "kind"},
+                           {"bow", "edge", "double", "bow_score"},
+                           {"frac", "edge", "double", "matched_fraction"},
                            {"inl", "edge", "int", "inliers"}};
   for (const auto& key : keys) {
     *out << "  <key id=\"" << key[0] << "\" for=\"" << key[1] << "\" attr.name=\"" << key[3] << "\" attr.type=\""
@@ -89,7 +93,9 @@ std::string ToGraphML(const TopoMap& map) {
     const NodeData& n = map.node(i);
     out << "    <node id=\"n" << i << "\"><data key=\"flight\">" << EscapeXml(n.flight) << "</data><data key=\"time\">"
         << n.timestamp_ns << "</data><data key=\"frame\">" << n.frame_index << "</data>";
-    if (n.gps) out << "<data key=\"lat\">" << Precise(n.gps->x()) << "</data><data key=\"lon\">" << Precise(n.gps->y()) << "</data>";
+    if (n.gps)
+      out << "<data key=\"lat\">" << Precise(n.gps->x()) << "</data><data key=\"lon\">" << Precise(n.gps->y())
+          << "</data>";
     out << "<data key=\"x\">" << Precise(n.layout.x()) << "</data><data key=\"y\">" << Precise(n.layout.y())
         << "</data></node>\n";
   }
@@ -196,13 +202,15 @@ std::string ToGeoJson(const TopoMap& map) {
   }
   for (const TopoMap::Edge& e : map.Edges()) {
     if (e.data.kind != EdgeKind::kLoopClosure || !map.node(e.a).gps || !map.node(e.b).gps) continue;
-    features.push_back({{"type", "Feature"},
-                        {"geometry", {{"type", "LineString"}, {"coordinates", {LonLat(map.node(e.a)), LonLat(map.node(e.b))}}}},
-                        {"properties", {{"kind", "loop_closure"}, {"query_node", e.a}, {"matched_node", e.b},
-                                        {"inliers", e.data.inliers}}}});
+    features.push_back(
+        {{"type", "Feature"},
+         {"geometry", {{"type", "LineString"}, {"coordinates", {LonLat(map.node(e.a)), LonLat(map.node(e.b))}}}},
+         {"properties",
+          {{"kind", "loop_closure"}, {"query_node", e.a}, {"matched_node", e.b}, {"inliers", e.data.inliers}}}});
   }
   return nlohmann::json({{"type", "FeatureCollection"}, {"features", features}})
-             .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+             .dump(1, ' ', false, nlohmann::json::error_handler_t::replace) +
+         "\n";
 }
 
 std::string ToKml(const TopoMap& map) {
@@ -254,7 +262,8 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
       colour = correct ? "#16a34a" : "#dc2626";
     }
     out << "<line x1='" << x(e.a) << "' y1='" << y(e.a) << "' x2='" << x(e.b) << "' y2='" << y(e.b) << "' stroke='"
-        << colour << "' stroke-width='" << (closure ? 2 : 3) << "'" << (closure ? " stroke-dasharray='6 4'" : "") << "/>\n";
+        << colour << "' stroke-width='" << (closure ? 2 : 3) << "'" << (closure ? " stroke-dasharray='6 4'" : "")
+        << "/>\n";
   }
   for (const auto& [a, b] : truth != nullptr ? truth->missed : std::vector<std::pair<int, int>>{}) {
     out << "<line x1='" << x(a) << "' y1='" << y(a) << "' x2='" << x(b) << "' y2='" << y(b)
@@ -263,16 +272,16 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
   for (int i = 0; i < map.node_count(); ++i) {
     const std::size_t flight = std::find(flights.begin(), flights.end(), map.node(i).flight) - flights.begin();
     out << "<circle class='node' data-node='" << i << "' cx='" << x(i) << "' cy='" << y(i) << "' r='6' fill='"
-        << colours[flight % 5] << "'/><text x='" << x(i)
-        << "' y='" << y(i) << "' dx='8' dy='-8' font-size='11'>" << i << "</text>\n";
-  }
-  for (std::size_t f = 0; f < flights.size(); ++f) {
-    out << "<text x='10' y='" << 18 + 16 * f << "' font-size='12' fill='" << colours[f % 5] << "'>" << EscapeXml(flights[f])
+        << colours[flight % 5] << "'/><text x='" << x(i) << "' y='" << y(i) << "' dx='8' dy='-8' font-size='11'>" << i
         << "</text>\n";
   }
+  for (std::size_t f = 0; f < flights.size(); ++f) {
+    out << "<text x='10' y='" << 18 + 16 * f << "' font-size='12' fill='" << colours[f % 5] << "'>"
+        << EscapeXml(flights[f]) << "</text>\n";
+  }
   const std::size_t legend = 18 + 16 * flights.size();
-  out << "<text x='10' y='" << legend << "' font-size='12' fill='#16a34a'>" << (truth ? "correct loop closure" : "loop closure")
-      << "</text>\n";
+  out << "<text x='10' y='" << legend << "' font-size='12' fill='#16a34a'>"
+      << (truth ? "correct loop closure" : "loop closure") << "</text>\n";
   if (truth != nullptr) {
     out << "<text x='10' y='" << legend + 16 << "' font-size='12' fill='#dc2626'>false loop closure</text>\n"
         << "<text x='10' y='" << legend + 32 << "' font-size='12' fill='#2563eb'>missed loop closure</text>\n";
@@ -283,7 +292,6 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth) {
 
 namespace {
 
-
 // JSON to embed in an HTML <script> element: '<', '>' and '&' become their JSON escapes (\u003c ...), so no
 // string from a log can end the element early (a flight id "x</script><img ...>").
 std::string JsonForScript(const nlohmann::json& value) {
@@ -291,10 +299,14 @@ std::string JsonForScript(const nlohmann::json& value) {
   std::string out;
   out.reserve(text.size());
   for (char c : text) {
-    if (c == '<') out += "\\u003c";
-    else if (c == '>') out += "\\u003e";
-    else if (c == '&') out += "\\u0026";
-    else out += c;
+    if (c == '<')
+      out += "\\u003c";
+    else if (c == '>')
+      out += "\\u003e";
+    else if (c == '&')
+      out += "\\u0026";
+    else
+      out += c;
   }
   return out;
 }

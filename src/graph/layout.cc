@@ -65,7 +65,8 @@ LayoutInput LayoutInputOf(const TopoMap& map) {
 
 Status LayoutMap(const LayoutInput& input, const LayoutOptions& options, TopoMap* map) {
   const int n = map->node_count();
-  if (static_cast<int>(input.heading.size()) != n) return Status::InvalidArgument("layout: one heading per node needed");
+  if (static_cast<int>(input.heading.size()) != n)
+    return Status::InvalidArgument("layout: one heading per node needed");
   std::vector<std::array<double, 3>> poses(n, {0.0, 0.0, 0.0});
   // Initial guess: dead reckoning along each flight; each flight starts below the previous ones.
   double offset = 0.0;
@@ -90,9 +91,9 @@ Status LayoutMap(const LayoutInput& input, const LayoutOptions& options, TopoMap
       const Eigen::Vector2d local(step * std::cos(0.5 * turn), step * std::sin(0.5 * turn));
       problem.AddResidualBlock(new OdometryCost(local, turn, options.heading_weight), nullptr, a, b);
     } else {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LoopClosureCost, 2, 3, 3>(
-                                   new LoopClosureCost(options.loop_closure_weight)),
-                               new ceres::CauchyLoss(options.robust_scale), a, b);
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<LoopClosureCost, 2, 3, 3>(new LoopClosureCost(options.loop_closure_weight)),
+          new ceres::CauchyLoss(options.robust_scale), a, b);
     }
   }
   // The first node anchors the layout (a node without edges is in no residual and needs no anchor).

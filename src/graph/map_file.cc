@@ -66,7 +66,8 @@ class Reader {
     const int type = Value<std::int32_t>(), rows = Value<std::int32_t>(), cols = Value<std::int32_t>();
     if (failed_ || rows < 0 || cols < 0 || (type != CV_8UC1 && type != CV_32FC1)) return Fail(), cv::Mat();
     // The bytes must be in the file before anything is allocated (a header may claim 2^31 x 2^31).
-    const std::size_t bytes = static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols) * (type == CV_8UC1 ? 1 : 4);
+    const std::size_t bytes =
+        static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols) * (type == CV_8UC1 ? 1 : 4);
     if (bytes > size_ - position_) return Fail(), cv::Mat();
     cv::Mat mat(rows, cols, type);
     if (!Take(bytes)) return cv::Mat();
@@ -78,7 +79,8 @@ class Reader {
     const std::uint32_t count = Value<std::uint32_t>();
     if (!Take(static_cast<std::size_t>(count) * sizeof(T))) return {};
     std::vector<T> values(count);
-    if (count > 0) std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
+    if (count > 0)
+      std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
     return values;
   }
   bool failed() const { return failed_; }
@@ -188,7 +190,8 @@ std::string PatrolSection(const TopoMap& map) {
     w.Value<std::int32_t>(p.feature_image_width);
     std::vector<PoseRecord> views;
     for (const CameraPoseSample& v : p.views) {
-      views.push_back({v.timestamp_ns, {v.position.x(), v.position.y(), v.position.z()},
+      views.push_back({v.timestamp_ns,
+                       {v.position.x(), v.position.y(), v.position.z()},
                        {v.rotation.w(), v.rotation.x(), v.rotation.y(), v.rotation.z()}});
     }
     w.Vector(views);
@@ -243,8 +246,8 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
     n.layout = Eigen::Vector2d(v[2], v[3]);
     n.heading = v[4];
     if (!ValidFlightId(n.flight)) return Corrupt(path, "flight id of node " + std::to_string(i));
-    if (!r->failed() && (n.thumbnail.empty() || n.thumbnail.type() != CV_8UC1 || n.thumbnail.cols > 4096 ||
-                         n.thumbnail.rows > 4096)) {
+    if (!r->failed() &&
+        (n.thumbnail.empty() || n.thumbnail.type() != CV_8UC1 || n.thumbnail.cols > 4096 || n.thumbnail.rows > 4096)) {
       return Corrupt(path, "thumbnail of node " + std::to_string(i));
     }
     map->AddNode(std::move(n));
@@ -398,7 +401,8 @@ Status LoadMap(const std::string& path, TopoMap* map) {
   if (error) return Status::NotFound(path + ": cannot read map: " + error.message());
   std::string bytes(size, '\0');
   std::ifstream(path, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(size));
-  if (size < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) return Status::DataLoss(path + ": not a patrolmap map file");
+  if (size < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    return Status::DataLoss(path + ": not a patrolmap map file");
   if (size < 16) return Status::DataLoss(path + ": truncated map (header incomplete)");
   std::uint32_t header[2];
   std::memcpy(header, bytes.data() + 8, sizeof(header));
@@ -406,14 +410,15 @@ Status LoadMap(const std::string& path, TopoMap* map) {
     return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is not one patrolmap wrote");
   }
   if (header[0] > kVersion) {
-    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is newer than this patrolmap reads (" +
-                            std::to_string(kVersion) + ")");
+    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) +
+                            " is newer than this patrolmap reads (" + std::to_string(kVersion) + ")");
   }
   *map = TopoMap();
   std::size_t position = 16;
   SectionsSeen seen;
   for (std::uint32_t s = 0; s < header[1]; ++s) {
-    if (size - position < 20) return Status::DataLoss(path + ": truncated map (section " + std::to_string(s) + " header)");
+    if (size - position < 20)
+      return Status::DataLoss(path + ": truncated map (section " + std::to_string(s) + " header)");
     const std::string tag(bytes.data() + position, 4);
     std::uint64_t length, checksum;
     std::memcpy(&length, bytes.data() + position + 4, 8);

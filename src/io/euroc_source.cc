@@ -49,16 +49,16 @@ Status ReadSpeedTable(const std::string& path, std::vector<SpeedSample>* samples
   return ReadTimedTable(path, 11, parse, samples);
 }
 
-Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* key,
-                   std::size_t count, std::vector<double>* values) {
+Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* key, std::size_t count,
+                   std::vector<double>* values) {
   try {
     *values = node.as<std::vector<double>>();
   } catch (const YAML::Exception&) {
     return Status::DataLoss(path + ": '" + key + "' must be a list of numbers");
   }
   if (values->size() != count) {
-    return Status::DataLoss(path + ": '" + key + "' must have " + std::to_string(count) +
-                            " numbers, has " + std::to_string(values->size()));
+    return Status::DataLoss(path + ": '" + key + "' must have " + std::to_string(count) + " numbers, has " +
+                            std::to_string(values->size()));
   }
   return Status::Ok();
 }
@@ -85,8 +85,12 @@ Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d*
   std::vector<double> intrinsics, resolution;
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
-  CameraIntrinsics camera{intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3],
-                          static_cast<int>(resolution[0]), static_cast<int>(resolution[1])};
+  CameraIntrinsics camera{intrinsics[0],
+                          intrinsics[1],
+                          intrinsics[2],
+                          intrinsics[3],
+                          static_cast<int>(resolution[0]),
+                          static_cast<int>(resolution[1])};
   if (!camera.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
   info->camera = camera;
   if (root["rate_hz"]) info->frame_rate_hz = root["rate_hz"].as<double>(0.0);
@@ -164,8 +168,8 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   if (!imu.empty() && !info.camera_from_imu) {
     spdlog::warn("{}: imu0 present but cam0/sensor.yaml missing: camera-IMU rotation unknown", log);
   }
-  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu),
-                                              std::move(speeds), std::move(gps));
+  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu), std::move(speeds),
+                                              std::move(gps));
   return Status::Ok();
 }
 

@@ -13,11 +13,9 @@
 
 namespace patrolmap::io {
 
-inline Status CheckColumns(const CsvReader& csv, const std::vector<std::string_view>& fields,
-                    std::size_t minimum) {
+inline Status CheckColumns(const CsvReader& csv, const std::vector<std::string_view>& fields, std::size_t minimum) {
   if (fields.size() >= minimum) return Status::Ok();
-  return csv.Error("expected at least " + std::to_string(minimum) + " columns, found " +
-                   std::to_string(fields.size()));
+  return csv.Error("expected at least " + std::to_string(minimum) + " columns, found " + std::to_string(fields.size()));
 }
 
 inline Status CheckIncreasing(const CsvReader& csv, TimestampNs previous, TimestampNs current, bool strict = true) {
@@ -49,8 +47,8 @@ Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow par
   return status.end_of_stream() ? Status::Ok() : status;
 }
 
-inline Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields,
-                   std::size_t first, const char* column, Eigen::Vector3d* vector) {
+inline Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields, std::size_t first,
+                          const char* column, Eigen::Vector3d* vector) {
   for (int axis = 0; axis < 3; ++axis) {
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + axis], column, &(*vector)[axis]));
   }

@@ -6,10 +6,13 @@
 
 namespace patrolmap::io {
 
-ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries,
-                                 std::vector<ImuSample> imu, std::vector<SpeedSample> speeds, std::vector<GpsSample> gps)
-    : info_(std::move(info)), entries_(std::move(entries)), imu_(std::move(imu)),
-      speeds_(std::move(speeds)), gps_(std::move(gps)) {
+ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries, std::vector<ImuSample> imu,
+                                 std::vector<SpeedSample> speeds, std::vector<GpsSample> gps)
+    : info_(std::move(info)),
+      entries_(std::move(entries)),
+      imu_(std::move(imu)),
+      speeds_(std::move(speeds)),
+      gps_(std::move(gps)) {
   info_.frame_count = static_cast<std::int64_t>(entries_.size());
   info_.has_imu = !imu_.empty();
   info_.has_speed = !speeds_.empty();
@@ -40,9 +43,8 @@ bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Ma
   }
   if (first_size_.empty()) first_size_ = image->size();
   if (image->size() != first_size_) {
-    RecordSkipped(index, path + ": image is " + std::to_string(image->cols) + "x" +
-                             std::to_string(image->rows) + ", the log's first image is " +
-                             std::to_string(first_size_.width) + "x" +
+    RecordSkipped(index, path + ": image is " + std::to_string(image->cols) + "x" + std::to_string(image->rows) +
+                             ", the log's first image is " + std::to_string(first_size_.width) + "x" +
                              std::to_string(first_size_.height));
     return false;
   }
@@ -57,9 +59,8 @@ void ImageListSource::AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSam
 
 std::optional<double> ImageListSource::SpeedAt(TimestampNs timestamp_ns) const {
   if (speeds_.empty()) return std::nullopt;
-  const auto after = std::lower_bound(
-      speeds_.begin(), speeds_.end(), timestamp_ns,
-      [](const SpeedSample& sample, TimestampNs t) { return sample.timestamp_ns < t; });
+  const auto after = std::lower_bound(speeds_.begin(), speeds_.end(), timestamp_ns,
+                                      [](const SpeedSample& sample, TimestampNs t) { return sample.timestamp_ns < t; });
   if (after == speeds_.begin()) return after->speed_mps;
   if (after == speeds_.end()) return speeds_.back().speed_mps;
   const SpeedSample& before = *(after - 1);

@@ -29,7 +29,10 @@ bool ParseTime(const std::string& text, TimestampNs* ns) {
   }
   if (whole.size() < 10 || whole[0] == '0') return false;  // frame numbers such as 000123, not times
   const long long value = std::stoll(whole);
-  const long long factor = whole.size() >= 18 ? 1 : whole.size() >= 15 ? 1000 : whole.size() >= 12 ? 1000000 : 1000000000;
+  const long long factor = whole.size() >= 18   ? 1
+                           : whole.size() >= 15 ? 1000
+                           : whole.size() >= 12 ? 1000000
+                                                : 1000000000;
   if (factor > 1 && value > std::numeric_limits<long long>::max() / factor) return false;
   *ns = value * factor;
   return true;
@@ -74,8 +77,8 @@ bool TimesFromNames(const std::vector<std::string>& paths, std::vector<Timestamp
 
 }  // namespace
 
-Status FindImageTimes(const std::string& folder, const std::vector<std::string>& paths,
-                      std::vector<TimestampNs>* times, std::string* source) {
+Status FindImageTimes(const std::string& folder, const std::vector<std::string>& paths, std::vector<TimestampNs>* times,
+                      std::string* source) {
   times->clear();
   source->clear();
   const fs::path directory = fs::path(folder).lexically_normal();

@@ -18,8 +18,8 @@ namespace patrolmap::io {
 // Times must increase. Fills `times` and names the source in `source` ("times.txt", "file names"), or
 // leaves both empty when the folder has no times. A times file that does not fit fails naming it and
 // the line.
-Status FindImageTimes(const std::string& folder, const std::vector<std::string>& paths,
-                      std::vector<TimestampNs>* times, std::string* source);
+Status FindImageTimes(const std::string& folder, const std::vector<std::string>& paths, std::vector<TimestampNs>* times,
+                      std::string* source);
 
 // The rate of increasing `times`: one over their median interval [Hz]; 0 for fewer than two.
 double MedianRate(const std::vector<TimestampNs>& times);

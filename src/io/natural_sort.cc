@@ -42,8 +42,7 @@ bool NaturalLess(std::string_view a, std::string_view b) {
 }
 
 void NaturalSort(std::vector<std::string>* names) {
-  std::sort(names->begin(), names->end(),
-            [](const std::string& a, const std::string& b) { return NaturalLess(a, b); });
+  std::sort(names->begin(), names->end(), [](const std::string& a, const std::string& b) { return NaturalLess(a, b); });
 }
 
 }  // namespace patrolmap::io

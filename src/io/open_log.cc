@@ -3,8 +3,8 @@
 #include <array>
 #include <cctype>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -208,8 +208,7 @@ Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& op
   return Status::Ok();
 }
 
-Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
-                 std::unique_ptr<FrameSource>* source) {
+Status OpenVideo(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
   PATROLMAP_RETURN_IF_ERROR(CheckFrameRate(options));
   if (!fs::is_regular_file(path)) return Status::NotFound(path + ": no such file");
   cv::VideoCapture capture(path);
@@ -231,7 +230,7 @@ Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr
   const double reported_rate = capture.get(cv::CAP_PROP_FPS);
   LogInfo info = MakeInfo("camera" + std::to_string(device), "camera", 0.0);
   info.timing = "the camera's clock";
-  info.frame_rate_hz = options.frame_rate_hz > 0.0 ? options.frame_rate_hz
+  info.frame_rate_hz = options.frame_rate_hz > 0.0                           ? options.frame_rate_hz
                        : std::isfinite(reported_rate) && reported_rate > 0.0 ? reported_rate
                                                                              : kAssumedFrameRateHz;
   *source = std::make_unique<VideoSource>(std::move(info), std::move(capture), true);
@@ -246,8 +245,7 @@ Status CheckLogExists(const std::string& path) {
   return Status::NotFound(path + ": no such file or folder");
 }
 
-Status OpenLog(const std::string& path, const ImageFolderOptions& options,
-               std::unique_ptr<FrameSource>* source) {
+Status OpenLog(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
   if (path.find('%') != std::string::npos) return OpenImagePattern(path, options, source);
   if (!fs::exists(path)) return Status::NotFound(path + ": no such file or folder");
   if (fs::is_directory(path)) {

@@ -115,8 +115,8 @@ Status BuildGrid(const io::PatrolSensors& sensors, const Config& config, PatrolR
 
 }  // namespace
 
-Status BuildPatrolRecord(const std::string& log, const Config& config, PatrolRecord* record,
-                         PatrolRecordStats* stats, const ChangeProgress& progress) {
+Status BuildPatrolRecord(const std::string& log, const Config& config, PatrolRecord* record, PatrolRecordStats* stats,
+                         const ChangeProgress& progress) {
   io::PatrolSensors sensors;
   PATROLMAP_RETURN_IF_ERROR(io::ReadPatrolSensors(log, &sensors));
   *record = PatrolRecord();
@@ -164,7 +164,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     };
     change::PlaceChange place;
     place.prior_node = a, place.current_node = b;
-    place.appearance = change::DetectAppearanceChange(view(a, prior_record), view(b, current_record), options.appearance);
+    place.appearance =
+        change::DetectAppearanceChange(view(a, prior_record), view(b, current_record), options.appearance);
     report->places.push_back(std::move(place));
   }
   report->seconds_appearance = SecondsSince(start);
@@ -177,7 +178,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   }
   report->seconds_objects = SecondsSince(start);
   start = std::chrono::steady_clock::now();
-  report->geometry_compared = change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
+  report->geometry_compared =
+      change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
   report->seconds_geometry = SecondsSince(start);
   return Status::Ok();
 }

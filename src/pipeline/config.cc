@@ -35,7 +35,8 @@ class YamlReader {
   void CheckUnknown(const YAML::Node& node, const std::string& prefix) {
     if (!status_.ok() || !node.IsMap()) return;
     for (const auto& item : node) {
-      const std::string path = prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
+      const std::string path =
+          prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
       if (known_.count(path) != 0) continue;
       if (item.second.IsMap() && IsSection(path)) {
         CheckUnknown(item.second, path);
@@ -68,8 +69,8 @@ class YamlReader {
   }
 
   void Fail(const std::string& path, const YAML::Node& node, const std::string& problem) {
-    status_ = Status::InvalidArgument(file_ + ":" + std::to_string(node.Mark().line + 1) + ": " + path + ": " +
-                                      problem);
+    status_ =
+        Status::InvalidArgument(file_ + ":" + std::to_string(node.Mark().line + 1) + ": " + path + ": " + problem);
   }
 
   template <typename T>

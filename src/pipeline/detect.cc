@@ -68,18 +68,24 @@ std::string WhyNoKeyLocation(const io::LogInfo& info, const DetectionResult& res
   int accepted = 0;
   for (const FlowSample& sample : result.samples) accepted += sample.accepted_vectors > 0;
   if (accepted == 0) {
-    return prefix + "no flow vector was accepted in any frame (too few edges, or the camera does not move); "
-                    "check flow.edges.canny_low/canny_high and that the log is a moving camera";
+    return prefix +
+           "no flow vector was accepted in any frame (too few edges, or the camera does not move); "
+           "check flow.edges.canny_low/canny_high and that the log is a moving camera";
   }
   const auto [low, high] = SmoothedRange(result.samples);
   if (high - low < options.extrema.min_change) {
-    return prefix + "the smoothed response varies by " + Number(high - low) + ", less than flow.extrema.min_change = " +
-           Number(options.extrema.min_change) + " (a camera that hardly moves, or a uniform scene); lower "
+    return prefix + "the smoothed response varies by " + Number(high - low) +
+           ", less than flow.extrema.min_change = " + Number(options.extrema.min_change) +
+           " (a camera that hardly moves, or a uniform scene); lower "
            "flow.extrema.min_change to about a third of that range";
   }
-  return prefix + "no peak or valley of the smoothed response was confirmed (the response must turn back by "
-                  "flow.extrema.min_change = " + Number(options.extrema.min_change) + " after it, at least "
-                  "flow.extrema.min_time_s = " + Number(options.extrema.min_time_s) + " s after the previous one)";
+  return prefix +
+         "no peak or valley of the smoothed response was confirmed (the response must turn back by "
+         "flow.extrema.min_change = " +
+         Number(options.extrema.min_change) +
+         " after it, at least "
+         "flow.extrema.min_time_s = " +
+         Number(options.extrema.min_time_s) + " s after the previous one)";
 }
 
 }  // namespace
@@ -91,17 +97,21 @@ std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const Detect
     warnings.push_back(info.path + ": the log has no timestamps, so its frames are taken as " +
                        Number(info.frame_rate_hz) + " Hz; give --fps (input.frame_rate_hz) for the real rate");
   }
-  const double duration_s =
-      result.samples.size() < 2 ? 0.0 : NsToSeconds(result.samples.back().timestamp_ns - result.samples.front().timestamp_ns);
+  const double duration_s = result.samples.size() < 2
+                                ? 0.0
+                                : NsToSeconds(result.samples.back().timestamp_ns - result.samples.front().timestamp_ns);
   if (duration_s < 2.0 * options.smoothing.window_s) {
-    warnings.push_back(info.path + ": the log lasts " + Number(duration_s) + " s, less than twice the smoothing "
-                       "window (flow.smoothing.window_s = " + Number(options.smoothing.window_s) + " s, " +
-                       std::to_string(result.timing.window) + " processed frames), which flattens the response; "
+    warnings.push_back(info.path + ": the log lasts " + Number(duration_s) +
+                       " s, less than twice the smoothing "
+                       "window (flow.smoothing.window_s = " +
+                       Number(options.smoothing.window_s) + " s, " + std::to_string(result.timing.window) +
+                       " processed frames), which flattens the response; "
                        "for short logs lower flow.smoothing.window_s to about a quarter of the log");
   }
   if (result.unusable_frames > 0) {
     warnings.push_back(info.path + ": " + std::to_string(result.unusable_frames) + " frames were too small (under " +
-                       std::to_string(flow::kMinProcessedSide) + " pixels a side at flow.frames.scale), of another size "
+                       std::to_string(flow::kMinProcessedSide) +
+                       " pixels a side at flow.frames.scale), of another size "
                        "than the frames before, or not grey, and were skipped");
   }
   if (result.key_locations.empty() && !result.samples.empty()) {

@@ -59,8 +59,8 @@ double NiceStep(double range, int count) {
 }
 
 void Axes(const PlotFrame& frame, std::ostringstream* svg) {
-  *svg << "<rect x='" << frame.left << "' y='" << frame.top << "' width='" << frame.right - frame.left
-       << "' height='" << frame.bottom - frame.top << "' fill='white' stroke='#444'/>\n";
+  *svg << "<rect x='" << frame.left << "' y='" << frame.top << "' width='" << frame.right - frame.left << "' height='"
+       << frame.bottom - frame.top << "' fill='white' stroke='#444'/>\n";
   const double t_step = NiceStep(frame.t1 - frame.t0, 10);
   for (double t = std::ceil(frame.t0 / t_step) * t_step; t <= frame.t1; t += t_step) {
     *svg << "<text x='" << Number(frame.X(t)) << "' y='" << frame.bottom + 16
@@ -68,20 +68,19 @@ void Axes(const PlotFrame& frame, std::ostringstream* svg) {
   }
   const double y_step = NiceStep(frame.y1 - frame.y0, 5);
   for (double y = std::ceil(frame.y0 / y_step) * y_step; y <= frame.y1; y += y_step) {
-    *svg << "<text x='" << frame.left - 6 << "' y='" << Number(frame.Y(y) + 4)
-         << "' font-size='11' text-anchor='end'>" << Number(y) << "</text>\n";
+    *svg << "<text x='" << frame.left - 6 << "' y='" << Number(frame.Y(y) + 4) << "' font-size='11' text-anchor='end'>"
+         << Number(y) << "</text>\n";
   }
   *svg << "<text x='" << (frame.left + frame.right) / 2 << "' y='" << frame.bottom + 34
        << "' font-size='12' text-anchor='middle'>time [s]</text>\n"
        << "<text x='18' y='" << (frame.top + frame.bottom) / 2 << "' font-size='12' text-anchor='middle' "
-       << "transform='rotate(-90 18 " << (frame.top + frame.bottom) / 2
-       << ")'>response [image widths / s]</text>\n";
+       << "transform='rotate(-90 18 " << (frame.top + frame.bottom) / 2 << ")'>response [image widths / s]</text>\n";
 }
 
 void Markers(const DetectionResult& result, const PlotTruth& truth, const PlotFrame& frame, std::ostringstream* svg) {
   for (double t : truth.times_s) {
-    *svg << "<line x1='" << Number(frame.X(t)) << "' x2='" << Number(frame.X(t)) << "' y1='" << frame.top
-         << "' y2='" << frame.bottom << "' stroke='#2a9d3a' stroke-dasharray='4 3'/>\n";
+    *svg << "<line x1='" << Number(frame.X(t)) << "' x2='" << Number(frame.X(t)) << "' y1='" << frame.top << "' y2='"
+         << frame.bottom << "' stroke='#2a9d3a' stroke-dasharray='4 3'/>\n";
   }
   for (const KeyLocation& node : result.key_locations) {
     const double x = frame.X(NsToSeconds(node.timestamp_ns)), y = frame.Y(node.response);
@@ -99,10 +98,10 @@ void Legend(const PlotFrame& frame, std::ostringstream* svg) {
        << "<text x='" << x + 24 << "' y='" << y + 4 << "'>raw</text>"
        << "<line x1='" << x + 60 << "' x2='" << x + 80 << "' y1='" << y << "' y2='" << y
        << "' stroke='black' stroke-width='2'/><text x='" << x + 84 << "' y='" << y + 4 << "'>smoothed</text>"
-       << "<circle cx='" << x + 150 << "' cy='" << y << "' r='5' fill='#d62828'/><text x='" << x + 158
-       << "' y='" << y + 4 << "'>peak</text>"
-       << "<circle cx='" << x + 200 << "' cy='" << y << "' r='5' fill='#1d4ed8'/><text x='" << x + 208
-       << "' y='" << y + 4 << "'>valley</text>"
+       << "<circle cx='" << x + 150 << "' cy='" << y << "' r='5' fill='#d62828'/><text x='" << x + 158 << "' y='"
+       << y + 4 << "'>peak</text>"
+       << "<circle cx='" << x + 200 << "' cy='" << y << "' r='5' fill='#1d4ed8'/><text x='" << x + 208 << "' y='"
+       << y + 4 << "'>valley</text>"
        << "<line x1='" << x + 255 << "' x2='" << x + 275 << "' y1='" << y << "' y2='" << y
        << "' stroke='#2a9d3a' stroke-dasharray='4 3'/><text x='" << x + 279 << "' y='" << y + 4
        << "'>ground-truth edge</text></g>\n";
@@ -114,8 +113,8 @@ std::string KeyLocationsCsv(const std::vector<KeyLocation>& key_locations) {
   std::ostringstream csv;
   csv << "node,timestamp_ns,frame_index,response,kind\n";
   for (const KeyLocation& node : key_locations) {
-    csv << node.node_index << "," << node.timestamp_ns << "," << node.frame_index << "," << Number(node.response)
-        << "," << ToString(node.kind) << "\n";
+    csv << node.node_index << "," << node.timestamp_ns << "," << node.frame_index << "," << Number(node.response) << ","
+        << ToString(node.kind) << "\n";
   }
   return csv.str();
 }
@@ -125,8 +124,7 @@ std::string ResponseCsv(const std::vector<FlowSample>& samples) {
   csv << "timestamp_ns,frame_index,raw_response,smoothed_response,tracked_vectors,accepted_vectors\n";
   for (const FlowSample& sample : samples) {
     csv << sample.timestamp_ns << "," << sample.frame_index << "," << Number(sample.raw_response) << ","
-        << Number(sample.smoothed_response) << "," << sample.tracked_vectors << "," << sample.accepted_vectors
-        << "\n";
+        << Number(sample.smoothed_response) << "," << sample.tracked_vectors << "," << sample.accepted_vectors << "\n";
   }
   return csv.str();
 }

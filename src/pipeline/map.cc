@@ -44,7 +44,8 @@ void YawIntegrator::Add(const std::vector<ImuSample>& samples) {
   }
 }
 
-PlaceStage::PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result) : recognizer_(recognizer), result_(result) {
+PlaceStage::PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result)
+    : recognizer_(recognizer), result_(result) {
   for (const MapNode& node : result->nodes) frame_of_[node.node] = node.frame_index;
 }
 
@@ -87,8 +88,10 @@ Status RecognisePlaces(const std::string& log, const Config& config, const KeyFr
     yaw.Add(frame.imu);
     if (frame.image.empty() || !Selected(selection, frame.index)) continue;
     ++described;
-    if (scale < 1.0) cv::resize(frame.image, input.key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
-    else input.key_frame.image = frame.image;
+    if (scale < 1.0)
+      cv::resize(frame.image, input.key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
+    else
+      input.key_frame.image = frame.image;
     input.key_frame.timestamp_ns = frame.timestamp_ns;
     input.key_frame.frame_index = frame.index;
     input.heading = yaw.yaw();
@@ -119,10 +122,12 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
   PATROLMAP_CHECK(recognizer->node_count() == 0);
   for (int i = 0; i < prior.node_count(); ++i) {
     const graph::NodeData& node = prior.node(i);
-    const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(),
-                                       [&](vocab::WordId word) { return word < static_cast<vocab::WordId>(vocabulary.word_count()); });
+    const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(), [&](vocab::WordId word) {
+      return word < static_cast<vocab::WordId>(vocabulary.word_count());
+    });
     if (!words_fit || (!node.descriptors.empty() && node.descriptors.cols != vocabulary.dimension())) {
-      return Status::DataLoss(prior_path + ": node " + std::to_string(i) + " was not described with this vocabulary "
+      return Status::DataLoss(prior_path + ": node " + std::to_string(i) +
+                              " was not described with this vocabulary "
                               "(word ids or descriptor width out of range)");
     }
     recognizer->AddDescribedNode(

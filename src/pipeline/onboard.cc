@@ -100,7 +100,8 @@ Status OnboardMapper::Enqueue(KeyFrameInput&& input) {
   if (!options_.place_worker) return places_.Add(input);
   const Clock::time_point start = Clock::now();
   std::unique_lock<std::mutex> lock(mutex_);
-  changed_.wait(lock, [this] { return static_cast<int>(queue_.size()) < options_.queue_capacity || !place_status_.ok(); });
+  changed_.wait(lock,
+                [this] { return static_cast<int>(queue_.size()) < options_.queue_capacity || !place_status_.ok(); });
   stats_.waited_seconds += SecondsSince(start);
   if (!place_status_.ok()) return place_status_;
   queue_.push_back(std::move(input));

@@ -57,8 +57,10 @@ void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& q
     const auto range = by_group.equal_range(query_groups[i]);
     for (auto it = range.first; it != range.second; ++it) {
       const double distance = cv::norm(query.row(i), candidate.row(it->second), cv::NORM_L2);
-      if (distance < best) second = best, best = distance, best_index = it->second;
-      else if (distance < second) second = distance;
+      if (distance < best)
+        second = best, best = distance, best_index = it->second;
+      else if (distance < second)
+        second = distance;
     }
     if (best_index >= 0 && best < ratio * second) matches->emplace_back(i, best_index);
   }
@@ -179,8 +181,8 @@ Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_poin
 }
 
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
-                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
-                        const std::vector<std::uint32_t>* query_groups,
+                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
+                        const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups,
                         const std::vector<std::uint32_t>* candidate_groups) {
   Verification verification;
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
@@ -201,8 +203,8 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPo
     return verification;
   }
   std::vector<unsigned char> mask;
-  const cv::Mat f = cv::findFundamentalMat(from, to, MethodFlag(options.method), options.inlier_threshold_px, 0.999,
-                                           2000, mask);
+  const cv::Mat f =
+      cv::findFundamentalMat(from, to, MethodFlag(options.method), options.inlier_threshold_px, 0.999, 2000, mask);
   if (f.rows < 3 || f.cols != 3) return verification;
   verification.inliers = cv::countNonZero(mask);
   verification.log_nfa = LogNumberOfFalseAlarms(cv::Matx33d(f.rowRange(0, 3)), from, to, ExtentOf(query_points),
@@ -229,20 +231,22 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
 
 PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
   const Node& n = nodes_.at(node);
-  return {n.flight, n.timestamp_ns, n.frame_index, n.keypoints, n.descriptors,
-          database_.entry(static_cast<vocab::EntryId>(node))};
+  return {n.flight,    n.timestamp_ns, n.frame_index,
+          n.keypoints, n.descriptors,  database_.entry(static_cast<vocab::EntryId>(node))};
 }
 
 int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
-  Node node{std::move(features.flight), features.timestamp_ns, features.frame_index, std::move(features.keypoints),
-            std::move(features.descriptors), {}};
+  Node node{std::move(features.flight),    features.timestamp_ns,           features.frame_index,
+            std::move(features.keypoints), std::move(features.descriptors), {}};
   if (options_.direct_index_levels_up > 0) {
     // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
     cv::Mat as_float;
-    node.descriptors.convertTo(as_float, CV_32F, node.descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
+    node.descriptors.convertTo(as_float, CV_32F,
+                               node.descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
     std::vector<vocab::WordId> words;
     vocabulary_->Quantize(as_float, &words);
-    for (vocab::WordId word : words) node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
+    for (vocab::WordId word : words)
+      node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
   }
   const int id = static_cast<int>(database_.Add(features.bow));
   nodes_.push_back(std::move(node));
@@ -262,7 +266,8 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   vocabulary_->Quantize(node.descriptors, &words);
   vocab::MakeBowVector(words, vocabulary_->idf().data(), &bow);
   if (options_.direct_index_levels_up > 0) {
-    for (vocab::WordId word : words) node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
+    for (vocab::WordId word : words)
+      node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
   }
   result->features = node.descriptors.rows;
   if (options_.compact_descriptors) node.descriptors = Compact(node.descriptors, options_.root_sift);
@@ -270,8 +275,8 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
 
   start = std::chrono::steady_clock::now();
   std::vector<vocab::QueryResult> candidates;
-  database_.Query(bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); },
-                  &candidates);
+  database_.Query(
+      bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); }, &candidates);
   result->seconds_query = Since(start);
 
   start = std::chrono::steady_clock::now();

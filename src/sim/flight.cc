@@ -47,10 +47,11 @@ std::string CameraYaml(const SimulatedFlight& flight) {
   const CameraIntrinsics& camera = flight.camera;
   std::ostringstream out;
   out.precision(12);
-  out << "sensor_type: camera\ncomment: patrolmap simulated camera\n" << MatrixYaml(BodyFromCamera(flight.mount_angle))
-      << "rate_hz: " << flight.frame_rate_hz << "\nresolution: [" << camera.width << ", " << camera.height
-      << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", " << camera.fy << ", " << camera.cx << ", "
-      << camera.cy << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
+  out << "sensor_type: camera\ncomment: patrolmap simulated camera\n"
+      << MatrixYaml(BodyFromCamera(flight.mount_angle)) << "rate_hz: " << flight.frame_rate_hz << "\nresolution: ["
+      << camera.width << ", " << camera.height << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", "
+      << camera.fy << ", " << camera.cx << ", " << camera.cy
+      << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
   return out.str();
 }
 
@@ -108,8 +109,8 @@ std::string PlacesTable(const SimulatedFlight& flight) {
   out << "#timestamp [ns],frame_index,x [m],y [m],z [m],camera_yaw [rad]\n";
   for (int frame = 0; frame < FrameCount(flight); ++frame) {
     const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
-    out << FrameTimestamp(flight, frame) << "," << frame << "," << pose.position.x() << "," << pose.position.y()
-        << "," << pose.position.z() << "," << std::remainder(pose.yaw, 2 * M_PI) << "\n";
+    out << FrameTimestamp(flight, frame) << "," << frame << "," << pose.position.x() << "," << pose.position.y() << ","
+        << pose.position.z() << "," << std::remainder(pose.yaw, 2 * M_PI) << "\n";
   }
   return out.str();
 }
@@ -219,8 +220,8 @@ Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, con
       tables->depth << timestamp << "," << name << "\n";
     }
     if (options.detections && frame % detector_step == 0) {
-      AppendDetections(timestamp, DetectObjects(flight.objects, flight.scene, flight.camera, pose, options.detector, frame),
-                       tables);
+      AppendDetections(
+          timestamp, DetectObjects(flight.objects, flight.scene, flight.camera, pose, options.detector, frame), tables);
     }
     if (progress) progress(frame + 1, frames);
   }
@@ -329,9 +330,9 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, options, progress, &tables));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/data.csv", tables.images.str()));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight)));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(
-      folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +
-                                        "rate_hz: " + std::to_string(flight.imu_rate_hz) + "\n"));
+  PATROLMAP_RETURN_IF_ERROR(
+      WriteFileAtomically(folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +
+                                                            "rate_hz: " + std::to_string(flight.imu_rate_hz) + "\n"));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/imu0/data.csv", ImuTable(flight)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/state_groundtruth_estimate0/data.csv", StateTable(flight)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/places.csv", PlacesTable(flight)));

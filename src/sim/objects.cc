@@ -46,7 +46,8 @@ WorldObject DrawObject(int id, cv::RNG* rng) {
   object.label = kind < 5 ? ObjectLabel::kCrate : (kind < 8 ? ObjectLabel::kBarrel : ObjectLabel::kVehicle);
   const Eigen::Vector2d along = (side.to - side.from).normalized();
   object.centre = side.from + rng->uniform(1.5, 16.5) * along + rng->uniform(1.5, 3.5) * side.outward;
-  object.yaw = std::atan2(along.y(), along.x()) + (object.label == ObjectLabel::kVehicle ? 0.0 : rng->uniform(-0.5, 0.5));
+  object.yaw =
+      std::atan2(along.y(), along.x()) + (object.label == ObjectLabel::kVehicle ? 0.0 : rng->uniform(-0.5, 0.5));
   if (object.label == ObjectLabel::kCrate) object.length = object.width = object.height = rng->uniform(0.9, 1.3);
   if (object.label == ObjectLabel::kBarrel) object.length = object.width = 0.6, object.height = 0.9;
   if (object.label == ObjectLabel::kVehicle) object.length = 4.2, object.width = 1.8, object.height = 1.5;
@@ -71,12 +72,14 @@ cv::Mat ObjectTexture(const WorldObject& object) {
   const int rows = std::max(8, static_cast<int>(object.height * kTexelsPerMetre));
   cv::Mat image(rows, columns, CV_8UC1, cv::Scalar(rng.uniform(60, 200)));
   if (object.label == ObjectLabel::kCrate) {  // planks
-    for (int y = 0; y < rows; y += rows / 5 + 1) cv::line(image, {0, y}, {columns, y}, cv::Scalar(rng.uniform(20, 60)), 2);
+    for (int y = 0; y < rows; y += rows / 5 + 1)
+      cv::line(image, {0, y}, {columns, y}, cv::Scalar(rng.uniform(20, 60)), 2);
     cv::line(image, {0, 0}, {columns, rows}, cv::Scalar(rng.uniform(20, 60)), 3);
   } else if (object.label == ObjectLabel::kBarrel) {  // hoops
     for (int y : {rows / 4, rows * 3 / 4}) cv::line(image, {0, y}, {columns, y}, cv::Scalar(rng.uniform(10, 50)), 3);
   } else {  // windows and wheels
-    cv::rectangle(image, cv::Rect(columns / 5, 2, columns * 3 / 5, rows / 3), cv::Scalar(rng.uniform(10, 50)), cv::FILLED);
+    cv::rectangle(image, cv::Rect(columns / 5, 2, columns * 3 / 5, rows / 3), cv::Scalar(rng.uniform(10, 50)),
+                  cv::FILLED);
     for (int x : {columns / 5, columns * 4 / 5}) cv::circle(image, {x, rows}, rows / 4, cv::Scalar(15), cv::FILLED);
   }
   cv::Mat noise(image.size(), CV_16SC1), sum;
@@ -125,10 +128,12 @@ Detection FalseDetection(const CameraIntrinsics& camera, cv::RNG* rng) {
   detection.label = static_cast<ObjectLabel>(rng->uniform(0, 3));
   detection.confidence = rng->uniform(0.3, 0.7);
   const double size = rng->uniform(30.0, 120.0);
-  detection.box = cv::Rect2d(rng->uniform(0.0, camera.width - size), rng->uniform(0.0, camera.height - size), size, size);
+  detection.box =
+      cv::Rect2d(rng->uniform(0.0, camera.width - size), rng->uniform(0.0, camera.height - size), size, size);
   const double depth = rng->uniform(4.0, 15.0);
   const cv::Point2d centre = (detection.box.tl() + detection.box.br()) * 0.5;
-  detection.centroid = depth * Eigen::Vector3d((centre.x - camera.cx) / camera.fx, (centre.y - camera.cy) / camera.fy, 1.0);
+  detection.centroid =
+      depth * Eigen::Vector3d((centre.x - camera.cx) / camera.fx, (centre.y - camera.cy) / camera.fy, 1.0);
   return detection;
 }
 
@@ -193,15 +198,16 @@ std::vector<WorldObject> ChangeObjects(const std::vector<WorldObject>& previous,
       }
       if (!move) moved.centre = object.centre;
     }
-    changes->push_back({object.id, move ? ChangeState::kMoved : ChangeState::kPersistent, object.label, object.centre,
-                        moved.centre});
+    changes->push_back(
+        {object.id, move ? ChangeState::kMoved : ChangeState::kPersistent, object.label, object.centre, moved.centre});
     next.push_back(moved);
   }
   for (int i = 0; i < spec.added; ++i) {
     const std::size_t before = next.size();
     AddClearObject(next_id++, &rng, &next);
     if (next.size() > before) {
-      changes->push_back({next.back().id, ChangeState::kNew, next.back().label, next.back().centre, next.back().centre});
+      changes->push_back(
+          {next.back().id, ChangeState::kNew, next.back().label, next.back().centre, next.back().centre});
     }
   }
   return next;
@@ -231,7 +237,8 @@ std::vector<Detection> DetectObjects(const std::vector<WorldObject>& objects, co
     if (rng.uniform(0.0, 1.0) < options.miss_rate) continue;
     detection.label = object.label;
     detection.confidence = rng.uniform(0.55, 0.95);
-    detection.centroid = in_camera + options.centroid_sigma_m * Eigen::Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1));
+    detection.centroid =
+        in_camera + options.centroid_sigma_m * Eigen::Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1));
     detection.truth_id = object.id;
     detections.push_back(detection);
   }

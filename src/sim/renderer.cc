@@ -80,7 +80,8 @@ Renderer::Renderer(const Scene* scene, const CameraIntrinsics& camera, const Lig
     const Eigen::Vector2d along = (wall.end - wall.start).normalized();
     normals_.emplace_back(along.y(), -along.x());
   }
-  sun_ = std::cos(lighting.sun_elevation) * Eigen::Vector2d(std::cos(lighting.sun_azimuth), std::sin(lighting.sun_azimuth));
+  sun_ = std::cos(lighting.sun_elevation) *
+         Eigen::Vector2d(std::cos(lighting.sun_azimuth), std::sin(lighting.sun_azimuth));
   ground_shade_ = static_cast<float>(lighting.ambient + (1.0 - lighting.ambient) * std::sin(lighting.sun_elevation));
   exposure_.resize(4 * 400);
   for (std::size_t i = 0; i < exposure_.size(); ++i) {
@@ -169,26 +170,21 @@ Renderer::Surface Renderer::SurfaceAt(double height, double slope) const {
   return {SurfaceKind::kSky, -1, 0.0};
 }
 
-void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction,
-                           cv::Mat* image) const {
+void Renderer::ShadeColumn(int column, const CameraPose& pose, const Eigen::Vector2d& direction, cv::Mat* image) const {
   const double height = pose.position.z();
   for (int row = 0; row < image->rows; ++row) {
     const double slope = (row - camera_.cy) / camera_.fy;  // metres down per metre of depth
     const Surface surface = SurfaceAt(height, slope);
     std::uint8_t grey = 0;
     switch (surface.kind) {
-      case SurfaceKind::kWall:
-        grey = ShadeWall(hits_[surface.hit], height - slope * surface.depth);
-        break;
+      case SurfaceKind::kWall: grey = ShadeWall(hits_[surface.hit], height - slope * surface.depth); break;
       case SurfaceKind::kRoof:
         grey = Expose(ground_shade_ * scene_->roof_grey[scene_->walls[hits_[surface.hit].wall].box]);
         break;
       case SurfaceKind::kGround:
         grey = ShadeGround(pose.position.head<2>() + surface.depth * direction, surface.depth);
         break;
-      case SurfaceKind::kSky:
-        grey = Expose(scene_->sky_grey);
-        break;
+      case SurfaceKind::kSky: grey = Expose(scene_->sky_grey); break;
     }
     image->at<std::uint8_t>(row, column) = grey;
   }

@@ -204,7 +204,8 @@ Status ReadWaypoints(const std::string& path, Route* route) {
     route->waypoints.push_back(point);
   }
   if (!status.end_of_stream()) return status;
-  if (DistinctPoints(route->waypoints).size() < 2) return Status::DataLoss(path + ": a route needs two distinct waypoints");
+  if (DistinctPoints(route->waypoints).size() < 2)
+    return Status::DataLoss(path + ": a route needs two distinct waypoints");
   return Status::Ok();
 }
 

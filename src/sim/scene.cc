@@ -39,12 +39,12 @@ void DrawBricks(cv::Mat* image, cv::RNG* rng, double texels_per_metre) {
 
 void DrawWindow(cv::Mat* image, const cv::Rect& frame, cv::RNG* rng) {
   cv::rectangle(*image, frame, cv::Scalar(rng->uniform(200, 250)), cv::FILLED);
-  const cv::Rect glass(frame.x + frame.width / 10 + 1, frame.y + frame.height / 10 + 1,
-                       frame.width * 8 / 10 - 2, frame.height * 8 / 10 - 2);
+  const cv::Rect glass(frame.x + frame.width / 10 + 1, frame.y + frame.height / 10 + 1, frame.width * 8 / 10 - 2,
+                       frame.height * 8 / 10 - 2);
   cv::rectangle(*image, glass, cv::Scalar(rng->uniform(20, 70)), cv::FILLED);
   if (rng->uniform(0, 2) == 1) {
-    cv::line(*image, {glass.x + glass.width / 2, glass.y}, {glass.x + glass.width / 2, glass.br().y},
-             cv::Scalar(220), 2);
+    cv::line(*image, {glass.x + glass.width / 2, glass.y}, {glass.x + glass.width / 2, glass.br().y}, cv::Scalar(220),
+             2);
   }
   if (rng->uniform(0, 3) == 0) {  // a half-drawn blind
     cv::rectangle(*image, cv::Rect(glass.x, glass.y, glass.width, glass.height * rng->uniform(2, 8) / 10),

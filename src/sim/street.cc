@@ -58,7 +58,8 @@ std::function<PlatformState(double)> StreetTrajectory(double start, double speed
     const double x = speed * (t + variation * speed_period / (2.0 * M_PI) * (1.0 - std::cos(speed_phase)));
     state.position = Eigen::Vector3d(start + x, 0.0, altitude);
     state.velocity = Eigen::Vector3d(speed * (1.0 + variation * std::sin(speed_phase)), 0.0, 0.0);
-    state.acceleration = Eigen::Vector3d(speed * variation * 2.0 * M_PI / speed_period * std::cos(speed_phase), 0.0, 0.0);
+    state.acceleration =
+        Eigen::Vector3d(speed * variation * 2.0 * M_PI / speed_period * std::cos(speed_phase), 0.0, 0.0);
     state.heading = yaw_amplitude * std::sin(yaw_phase);
     state.yaw_rate = yaw_amplitude * 2.0 * M_PI / yaw_period * std::cos(yaw_phase);
     return state;
@@ -80,8 +81,8 @@ SimulatedFlight MakeStreetFlight(const StreetOptions& options, std::vector<Eigen
   }
   const double street_end = facades.back().x1;
   const double margin = 4.0 * options.far_depth_m;
-  scene.textures.push_back(MakeFacadeTexture(street_end + 2 * margin, 2.0 * options.wall_height_m,
-                                             options.seed * 1000u + 999u));
+  scene.textures.push_back(
+      MakeFacadeTexture(street_end + 2 * margin, 2.0 * options.wall_height_m, options.seed * 1000u + 999u));
   scene.walls.push_back({Eigen::Vector2d(-margin, options.far_depth_m),
                          Eigen::Vector2d(street_end + margin, options.far_depth_m), 2.0 * options.wall_height_m,
                          static_cast<int>(scene.textures.size()) - 1});

@@ -111,7 +111,8 @@ Village MakeVillage(const VillageOptions& options) {
   FillOuterRow({-12.0, -12.0, 58.0, 42.0}, &builder, &village);
   builder.MakeAlike(options.alike_facade_pairs, &village);
   Scene& scene = village.scene;
-  scene.ground_texture = AddTexture(MakeGroundTexture(scene.ground_tile_metres, options.seed * 100000u + 99999u), &scene);
+  scene.ground_texture =
+      AddTexture(MakeGroundTexture(scene.ground_tile_metres, options.seed * 100000u + 99999u), &scene);
   return village;
 }
 
@@ -119,8 +120,8 @@ Status RoutePreset(const std::string& name, Route* route) {
   using P = Eigen::Vector2d;
   route->name = name;
   if (name == "double-loop") {
-    route->waypoints = {P(10, -6), P(52, -6), P(52, 36), P(-6, 36), P(-6, -6), P(52, -6),
-                        P(52, 36), P(-6, 36), P(-6, -6), P(10, -6)};
+    route->waypoints = {P(10, -6), P(52, -6), P(52, 36), P(-6, 36), P(-6, -6),
+                        P(52, -6), P(52, 36), P(-6, 36), P(-6, -6), P(10, -6)};
   } else if (name == "inner-loop") {
     route->waypoints = {P(5, -6), P(23, -6), P(23, 36), P(-6, 36), P(-6, -6), P(5, -6)};
   } else if (name == "l-shape") {

@@ -22,8 +22,7 @@ double L1Score(const BowVector& a, const BowVector& b) {
   return std::clamp(0.5 * common, 0.0, 1.0);
 }
 
-void MakeBowVector(const std::vector<WordId>& descriptor_words, const float* word_weights,
-                   BowVector* bow) {
+void MakeBowVector(const std::vector<WordId>& descriptor_words, const float* word_weights, BowVector* bow) {
   std::vector<WordId> sorted = descriptor_words;
   std::sort(sorted.begin(), sorted.end());
   bow->words.clear();

@@ -18,8 +18,8 @@ int Nearest(const float* point, const std::vector<float>& centres, int clusters,
 }
 
 // k-means++: the first centre uniformly, each next one with probability proportional to D^2.
-void SeedPlusPlus(const float* data, int dimension, const std::vector<std::uint32_t>& indices, int k,
-                  std::mt19937* rng, std::vector<float>* centres) {
+void SeedPlusPlus(const float* data, int dimension, const std::vector<std::uint32_t>& indices, int k, std::mt19937* rng,
+                  std::vector<float>* centres) {
   const std::size_t n = indices.size();
   centres->assign(static_cast<std::size_t>(k) * dimension, 0.0f);
   std::vector<double> distance(n, std::numeric_limits<double>::max());
@@ -29,9 +29,9 @@ void SeedPlusPlus(const float* data, int dimension, const std::vector<std::uint3
     std::copy(centre, centre + dimension, centres->begin() + static_cast<std::size_t>(c) * dimension);
     double total = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
-      distance[i] = std::min(distance[i],
-                             static_cast<double>(SquaredDistance(data + static_cast<std::size_t>(indices[i]) * dimension,
-                                                                 centre, dimension)));
+      distance[i] =
+          std::min(distance[i], static_cast<double>(SquaredDistance(
+                                    data + static_cast<std::size_t>(indices[i]) * dimension, centre, dimension)));
       total += distance[i];
     }
     if (total <= 0.0) {
@@ -94,8 +94,8 @@ void KMeans(const float* data, int dimension, const std::vector<std::uint32_t>& 
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     bool changed = iteration == 0;
     for (int i = 0; i < n; ++i) {
-      const int nearest = Nearest(data + static_cast<std::size_t>(indices[i]) * dimension, result->centres, k,
-                                  dimension, nullptr);
+      const int nearest =
+          Nearest(data + static_cast<std::size_t>(indices[i]) * dimension, result->centres, k, dimension, nullptr);
       changed |= nearest != result->assignment[i];
       result->assignment[i] = nearest;
     }

@@ -9,9 +9,9 @@
 namespace patrolmap::vocab {
 
 struct Clustering {
-  int clusters = 0;               // k, or fewer when there are fewer points
-  std::vector<float> centres;     // clusters x dimension
-  std::vector<int> assignment;    // per point (position in `indices`)
+  int clusters = 0;             // k, or fewer when there are fewer points
+  std::vector<float> centres;   // clusters x dimension
+  std::vector<int> assignment;  // per point (position in `indices`)
   int iterations = 0;
 };
 

@@ -18,7 +18,8 @@ bool VocabularyOptions::IsValid(std::string* error) const {
   if (branching < 2 || branching > 1000) return *error = "vocab branching k must be in [2, 1000]", false;
   if (depth < 1 || depth > 10) return *error = "vocab depth L must be in [1, 10]", false;
   if (max_iterations < 1) return *error = "vocab max_iterations must be at least 1", false;
-  if (std::pow(static_cast<double>(branching), depth) > 4e9) return *error = "vocab k^L must stay under 4e9 words", false;
+  if (std::pow(static_cast<double>(branching), depth) > 4e9)
+    return *error = "vocab k^L must stay under 4e9 words", false;
   return true;
 }
 
@@ -80,7 +81,8 @@ class VocabularyBuilder {
     Clustering clustering;
     KMeans(data_, dimension_, pending.points, options_.branching, options_.max_iterations, &rng_, &clustering);
     std::vector<std::vector<std::uint32_t>> members(clustering.clusters);
-    for (std::size_t i = 0; i < pending.points.size(); ++i) members[clustering.assignment[i]].push_back(pending.points[i]);
+    for (std::size_t i = 0; i < pending.points.size(); ++i)
+      members[clustering.assignment[i]].push_back(pending.points[i]);
     pending.points = {};
     Vocabulary& v = *vocabulary_;
     v.first_child_[pending.node] = static_cast<std::uint32_t>(v.first_child_.size());
@@ -106,7 +108,8 @@ Status StackDescriptors(const std::vector<cv::Mat>& images, cv::Mat* stacked) {
   std::vector<cv::Mat> valid;
   for (std::size_t i = 0; i < images.size(); ++i) {
     if (images[i].empty()) continue;
-    if (images[i].type() != CV_32FC1) return Status::InvalidArgument("descriptors of image " + std::to_string(i) + " are not CV_32F");
+    if (images[i].type() != CV_32FC1)
+      return Status::InvalidArgument("descriptors of image " + std::to_string(i) + " are not CV_32F");
     if (dimension >= 0 && images[i].cols != dimension) return Status::InvalidArgument("descriptor widths differ");
     dimension = images[i].cols;
     valid.push_back(images[i]);
@@ -170,7 +173,8 @@ WordId Vocabulary::WordOfDescriptor(const float* descriptor, float* scaled) cons
     std::uint32_t best = first;
     float best_distance = std::numeric_limits<float>::max();
     for (std::uint32_t child = first; child < first + child_count_[node]; ++child) {
-      const float d = SquaredDistanceTo8Bit(scaled, &centres_[static_cast<std::size_t>(child) * dimension_], dimension_);
+      const float d =
+          SquaredDistanceTo8Bit(scaled, &centres_[static_cast<std::size_t>(child) * dimension_], dimension_);
       if (d < best_distance) best_distance = d, best = child;
     }
     node = best;
@@ -203,7 +207,8 @@ std::uint64_t Vocabulary::Fingerprint() const {
   const std::int32_t parameters[3] = {branching_, depth_, dimension_};
   std::uint64_t hash = Checksum(reinterpret_cast<const char*>(parameters), sizeof(parameters));
   hash = Checksum(reinterpret_cast<const char*>(&scale_), sizeof(scale_), hash);
-  hash = Checksum(reinterpret_cast<const char*>(first_child_.data()), first_child_.size() * sizeof(std::uint32_t), hash);
+  hash =
+      Checksum(reinterpret_cast<const char*>(first_child_.data()), first_child_.size() * sizeof(std::uint32_t), hash);
   hash = Checksum(reinterpret_cast<const char*>(centres_.data()), centres_.size(), hash);
   return Checksum(reinterpret_cast<const char*>(idf_.data()), idf_.size() * sizeof(float), hash);
 }

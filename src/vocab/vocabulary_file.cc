@@ -49,7 +49,6 @@ std::size_t BodyBytes(std::uint64_t nodes, std::uint64_t words, std::uint64_t di
   return nodes * (4 + 2 + 4 + 4 + dimension) + words * (4 + 4);
 }
 
-
 }  // namespace
 
 // Befriended by Vocabulary to fill its arrays.
@@ -61,7 +60,8 @@ struct VocabularyFile {
     std::ifstream stream(path, std::ios::binary);
     char header[kHeaderBytes] = {};
     stream.read(header, static_cast<std::streamsize>(std::min<std::uint64_t>(size, kHeaderBytes)));
-    if (size < 8 || std::memcmp(header, kMagic, 8) != 0) return Status::DataLoss(path + ": not a patrolmap vocabulary file");
+    if (size < 8 || std::memcmp(header, kMagic, 8) != 0)
+      return Status::DataLoss(path + ": not a patrolmap vocabulary file");
     if (size < kHeaderBytes) return Status::DataLoss(path + ": truncated vocabulary (header incomplete)");
     std::uint32_t fields[6];
     std::memcpy(fields, header + 8, sizeof(fields));
@@ -83,8 +83,9 @@ struct VocabularyFile {
     v->dimension_ = static_cast<int>(dimension);
     std::memcpy(&v->scale_, header + 8 + 4 * 6, 4);
     std::uint64_t checksum = Checksum(header + 8, kHeaderBytes - 8, kChecksumSeed);
-    const bool read = Take(&stream, nodes, &v->first_child_, &checksum) && Take(&stream, nodes, &v->child_count_, &checksum) &&
-                      Take(&stream, nodes, &v->word_, &checksum) && Take(&stream, nodes, &v->parent_, &checksum) &&
+    const bool read = Take(&stream, nodes, &v->first_child_, &checksum) &&
+                      Take(&stream, nodes, &v->child_count_, &checksum) && Take(&stream, nodes, &v->word_, &checksum) &&
+                      Take(&stream, nodes, &v->parent_, &checksum) &&
                       Take(&stream, nodes * dimension, &v->centres_, &checksum) &&
                       Take(&stream, words, &v->idf_, &checksum) && Take(&stream, words, &v->leaf_, &checksum);
     std::uint64_t stored = 0;
@@ -120,9 +121,10 @@ struct VocabularyFile {
   static std::string Serialise(const Vocabulary& v) {
     std::string out(kMagic, 8);
     out.reserve(kHeaderBytes + BodyBytes(v.first_child_.size(), v.idf_.size(), v.dimension_) + 8);
-    for (std::uint32_t value : {kVersion, static_cast<std::uint32_t>(v.branching_), static_cast<std::uint32_t>(v.depth_),
-                                static_cast<std::uint32_t>(v.dimension_), static_cast<std::uint32_t>(v.first_child_.size()),
-                                static_cast<std::uint32_t>(v.idf_.size())}) {
+    for (std::uint32_t value :
+         {kVersion, static_cast<std::uint32_t>(v.branching_), static_cast<std::uint32_t>(v.depth_),
+          static_cast<std::uint32_t>(v.dimension_), static_cast<std::uint32_t>(v.first_child_.size()),
+          static_cast<std::uint32_t>(v.idf_.size())}) {
       AppendValue(value, &out);
     }
     AppendValue(v.scale_, &out);

@@ -10,9 +10,9 @@
 #include <string>
 #include <thread>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/map_file.h"
@@ -41,7 +41,8 @@ struct Arguments {
   pipeline::OnboardOptions options;
 };
 
-Status OpenSource(const Arguments& arguments, const pipeline::Config& config, std::unique_ptr<io::FrameSource>* source) {
+Status OpenSource(const Arguments& arguments, const pipeline::Config& config,
+                  std::unique_ptr<io::FrameSource>* source) {
   const std::string prefix = "camera:";
   if (arguments.source.rfind(prefix, 0) != 0) return io::OpenLog(arguments.source, config.input, source);
   try {
@@ -71,13 +72,17 @@ Status Stream(const Arguments& arguments, io::FrameSource* source, pipeline::Onb
     if (!first_ns) first_ns = frame.timestamp_ns;
     const double flight_s = NsToSeconds(frame.timestamp_ns - *first_ns);
     if (arguments.max_seconds > 0.0 && flight_s > arguments.max_seconds) break;
-    const Clock::time_point due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(flight_s));
+    const Clock::time_point due =
+        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(flight_s));
     if (paced) std::this_thread::sleep_until(due);
     PATROLMAP_RETURN_IF_ERROR(mapper->AddFrame(frame));
-    if (paced) pace->max_lag_seconds = std::max(pace->max_lag_seconds, std::chrono::duration<double>(Clock::now() - due).count());
+    if (paced)
+      pace->max_lag_seconds =
+          std::max(pace->max_lag_seconds, std::chrono::duration<double>(Clock::now() - due).count());
     if (Clock::now() - last_report > std::chrono::seconds(5)) {
       last_report = Clock::now();
-      spdlog::info("{:.0f} s of flight, {} frames, {} key frames", flight_s, mapper->stats().frames, mapper->stats().key_frames);
+      spdlog::info("{:.0f} s of flight, {} frames, {} key frames", flight_s, mapper->stats().frames,
+                   mapper->stats().key_frames);
     }
   }
   pace->interrupted = stop_requested.load();
@@ -87,14 +92,15 @@ Status Stream(const Arguments& arguments, io::FrameSource* source, pipeline::Onb
 
 void PrintSummary(const Arguments& arguments, const pipeline::OnboardStats& s, const pipeline::MapResult& result,
                   const Pace& pace) {
-  std::printf("%s%lld frames in %.1f s (%.1f frames/s), %lld processed: flow %.2f ms per processed frame (slowest "
-              "%.1f ms); %d key frames (%d lost from the ring), %zu nodes, %zu loop closures; place queue at most "
-              "%d deep, frame thread waited %.2f s for it, fell at most %.3f s behind the log's clock; outputs in %s\n",
-              pace.interrupted ? "interrupted: " : "", static_cast<long long>(s.frames), pace.seconds,
-              pace.seconds > 0 ? s.frames / pace.seconds : 0.0, static_cast<long long>(s.processed),
-              s.processed ? 1e3 * s.flow_seconds / s.processed : 0.0, 1e3 * s.max_flow_seconds, s.key_frames,
-              s.lost_key_frames, result.nodes.size(), result.loop_closures.size(), s.max_queue, s.waited_seconds,
-              pace.max_lag_seconds, arguments.out.c_str());
+  std::printf(
+      "%s%lld frames in %.1f s (%.1f frames/s), %lld processed: flow %.2f ms per processed frame (slowest "
+      "%.1f ms); %d key frames (%d lost from the ring), %zu nodes, %zu loop closures; place queue at most "
+      "%d deep, frame thread waited %.2f s for it, fell at most %.3f s behind the log's clock; outputs in %s\n",
+      pace.interrupted ? "interrupted: " : "", static_cast<long long>(s.frames), pace.seconds,
+      pace.seconds > 0 ? s.frames / pace.seconds : 0.0, static_cast<long long>(s.processed),
+      s.processed ? 1e3 * s.flow_seconds / s.processed : 0.0, 1e3 * s.max_flow_seconds, s.key_frames, s.lost_key_frames,
+      result.nodes.size(), result.loop_closures.size(), s.max_queue, s.waited_seconds, pace.max_lag_seconds,
+      arguments.out.c_str());
 }
 
 // The patrol record of a flight mapped onboard: no objects or evidence grid (they need the whole log), but
@@ -167,12 +173,16 @@ int main(int argc, char** argv) {
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
   app.add_option("--max-seconds", arguments.max_seconds, "stop after this much of the flight [s]; 0: at its end")
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--inline-places", [&arguments](std::int64_t) { arguments.options.place_worker = false; },
-               "run place recognition on the frame thread (the map is the same)");
+  app.add_flag(
+      "--inline-places", [&arguments](std::int64_t) { arguments.options.place_worker = false; },
+      "run place recognition on the frame thread (the map is the same)");
   app.add_option("--queue", arguments.options.queue_capacity, "key frames waiting for place recognition at most")
-      ->capture_default_str()->check(CLI::PositiveNumber);
-  app.add_option("--ring-s", arguments.options.ring_s, "seconds of processed frames kept for key locations confirmed late")
-      ->capture_default_str()->check(CLI::Range(0.1, 3600.0));
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--ring-s", arguments.options.ring_s,
+                 "seconds of processed frames kept for key locations confirmed late")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
   app.add_flag("-q,--quiet", quiet, "only print errors");
   app.footer("SIGINT or SIGTERM ends the stream; the map is written as if it had ended, and the exit code is 0.");
   try {

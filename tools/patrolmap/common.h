@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "patrolmap/change/report.h"
 #include "patrolmap/core/status.h"

@@ -46,11 +46,12 @@ pipeline::PlotTruth LoadPlotTruth(const std::string& log) {
 void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionResult& result) {
   int peaks = 0;
   for (const KeyLocation& node : result.key_locations) peaks += node.kind == ExtremumKind::kPeak;
-  std::printf("%s: %lld frames, %zu processed, %zu key locations (%d peaks, %zu valleys), %zu unreadable frames "
-              "skipped, %.1f s (%.0f frames/s); outputs in %s\n",
-              arguments.log.c_str(), static_cast<long long>(result.frames_read), result.samples.size(),
-              result.key_locations.size(), peaks, result.key_locations.size() - peaks, result.skipped.size(),
-              result.seconds, result.frames_read / std::max(result.seconds, 1e-9), arguments.out.c_str());
+  std::printf(
+      "%s: %lld frames, %zu processed, %zu key locations (%d peaks, %zu valleys), %zu unreadable frames "
+      "skipped, %.1f s (%.0f frames/s); outputs in %s\n",
+      arguments.log.c_str(), static_cast<long long>(result.frames_read), result.samples.size(),
+      result.key_locations.size(), peaks, result.key_locations.size() - peaks, result.skipped.size(), result.seconds,
+      result.frames_read / std::max(result.seconds, 1e-9), arguments.out.c_str());
 }
 
 int RunDetect(const DetectArguments& arguments) {
@@ -66,8 +67,9 @@ int RunDetect(const DetectArguments& arguments) {
   pipeline::DetectionResult result;
   {
     Progress progress("detect");
-    status = pipeline::RunDetection(source.get(), config.flow, &result,
-                                    [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); });
+    status =
+        pipeline::RunDetection(source.get(), config.flow, &result,
+                               [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); });
   }
   if (!status.ok()) return Fail(status);
   for (const std::string& warning : pipeline::DetectionWarnings(source->info(), result, config.flow)) {
@@ -91,8 +93,7 @@ Command AddDetectCommand(CLI::App* app) {
       ->required();
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
-  app->add_option("--response", arguments->quantity,
-                  "override flow.response.quantity: length or line_parameter");
+  app->add_option("--response", arguments->quantity, "override flow.response.quantity: length or line_parameter");
   app->add_option("--smoothing", arguments->smoothing, "override flow.smoothing.mode: centered or causal");
   AddFpsOption(app, &arguments->fps);
   app->footer("Writes OUT/key_locations.csv, OUT/response.csv and OUT/response.svg.");

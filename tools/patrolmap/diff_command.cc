@@ -2,8 +2,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "commands.h"
@@ -31,7 +31,8 @@ int RunDiff(const DiffArguments& arguments) {
   std::string from = arguments.from, to = arguments.to;
   if (to.empty() && !flights.empty()) to = flights.back();
   if (from.empty() && flights.size() >= 2) from = flights[flights.size() - 2];
-  if (from.empty() || to.empty()) return Fail(Status::InvalidArgument(arguments.map + ": needs two flights to compare"));
+  if (from.empty() || to.empty())
+    return Fail(Status::InvalidArgument(arguments.map + ": needs two flights to compare"));
   if (from == to) return Fail(Status::InvalidArgument("--from and --to name the same flight '" + from + "'"));
   change::ChangeReport report;
   status = pipeline::CompareFlights(map, from, to, config.change, &report);
@@ -89,9 +90,10 @@ Command AddDiffCommand(CLI::App* app) {
   app->add_option("--to", arguments->to, "the later flight (default: the map's last flight)");
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->config, "YAML configuration (change.* keys; see config/default.yaml)");
-  app->footer("Compares the two flights: appearance at every place both saw (their loop closures), objects when both "
-              "logs had detections, geometry when both had depth. Writes OUT/changes.json (format "
-              "patrolmap.changes/1, docs/changes.schema.json) and OUT/changes.html.");
+  app->footer(
+      "Compares the two flights: appearance at every place both saw (their loop closures), objects when both "
+      "logs had detections, geometry when both had depth. Writes OUT/changes.json (format "
+      "patrolmap.changes/1, docs/changes.schema.json) and OUT/changes.html.");
   return [arguments] { return RunDiff(*arguments); };
 }
 

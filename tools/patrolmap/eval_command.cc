@@ -6,20 +6,20 @@
 #include <memory>
 #include <string>
 
+#include <spdlog/spdlog.h>
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/eigen.hpp>
-#include <spdlog/spdlog.h>
 
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/eval/change_score.h"
 #include "patrolmap/eval/key_location_score.h"
-#include "patrolmap/graph/map_file.h"
-#include "patrolmap/pipeline/change.h"
 #include "patrolmap/eval/loop_closure_score.h"
+#include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/readers.h"
+#include "patrolmap/pipeline/change.h"
 
 namespace patrolmap::tools {
 namespace {
@@ -57,13 +57,17 @@ Status EvaluateKeyLocations(const EvalArguments& arguments, const TruthLog& log,
   PATROLMAP_RETURN_IF_ERROR(eval::ReadKeyLocationsCsv(arguments.run + "/key_locations.csv", &detected));
   PATROLMAP_RETURN_IF_ERROR(eval::ReadTruthEdges(log.path, &edges));
   const eval::KeyLocationScore score = eval::ScoreKeyLocations(detected, edges, arguments.key_locations);
-  (*report)["key_locations"] = {
-      {"flight", log.info.flight_id},          {"frames", log.info.frame_count},
-      {"tolerance_s", arguments.key_locations.tolerance_s}, {"min_span_s", arguments.key_locations.min_span_s},
-      {"nodes", score.detected},               {"expected", score.expected},
-      {"true_positives", score.true_positives}, {"false_positives", score.false_positives},
-      {"missed", score.missed},                {"precision", score.precision()},
-      {"recall", score.recall()}};
+  (*report)["key_locations"] = {{"flight", log.info.flight_id},
+                                {"frames", log.info.frame_count},
+                                {"tolerance_s", arguments.key_locations.tolerance_s},
+                                {"min_span_s", arguments.key_locations.min_span_s},
+                                {"nodes", score.detected},
+                                {"expected", score.expected},
+                                {"true_positives", score.true_positives},
+                                {"false_positives", score.false_positives},
+                                {"missed", score.missed},
+                                {"precision", score.precision()},
+                                {"recall", score.recall()}};
   if (arguments.verbose && !arguments.json) {
     for (std::size_t i = 0; i < score.spans.size(); ++i) {
       const eval::ExpectedSpan& span = score.spans[i];
@@ -87,7 +91,9 @@ Status EvaluateLoopClosures(const EvalArguments& arguments, const std::vector<Tr
   std::vector<eval::Place> places;
   for (const eval::NodeRecord& node : nodes) {
     const auto log = by_flight.find(node.flight);
-    if (log == by_flight.end()) return Status::InvalidArgument(arguments.run + "/nodes.csv: node " + std::to_string(node.node) + " comes from flight '" + node.flight + "', which no --log holds");
+    if (log == by_flight.end())
+      return Status::InvalidArgument(arguments.run + "/nodes.csv: node " + std::to_string(node.node) +
+                                     " comes from flight '" + node.flight + "', which no --log holds");
     if (node.frame_index < 0 || node.frame_index >= static_cast<std::int64_t>(log->second->places.size())) {
       return Status::DataLoss(arguments.run + "/nodes.csv: node " + std::to_string(node.node) + ": frame " +
                               std::to_string(node.frame_index) + " is not in " + log->second->path);
@@ -109,8 +115,12 @@ Status EvaluateLoopClosures(const EvalArguments& arguments, const std::vector<Tr
 }
 
 nlohmann::json CountsJson(const eval::Counts& c) {
-  return {{"true_positives", c.true_positives}, {"false_positives", c.false_positives},
-          {"false_negatives", c.false_negatives}, {"precision", c.Precision()}, {"recall", c.Recall()}, {"f1", c.F1()}};
+  return {{"true_positives", c.true_positives},
+          {"false_positives", c.false_positives},
+          {"false_negatives", c.false_negatives},
+          {"precision", c.Precision()},
+          {"recall", c.Recall()},
+          {"f1", c.F1()}};
 }
 
 Status ReadReportedObjects(const std::string& path, const nlohmann::json& objects,
@@ -135,8 +145,9 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
 void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& report,
                      const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
                      const eval::ChangeScoreOptions& options, nlohmann::json* result) {
-  const eval::GeometryScore score = eval::ScoreGeometry(report.geometry.changed_voxels, map.Patrol(report.prior_flight)->grid,
-                                                        map.Patrol(report.current_flight)->grid, before, after, options);
+  const eval::GeometryScore score =
+      eval::ScoreGeometry(report.geometry.changed_voxels, map.Patrol(report.prior_flight)->grid,
+                          map.Patrol(report.current_flight)->grid, before, after, options);
   (*result)["geometry"] = CountsJson(score.voxels);
   (*result)["geometry"]["iou"] = score.Iou();
   (*result)["geometry"]["observed_voxels"] = score.observed_voxels;
@@ -153,7 +164,8 @@ bool KeyFrameTruth(const graph::TopoMap& map, int node, const std::vector<eval::
   if (patrol == nullptr || !patrol->camera.valid() || n.thumbnail.empty()) return false;
   const std::optional<CameraPoseSample> pose = io::PoseAt(patrol->views, n.timestamp_ns);
   if (!pose) return false;
-  const CameraIntrinsics thumbnail = patrol->camera.Scaled(static_cast<double>(n.thumbnail.cols) / patrol->camera.width);
+  const CameraIntrinsics thumbnail =
+      patrol->camera.Scaled(static_cast<double>(n.thumbnail.cols) / patrol->camera.width);
   *boxes = eval::VisibleChangeBoxes(here, other, n.timestamp_ns, *pose, thumbnail, options);
   return true;
 }
@@ -181,13 +193,17 @@ void ScoreAppearanceOf(const graph::TopoMap& map, const change::ChangeReport& re
     eval::KeepInOverlap(current_from_prior.inverse(), prior_thumbnail.cols, prior_thumbnail.rows, &t.current);
     truth.push_back(t);
     regions.emplace_back();
-    for (const change::AppearanceRegion& r : place.appearance.regions) regions.back().push_back({r.prior_box, r.current_box});
+    for (const change::AppearanceRegion& r : place.appearance.regions)
+      regions.back().push_back({r.prior_box, r.current_box});
   }
   if (truth.empty()) return;
   const eval::AppearanceScore score = eval::ScoreAppearance(truth, regions, options);
-  (*result)["appearance"] = {{"places", truth.size()},           {"regions", score.regions},
-                             {"regions_on_change", score.regions_on_change}, {"changes", score.changes},
-                             {"changes_found", score.changes_found}, {"precision", score.Precision()},
+  (*result)["appearance"] = {{"places", truth.size()},
+                             {"regions", score.regions},
+                             {"regions_on_change", score.regions_on_change},
+                             {"changes", score.changes},
+                             {"changes_found", score.changes_found},
+                             {"precision", score.Precision()},
                              {"recall", score.Recall()}};
 }
 
@@ -200,7 +216,8 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
   } catch (const nlohmann::json::exception& e) {
     return Status::DataLoss(path + ": not JSON: " + e.what());
   }
-  if (changes.value("format", "") != "patrolmap.changes") return Status::DataLoss(path + ": not a patrolmap change report");
+  if (changes.value("format", "") != "patrolmap.changes")
+    return Status::DataLoss(path + ": not a patrolmap change report");
   const std::string prior = changes.value("prior_flight", ""), current = changes.value("current_flight", "");
   const TruthLog *prior_log = nullptr, *current_log = nullptr;
   for (const TruthLog& log : logs) {
@@ -208,12 +225,14 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     if (log.info.flight_id == current) current_log = &log;
   }
   if (prior_log == nullptr || current_log == nullptr) {
-    return Status::InvalidArgument(path + ": compares '" + prior + "' with '" + current + "': pass both logs with --log");
+    return Status::InvalidArgument(path + ": compares '" + prior + "' with '" + current +
+                                   "': pass both logs with --log");
   }
   std::vector<eval::TruthObject> before, after;
   PATROLMAP_RETURN_IF_ERROR(eval::ReadTruthObjects(prior_log->path, &before));
   PATROLMAP_RETURN_IF_ERROR(eval::ReadTruthObjects(current_log->path, &after));
-  nlohmann::json result = {{"prior_flight", prior}, {"current_flight", current},
+  nlohmann::json result = {{"prior_flight", prior},
+                           {"current_flight", current},
                            {"distance_m", arguments.changes.distance_m},
                            {"places_compared", changes["summary"].value("places_compared", 0)},
                            {"places_changed", changes["summary"].value("places_changed", 0)}};
@@ -336,7 +355,8 @@ Command AddEvalCommand(CLI::App* app) {
   auto arguments = std::make_shared<EvalArguments>();
   app->add_option("run", arguments->run, "output folder of a run (key_locations.csv; nodes.csv + loop_closures.csv)")
       ->required();
-  app->add_option("--log", arguments->logs, "simulated log(s) the run processed (with groundtruth/); key locations "
+  app->add_option("--log", arguments->logs,
+                  "simulated log(s) the run processed (with groundtruth/); key locations "
                   "are scored against the first")
       ->required();
   app->add_flag("--json", arguments->json, "print JSON (schema patrolmap.eval/1) instead of tables");

@@ -7,8 +7,8 @@
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/core/files.h"
-#include "patrolmap/graph/export.h"
 #include "patrolmap/eval/loop_closure_score.h"
+#include "patrolmap/graph/export.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
 
@@ -71,12 +71,12 @@ int RunExport(const ExportArguments& arguments) {
   if (geographic && !graph::HasGps(map)) {
     return Fail(Status::InvalidArgument(arguments.map + ": no node has a GPS position (the logs had no gps0/)"));
   }
-  const std::string text = arguments.format == "graphml" ? graph::ToGraphML(map)
-                           : arguments.format == "geojson" ? graph::ToGeoJson(map)
-                           : arguments.format == "kml"     ? graph::ToKml(map)
-                           : arguments.format == "dot"   ? graph::ToDot(map)
+  const std::string text = arguments.format == "graphml"                             ? graph::ToGraphML(map)
+                           : arguments.format == "geojson"                           ? graph::ToGeoJson(map)
+                           : arguments.format == "kml"                               ? graph::ToKml(map)
+                           : arguments.format == "dot"                               ? graph::ToDot(map)
                            : arguments.format == "svg" || arguments.format == "html" ? Picture(map, arguments, &status)
-                                                         : graph::ToJson(map);
+                                                                                     : graph::ToJson(map);
   if (!status.ok()) {
     Fail(status);
     return status.code() == StatusCode::kInvalidArgument ? 2 : 1;
@@ -94,15 +94,17 @@ int RunExport(const ExportArguments& arguments) {
 Command AddExportCommand(CLI::App* app) {
   auto arguments = std::make_shared<ExportArguments>();
   app->add_option("map", arguments->map, "map file (map.pmap)")->required();
-  app->add_option("-f,--format", arguments->format,
-                  "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link), svg (the layout, like paper Fig. 5), "
-                  "html (a self-contained page: pan, zoom, click a node for its key frame), geojson or kml (with GPS)")
+  app->add_option(
+         "-f,--format", arguments->format,
+         "graphml (NetworkX, Gephi, yEd), dot (Graphviz), json (node-link), svg (the layout, like paper Fig. 5), "
+         "html (a self-contained page: pan, zoom, click a node for its key frame), geojson or kml (with GPS)")
       ->check(CLI::IsMember({"graphml", "dot", "json", "svg", "html", "geojson", "kml"}))
       ->capture_default_str();
   app->add_option("-o,--out", arguments->out, "file to write (default: standard output)");
-  app->add_option("--log", arguments->logs,
-                  "svg, html: simulated logs of the map's flights; loop closures are drawn correct (green), false (red) and "
-                  "missed (blue) against their ground truth");
+  app->add_option(
+      "--log", arguments->logs,
+      "svg, html: simulated logs of the map's flights; loop closures are drawn correct (green), false (red) and "
+      "missed (blue) against their ground truth");
   return [arguments] { return RunExport(*arguments); };
 }
 

@@ -18,13 +18,16 @@ int RunInfo(const std::string& path, bool verbose) {
   if (!status.ok()) return Fail(status);
   int within = 0, across = 0, traversals = 0;
   for (const graph::TopoMap::Edge& edge : map.Edges()) {
-    if (edge.data.kind == graph::EdgeKind::kTraversal) ++traversals;
-    else if (map.node(edge.a).flight == map.node(edge.b).flight) ++within;
-    else ++across;
+    if (edge.data.kind == graph::EdgeKind::kTraversal)
+      ++traversals;
+    else if (map.node(edge.a).flight == map.node(edge.b).flight)
+      ++within;
+    else
+      ++across;
   }
   std::printf("%s: %.1f KB, %zu flights, %d nodes, %d traversals, %d loop closures (%d within flights, %d across)\n",
-              path.c_str(), std::filesystem::file_size(path) / 1024.0, map.Flights().size(), map.node_count(), traversals,
-              within + across, within, across);
+              path.c_str(), std::filesystem::file_size(path) / 1024.0, map.Flights().size(), map.node_count(),
+              traversals, within + across, within, across);
   for (const std::string& flight : map.Flights()) {
     int nodes = 0;
     double first = 0.0, last = 0.0;
@@ -37,8 +40,8 @@ int RunInfo(const std::string& path, bool verbose) {
     std::printf("  flight %-24s %4d nodes, %.1f-%.1f s", flight.c_str(), nodes, first, last);
     const PatrolRecord* record = map.Patrol(flight);
     if (record != nullptr && record->has_objects) {
-      const auto confirmed = std::count_if(record->objects.begin(), record->objects.end(),
-                                           [](const MapObject& o) { return o.confirmed; });
+      const auto confirmed =
+          std::count_if(record->objects.begin(), record->objects.end(), [](const MapObject& o) { return o.confirmed; });
       std::printf(", %zu objects (%zu unconfirmed)", static_cast<std::size_t>(confirmed),
                   record->objects.size() - static_cast<std::size_t>(confirmed));
     }

@@ -20,7 +20,8 @@ int main(int argc, char** argv) {
   add("detect", "detect key locations in a flight log (paper 002 III-A)", patrolmap::tools::AddDetectCommand);
   add("simulate", "render a simulated flight log with ground truth", patrolmap::tools::AddSimulateCommand);
   add("map", "detect key locations and close loops between them (paper 002 III)", patrolmap::tools::AddMapCommand);
-  add("patrol", "add a later flight to a map, closing loops against every earlier flight", patrolmap::tools::AddPatrolCommand);
+  add("patrol", "add a later flight to a map, closing loops against every earlier flight",
+      patrolmap::tools::AddPatrolCommand);
   add("info", "summarise a map file", patrolmap::tools::AddInfoCommand);
   add("diff", "report what changed between two flights of a map", patrolmap::tools::AddDiffCommand);
   add("export", "write a map as GraphML, DOT or JSON", patrolmap::tools::AddExportCommand);

@@ -36,32 +36,36 @@ Status SelectKeyFrames(const MapArguments& arguments, const std::string& log, co
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
   if (arguments.every_frame) {
     if (!source->info().timed) {
-      spdlog::warn("{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} "
-                   "before a query are not its candidates", log, config.place.exclude_recent_images);
+      spdlog::warn(
+          "{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} "
+          "before a query are not its candidates",
+          log, config.place.exclude_recent_images);
     }
     return Status::Ok();
   }
   pipeline::DetectionResult detection;
   {
     Progress progress("detect");
-    PATROLMAP_RETURN_IF_ERROR(pipeline::RunDetection(source.get(), config.flow, &detection,
-                                                     [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
+    PATROLMAP_RETURN_IF_ERROR(pipeline::RunDetection(
+        source.get(), config.flow, &detection, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
   }
   for (const std::string& warning : pipeline::DetectionWarnings(source->info(), detection, config.flow)) {
     spdlog::warn("{}", warning);
   }
   for (const KeyLocation& node : detection.key_locations) selection->frames.push_back(node.frame_index);
   const bool several = arguments.logs.size() > 1;
-  return pipeline::WriteDetectionOutputs(detection, several ? arguments.out + "/" + source->info().flight_id : arguments.out);
+  return pipeline::WriteDetectionOutputs(detection,
+                                         several ? arguments.out + "/" + source->info().flight_id : arguments.out);
 }
 
 void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& result) {
   const double nodes = std::max<std::size_t>(1, result.nodes.size());
-  std::printf("%zu log(s): %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
-              "verification, %.2f ms database update; outputs in %s\n",
-              arguments.logs.size(), result.nodes.size(), result.loop_closures.size(),
-              1e3 * result.seconds_features / nodes, 1e3 * result.seconds_query / nodes,
-              1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes, arguments.out.c_str());
+  std::printf(
+      "%zu log(s): %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
+      "verification, %.2f ms database update; outputs in %s\n",
+      arguments.logs.size(), result.nodes.size(), result.loop_closures.size(), 1e3 * result.seconds_features / nodes,
+      1e3 * result.seconds_query / nodes, 1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes,
+      arguments.out.c_str());
 }
 
 // The patrol record of `log` (object map, evidence grid, views) for change detection.
@@ -160,15 +164,17 @@ Command AddPatrolCommand(CLI::App* app) {
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
   app->add_option("--vocabulary", arguments->vocabulary, "vocabulary file (default: the shipped one)");
   AddFpsOption(app, &arguments->fps);
-  app->footer("Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
-              "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
-              "since the map's last flight to OUT/changes.json and OUT/changes.html (as patrolmap diff).");
+  app->footer(
+      "Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
+      "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
+      "since the map's last flight to OUT/changes.json and OUT/changes.html (as patrolmap diff).");
   return [arguments] { return RunMap(*arguments); };
 }
 
 Command AddMapCommand(CLI::App* app) {
   auto arguments = std::make_shared<MapArguments>();
-  app->add_option("logs", arguments->logs, "flight log(s) as for detect; several are matched in order through one "
+  app->add_option("logs", arguments->logs,
+                  "flight log(s) as for detect; several are matched in order through one "
                   "database, so later flights close loops against earlier ones")
       ->required();
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
@@ -180,7 +186,8 @@ Command AddMapCommand(CLI::App* app) {
   app->add_flag("--every-frame", arguments->every_frame,
                 "make every image a node, without key-location detection (image collections, place recognition "
                 "alone); without timestamps 'recent' is counted in images (place.exclude_recent_images)");
-  app->footer("Writes OUT/map.pmap, OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
+  app->footer(
+      "Writes OUT/map.pmap, OUT/nodes.csv and OUT/loop_closures.csv, and the detect outputs unless --every-frame.");
   return [arguments] { return RunMap(*arguments); };
 }
 

@@ -19,8 +19,7 @@ class Progress {
   // Shows "what: done/total (rate/s)"; total < 0 when unknown.
   void Update(std::int64_t done, std::int64_t total) {
     if (!enabled_) return;
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double rate = seconds > 0.0 ? done / seconds : 0.0;
     if (total > 0) {
       std::fprintf(stderr, "\r%s: %lld/%lld frames (%.0f/s)   ", what_, static_cast<long long>(done),

@@ -84,7 +84,8 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   int width = 0, height = 0;
   PATROLMAP_RETURN_IF_ERROR(ParseResolution(arguments.resolution, &width, &height));
   PATROLMAP_RETURN_IF_ERROR(BuildFlight(arguments, number, &flight));
-  flight.flight_id += "-" + std::to_string(arguments.seed) + (arguments.flights > 1 ? "-f" + std::to_string(number) : "");
+  flight.flight_id +=
+      "-" + std::to_string(arguments.seed) + (arguments.flights > 1 ? "-f" + std::to_string(number) : "");
   flight.camera = flight.camera.Scaled(static_cast<double>(width) / flight.camera.width);
   flight.camera.height = height;
   if (!arguments.plain_lighting) flight.lighting = sim::DrawLighting(arguments.seed, number);
@@ -115,17 +116,20 @@ int RunSimulate(SimulateArguments arguments) {
 }
 
 void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
-  app->add_option("--flights", arguments->flights, "flights of a patrol series, written to OUT/flight_1 ... (lighting, "
+  app->add_option("--flights", arguments->flights,
+                  "flights of a patrol series, written to OUT/flight_1 ... (lighting, "
                   "flight path jitter and objects change between them)")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   app->add_option("--objects", arguments->objects, "village: movable objects (crates, barrels, vehicles) in flight 1")
       ->check(CLI::Range(0, 200))
       ->capture_default_str();
-  app->add_option("--remove-fraction", arguments->changes.remove_fraction, "series: share of objects removed per flight")
+  app->add_option("--remove-fraction", arguments->changes.remove_fraction,
+                  "series: share of objects removed per flight")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app->add_option("--move-fraction", arguments->changes.move_fraction, "series: share of objects moved 2-6 m per flight")
+  app->add_option("--move-fraction", arguments->changes.move_fraction,
+                  "series: share of objects moved 2-6 m per flight")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--added", arguments->changes.added, "series: objects added per flight")
@@ -147,8 +151,11 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
 }
 
 void AddStreetOptions(CLI::App* app, sim::StreetOptions* street) {
-  app->add_option("--walls", street->walls, "street: facades along the street")->check(CLI::Range(1, 100))->capture_default_str();
-  app->add_flag("--irregular", street->irregular, "street: draw facade lengths, gaps, depths and heights from the seed");
+  app->add_option("--walls", street->walls, "street: facades along the street")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app->add_flag("--irregular", street->irregular,
+                "street: draw facade lengths, gaps, depths and heights from the seed");
   app->add_option("--yaw-wobble", street->yaw_wobble_deg, "street: heading swing amplitude [deg]")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
@@ -168,8 +175,11 @@ void AddRouteOptions(CLI::App* app, sim::RouteOptions* flight) {
   app->add_option("--speed-jitter", flight->speed_jitter, "village: smooth speed variation, fraction of the speed")
       ->check(CLI::Range(0.0, 0.9))
       ->capture_default_str();
-  app->add_option("--altitude", flight->altitude_m, "village: flight height [m]")->check(CLI::Range(0.5, 30.0))->capture_default_str();
-  app->add_option("--altitude-changes", flight->altitude_changes, "village: sudden climbs or descents during the flight")
+  app->add_option("--altitude", flight->altitude_m, "village: flight height [m]")
+      ->check(CLI::Range(0.5, 30.0))
+      ->capture_default_str();
+  app->add_option("--altitude-changes", flight->altitude_changes,
+                  "village: sudden climbs or descents during the flight")
       ->check(CLI::Range(0, 20))
       ->capture_default_str();
   app->add_option("--altitude-change", flight->altitude_change_m, "village: size of each altitude change [m]")

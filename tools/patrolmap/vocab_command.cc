@@ -96,7 +96,8 @@ int RunBuild(const VocabArguments& arguments) {
   if (status.ok()) status = vocabulary.Save(arguments.out);
   if (!status.ok()) return Fail(status);
   std::printf("%s: %d words (k=%d, L=%d) from %zu descriptors of %zu images\n", arguments.out.c_str(),
-              vocabulary.word_count(), arguments.options.branching, arguments.options.depth, descriptors, images.size());
+              vocabulary.word_count(), arguments.options.branching, arguments.options.depth, descriptors,
+              images.size());
   return 0;
 }
 
@@ -105,16 +106,22 @@ int RunBuild(const VocabArguments& arguments) {
 Command AddVocabCommand(CLI::App* app) {
   auto arguments = std::make_shared<VocabArguments>();
   app->require_subcommand(1);
-  CLI::App* build = app->add_subcommand("build", "train a vocabulary tree on the SIFT features of logs or image folders");
-  build->add_option("inputs", arguments->inputs,
-                    "logs, image folders, patterns or videos (every n-th frame), or single photographs (each "
-                    "described at " + std::to_string(kPhotoWidth) + " pixels wide)")
+  CLI::App* build =
+      app->add_subcommand("build", "train a vocabulary tree on the SIFT features of logs or image folders");
+  build
+      ->add_option("inputs", arguments->inputs,
+                   "logs, image folders, patterns or videos (every n-th frame), or single photographs (each "
+                   "described at " +
+                       std::to_string(kPhotoWidth) + " pixels wide)")
       ->required();
   build->add_option("-o,--out", arguments->out, "vocabulary file to write")->required();
-  build->add_option("-c,--config", arguments->config, "YAML configuration (features: place.*, scale: flow.frames.scale)");
+  build->add_option("-c,--config", arguments->config,
+                    "YAML configuration (features: place.*, scale: flow.frames.scale)");
   build->add_option("-k,--branching", arguments->options.branching, "children per node")->capture_default_str();
   build->add_option("-L,--depth", arguments->options.depth, "levels below the root")->capture_default_str();
-  build->add_option("--every", arguments->every, "use every n-th frame")->check(CLI::PositiveNumber)->capture_default_str();
+  build->add_option("--every", arguments->every, "use every n-th frame")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   build->add_option("--seed", arguments->options.seed, "k-means++ seed")->capture_default_str();
   build->add_option("--max-iterations", arguments->options.max_iterations, "k-means iteration cap per node")
       ->capture_default_str();

@@ -32,22 +32,22 @@ struct KeyFrameView {
 };
 
 struct AppearanceRegion {
-  cv::Rect current_box;   // in the current key frame
-  cv::Rect prior_box;     // the same region in the prior key frame
+  cv::Rect current_box;  // in the current key frame
+  cv::Rect prior_box;    // the same region in the prior key frame
   int area_px = 0;
-  double score = 0.0;     // mean structure change in the region (1 - contrast-structure term)
-  int prior_features = 0;             // prior features inside the region's box (mapped into the current frame)
-  int unmatched_prior_features = 0;   // ... of which no current feature matches (they support the change)
-  int current_features = 0;           // current features inside the box
-  int unmatched_current_features = 0; // ... of which no prior feature matches
+  double score = 0.0;                  // mean structure change in the region (1 - contrast-structure term)
+  int prior_features = 0;              // prior features inside the region's box (mapped into the current frame)
+  int unmatched_prior_features = 0;    // ... of which no current feature matches (they support the change)
+  int current_features = 0;            // current features inside the box
+  int unmatched_current_features = 0;  // ... of which no prior feature matches
 };
 
 struct AppearanceChange {
   bool registered = false;
   int matches = 0, inliers = 0;
-  double gain = 1.0, offset = 0.0;  // current ~ gain * prior + offset over the overlap
-  double compared_fraction = 0.0;   // share of the current image the registered prior covers
-  cv::Mat homography;               // current_from_prior, image pixels (CV_64F 3x3)
+  double gain = 1.0, offset = 0.0;        // current ~ gain * prior + offset over the overlap
+  double compared_fraction = 0.0;         // share of the current image the registered prior covers
+  cv::Mat homography;                     // current_from_prior, image pixels (CV_64F 3x3)
   std::vector<AppearanceRegion> regions;  // largest first
 };
 

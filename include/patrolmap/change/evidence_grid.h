@@ -59,16 +59,16 @@ struct GeometryRegion {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  // voxel-centre extent
   int voxels = 0;
-  int appeared = 0;   // voxels that became occupied
-  int vanished = 0;   // voxels that became free
-  double score = 0.0; // mean occupancy change
+  int appeared = 0;    // voxels that became occupied
+  int vanished = 0;    // voxels that became free
+  double score = 0.0;  // mean occupancy change
 };
 
 struct GeometryChange {
   double voxel_size = 0.0;
-  long long compared_voxels = 0;                 // observed enough in both patrols
-  std::vector<Eigen::Vector3i> changed_voxels;   // of the reported regions
-  std::vector<GeometryRegion> regions;           // largest first
+  long long compared_voxels = 0;                // observed enough in both patrols
+  std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions
+  std::vector<GeometryRegion> regions;          // largest first
 };
 
 // Fails (returns false) when the grids have different voxel sizes or none.

@@ -36,15 +36,15 @@ bool ParseObjectState(const std::string& text, ObjectState* state);
 struct ObjectChange {
   ObjectState state = ObjectState::kPersistent;
   std::string label;
-  double confidence = 0.0;                 // in [0, 1]
-  int prior_id = -1, current_id = -1;      // object ids in the two patrols' object maps
-  std::optional<Eigen::Vector3d> before;   // prior position (not for new)
-  std::optional<Eigen::Vector3d> after;    // current position (not for removed or unobserved)
-  int covering_views = 0;                  // current views that covered the prior object
-  double expected_detections = 0.0;        // detections they would have given of it (removed, unobserved, moved)
+  double confidence = 0.0;                // in [0, 1]
+  int prior_id = -1, current_id = -1;     // object ids in the two patrols' object maps
+  std::optional<Eigen::Vector3d> before;  // prior position (not for new)
+  std::optional<Eigen::Vector3d> after;   // current position (not for removed or unobserved)
+  int covering_views = 0;                 // current views that covered the prior object
+  double expected_detections = 0.0;       // detections they would have given of it (removed, unobserved, moved)
   // moved: after ~ rotation * (before-point - before) + after, from the SVD registration.
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  double weighted_distance = 0.0;          // moved: paper 003's delta
+  double weighted_distance = 0.0;  // moved: paper 003's delta
 };
 
 // The appearance terms between two objects, each in [0, 1] and present when both have it: texture (half

@@ -26,8 +26,8 @@
 namespace patrolmap::change {
 
 // Layout of MapObject::descriptor.
-constexpr std::size_t kOrientationBins = 8;    // [0, 8): gradient-orientation histogram
-constexpr std::size_t kBrightnessRankAt = 8;   // brightness rank
+constexpr std::size_t kOrientationBins = 8;   // [0, 8): gradient-orientation histogram
+constexpr std::size_t kBrightnessRankAt = 8;  // brightness rank
 
 class ObjectMapper {
  public:
@@ -38,14 +38,14 @@ class ObjectMapper {
   // camera's size, may be empty) its appearance descriptor. Detections
   // without a 3D centroid take it from the depth; without either they are
   // skipped (counted in skipped()).
-  void AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,
-                const cv::Mat& depth_m, const cv::Mat& image);
+  void AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose, const cv::Mat& depth_m,
+                const cv::Mat& image);
 
   // The objects with their final label and confidence; those seen fewer than min_detections times are
   // kept unconfirmed (they are not reported, but a later patrol's sighting there is then no new object).
   std::vector<MapObject> Finish() const;
 
-  int associations() const { return associations_; }   // detections compared with the map
+  int associations() const { return associations_; }  // detections compared with the map
   double association_seconds() const { return association_seconds_; }
   int skipped() const { return skipped_; }
 
@@ -53,7 +53,7 @@ class ObjectMapper {
   struct Candidate;
   struct Measured {
     Eigen::Vector3d centroid;
-    std::vector<Eigen::Vector3f> points;  // world frame
+    std::vector<Eigen::Vector3f> points;             // world frame
     Eigen::Vector2d size = Eigen::Vector2d::Zero();  // width, height [m]
     std::vector<float> descriptor;
   };
@@ -70,7 +70,7 @@ class ObjectMapper {
   ObjectMapOptions options_;
   CameraIntrinsics camera_;
   std::vector<MapObject> objects_;
-  std::vector<Eigen::Vector2d> sizes_;  // running mean width, height of each object
+  std::vector<Eigen::Vector2d> sizes_;       // running mean width, height of each object
   std::array<float, 256> brightness_cdf_{};  // of the current frame's image
   int associations_ = 0;
   double association_seconds_ = 0.0;

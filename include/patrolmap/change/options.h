@@ -8,79 +8,79 @@ namespace patrolmap::change {
 
 // Appearance: changed regions between two registered key frames.
 struct AppearanceOptions {
-  double ratio = 0.8;                // descriptor ratio test for the registration matches
-  double inlier_threshold_px = 3.0;  // homography RANSAC threshold [key-frame pixels]
-  int min_inliers = 12;              // fewer: the pair is not registered and not compared
-  double blur_sigma_px = 1.0;        // Gaussian blur before differencing
-  int search_radius_px = 2;          // each pixel takes the best match within this shift (parallax)
-  double min_difference = 30.0;      // after global gain/offset compensation [grey levels], and ...
-  double min_structure_change = 0.5; // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
-  double structure_sigma_px = 1.5;   // Gaussian window of that term
-  double min_area_fraction = 0.01;   // regions smaller than this share of the compared area are dropped
-  double min_unmatched_share = 0.5;  // ... and so are regions with features of which fewer than this share lost
-                                     // their match between the key frames (parallax, not change)
-  int parallax_search_px = 8;        // ... and regions whose content the registered prior image shows, up to
-  double max_shifted_similarity = 0.7; // this far off, with a normalised cross-correlation above this
+  double ratio = 0.8;                   // descriptor ratio test for the registration matches
+  double inlier_threshold_px = 3.0;     // homography RANSAC threshold [key-frame pixels]
+  int min_inliers = 12;                 // fewer: the pair is not registered and not compared
+  double blur_sigma_px = 1.0;           // Gaussian blur before differencing
+  int search_radius_px = 2;             // each pixel takes the best match within this shift (parallax)
+  double min_difference = 30.0;         // after global gain/offset compensation [grey levels], and ...
+  double min_structure_change = 0.5;    // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
+  double structure_sigma_px = 1.5;      // Gaussian window of that term
+  double min_area_fraction = 0.01;      // regions smaller than this share of the compared area are dropped
+  double min_unmatched_share = 0.5;     // ... and so are regions with features of which fewer than this share lost
+                                        // their match between the key frames (parallax, not change)
+  int parallax_search_px = 8;           // ... and regions whose content the registered prior image shows, up to
+  double max_shifted_similarity = 0.7;  // this far off, with a normalised cross-correlation above this
 };
 
 // Object map of one patrol (paper 000, with the 2D fallback of paper 001).
 struct ObjectMapOptions {
-  double centroid_gate_m = 1.0;       // candidates: map objects whose centroid is this close
-  double pair_distance_m = 0.2;       // point-pair test: nearest-neighbour pairs closer than this agree
-  double min_pair_fraction = 0.5;     // ... and at least this share of pairs must agree
-  double point_voxel_m = 0.1;         // object points are kept one per voxel of this size
-  double segment_depth_m = 0.8;       // depth pixels within this of the centroid's depth belong to the object
-  int max_segment_samples = 400;      // depth pixels sampled per detection
-  double min_box_iou = 0.3;           // 2D test: predicted and detected box must overlap this much
-  double category_sigma_m = 0.5;      // 2D test: per-category prior, Gaussian on the centroid offset
-  double vehicle_sigma_m = 1.0;       // ... wider for vehicles (labels containing "vehicle", "car", "truck")
-  double min_category_prior = 0.1;    // 2D test: smallest prior probability accepted
-  double merge_distance_m = 0.5;      // when the patrol ends, objects whose centroids are this close merge
-  int min_detections = 3;             // objects seen fewer times stay unconfirmed: never reported themselves
-  double max_range_m = 25.0;          // detections farther than this are ignored
+  double centroid_gate_m = 1.0;     // candidates: map objects whose centroid is this close
+  double pair_distance_m = 0.2;     // point-pair test: nearest-neighbour pairs closer than this agree
+  double min_pair_fraction = 0.5;   // ... and at least this share of pairs must agree
+  double point_voxel_m = 0.1;       // object points are kept one per voxel of this size
+  double segment_depth_m = 0.8;     // depth pixels within this of the centroid's depth belong to the object
+  int max_segment_samples = 400;    // depth pixels sampled per detection
+  double min_box_iou = 0.3;         // 2D test: predicted and detected box must overlap this much
+  double category_sigma_m = 0.5;    // 2D test: per-category prior, Gaussian on the centroid offset
+  double vehicle_sigma_m = 1.0;     // ... wider for vehicles (labels containing "vehicle", "car", "truck")
+  double min_category_prior = 0.1;  // 2D test: smallest prior probability accepted
+  double merge_distance_m = 0.5;    // when the patrol ends, objects whose centroids are this close merge
+  int min_detections = 3;           // objects seen fewer times stay unconfirmed: never reported themselves
+  double max_range_m = 25.0;        // detections farther than this are ignored
 };
 
 // State of every object between two patrols (papers 000, 001, 003).
 struct ObjectDiffOptions {
-  double match_distance_m = 1.0;      // persistent: centroids this close (then the point-pair test)
-  double max_move_m = 8.0;            // moved: the two positions at most this far apart (farther: removed + new)
-  double physical_weight = 0.6;       // alpha of paper 003's weighted normalised distance
-  double appearance_weight = 0.4;     // beta
-  double max_texture_distance = 0.25; // pairs whose gradient-orientation histograms differ more (half their
-                                      // L1 distance) are not a move
-  double max_visible_range_m = 20.0;  // visibility: a prior object farther than this is not covered by a view
-  double min_visible_fraction = 0.5;  // visibility: at least this share of its projected box inside the image
-  double min_expected_detections = 3; // removed: the current views covering a prior object would have given at
-                                      // least this many detections (its prior detections x covering views now /
-                                      // covering views in its own patrol); fewer: unobserved
-  double min_shape_overlap = 0.85;    // moved: share of the current object's points, shifted onto the prior
-                                      // object, within 0.15 m of its points (1 when either has none)
+  double match_distance_m = 1.0;       // persistent: centroids this close (then the point-pair test)
+  double max_move_m = 8.0;             // moved: the two positions at most this far apart (farther: removed + new)
+  double physical_weight = 0.6;        // alpha of paper 003's weighted normalised distance
+  double appearance_weight = 0.4;      // beta
+  double max_texture_distance = 0.25;  // pairs whose gradient-orientation histograms differ more (half their
+                                       // L1 distance) are not a move
+  double max_visible_range_m = 20.0;   // visibility: a prior object farther than this is not covered by a view
+  double min_visible_fraction = 0.5;   // visibility: at least this share of its projected box inside the image
+  double min_expected_detections = 3;  // removed: the current views covering a prior object would have given at
+                                       // least this many detections (its prior detections x covering views now /
+                                       // covering views in its own patrol); fewer: unobserved
+  double min_shape_overlap = 0.85;     // moved: share of the current object's points, shifted onto the prior
+                                       // object, within 0.15 m of its points (1 when either has none)
   double max_top_difference_m = 0.05;  // moved: the tops of the two objects (95th percentile of their points'
-                                      // height) differ by at most this; objects stand on level ground
+                                       // height) differ by at most this; objects stand on level ground
 };
 
 // Evidence grid of one patrol (paper 004).
 struct EvidenceGridOptions {
   double voxel_size_m = 0.2;
-  double max_range_m = 20.0;          // rays are traced this far; farther returns count as passes only
-  int rays_per_row = 94;              // depth pixels traced per image row (every width/94-th pixel, and
-                                      // every as many rows): 94 is every 8th pixel at 752 px
-  double rate_hz = 5.0;               // depth frames integrated per second of flight
-  int max_voxels = 40000000;          // memory bound (16 bytes a voxel); further voxels are not created
+  double max_range_m = 20.0;  // rays are traced this far; farther returns count as passes only
+  int rays_per_row = 94;      // depth pixels traced per image row (every width/94-th pixel, and
+                              // every as many rows): 94 is every 8th pixel at 752 px
+  double rate_hz = 5.0;       // depth frames integrated per second of flight
+  int max_voxels = 40000000;  // memory bound (16 bytes a voxel); further voxels are not created
 };
 
 // Geometry change between two evidence grids (paper 004).
 struct GeometryDiffOptions {
-  double min_occupancy_change = 0.45; // |hits/(hits+passes) before - after| above this: changed
-  double max_free_occupancy = 0.1;    // ... and in one patrol it must be free (a surface cut by the voxel's
-                                      // edge fills it partly, by a share that changes with the view)
-  int min_observations = 3;           // rays per voxel in each patrol; fewer: unobserved, never a change
-  int surface_tolerance_voxels = 1;   // no change where the free patrol has an occupied voxel this near
-                                      // (a surface seen a voxel off: edges, corners); 0 = off
-  bool vertical_tolerance = false;    // ... counting voxels above and below too (not only beside)
-  double join_distance_m = 1.0;       // a changed voxel joins a region whose centroid is this close
-  int min_region_voxels = 10;         // smaller regions are dropped as outliers, ...
-  double min_region_width_m = 0.4;    // ... and so are narrower ones (a lone column of voxels at an edge)
+  double min_occupancy_change = 0.45;  // |hits/(hits+passes) before - after| above this: changed
+  double max_free_occupancy = 0.1;     // ... and in one patrol it must be free (a surface cut by the voxel's
+                                       // edge fills it partly, by a share that changes with the view)
+  int min_observations = 3;            // rays per voxel in each patrol; fewer: unobserved, never a change
+  int surface_tolerance_voxels = 1;    // no change where the free patrol has an occupied voxel this near
+                                       // (a surface seen a voxel off: edges, corners); 0 = off
+  bool vertical_tolerance = false;     // ... counting voxels above and below too (not only beside)
+  double join_distance_m = 1.0;        // a changed voxel joins a region whose centroid is this close
+  int min_region_voxels = 10;          // smaller regions are dropped as outliers, ...
+  double min_region_width_m = 0.4;     // ... and so are narrower ones (a lone column of voxels at an edge)
 };
 
 struct ChangeOptions {

@@ -24,10 +24,10 @@ struct PlaceChange {
 
 struct ChangeReport {
   std::string prior_flight, current_flight;
-  std::vector<PlaceChange> places;      // every place both patrols saw
-  bool objects_compared = false;        // both patrols had detections and poses
+  std::vector<PlaceChange> places;  // every place both patrols saw
+  bool objects_compared = false;    // both patrols had detections and poses
   std::vector<ObjectChange> objects;
-  bool geometry_compared = false;       // both patrols had depth and poses
+  bool geometry_compared = false;  // both patrols had depth and poses
   GeometryChange geometry;
   double seconds_appearance = 0.0, seconds_objects = 0.0, seconds_geometry = 0.0;
 

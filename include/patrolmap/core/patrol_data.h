@@ -40,26 +40,26 @@ struct ObjectObservation {
   TimestampNs timestamp_ns = 0;
   std::string label;
   double confidence = 0.0;
-  cv::Rect2d box;                                   // in the image [pixels]
-  std::optional<Eigen::Vector3d> centroid_camera;   // 3D centroid in the camera frame, when the detector gives one
+  cv::Rect2d box;                                  // in the image [pixels]
+  std::optional<Eigen::Vector3d> centroid_camera;  // 3D centroid in the camera frame, when the detector gives one
 };
 
 // One object of a patrol's object map (paper 000): detections associated
 // across frames, with the label-confidence and label-count accumulators.
 struct MapObject {
   int id = 0;
-  std::string label;                 // the label with the highest accumulated confidence
-  double confidence = 0.0;           // mean confidence of the detections with that label
+  std::string label;        // the label with the highest accumulated confidence
+  double confidence = 0.0;  // mean confidence of the detections with that label
   int detections = 0;
-  bool confirmed = true;             // seen often enough to count; unconfirmed ones only explain later sightings
+  bool confirmed = true;  // seen often enough to count; unconfirmed ones only explain later sightings
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // world frame [m]
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   // axis-aligned extent of its points (2nd to 98th
                                                        // percentile; without points: its mean detected size)
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3f> points;                 // segmented points (voxel-filtered); empty without depth
-  std::vector<float> descriptor;  // appearance, mean over its views: 8-bin gradient-orientation histogram, then
-                                  // the brightness rank (share of the frame's pixels darker than it)
-  double height = 0.0;            // vertical extent of its points [m]; 0 without points
+  std::vector<Eigen::Vector3f> points;  // segmented points (voxel-filtered); empty without depth
+  std::vector<float> descriptor;        // appearance, mean over its views: 8-bin gradient-orientation histogram, then
+                                        // the brightness rank (share of the frame's pixels darker than it)
+  double height = 0.0;                  // vertical extent of its points [m]; 0 without points
   struct LabelEvidence {
     std::string label;
     double confidence_sum = 0.0;
@@ -107,12 +107,12 @@ void ForEachCommonVoxel(const EvidenceGridData& a, const EvidenceGridData& b, Vi
 // What a patrol (one flight of a map) keeps for change detection.
 struct PatrolRecord {
   std::string flight;
-  CameraIntrinsics camera;               // of the images the views and detections refer to
-  int feature_image_width = 0;           // width of the images its key-frame features were found in
-  std::vector<CameraPoseSample> views;   // camera poses sampled along the flight
-  bool has_objects = false;              // the log had detections
+  CameraIntrinsics camera;              // of the images the views and detections refer to
+  int feature_image_width = 0;          // width of the images its key-frame features were found in
+  std::vector<CameraPoseSample> views;  // camera poses sampled along the flight
+  bool has_objects = false;             // the log had detections
   std::vector<MapObject> objects;
-  EvidenceGridData grid;                 // voxel_size 0 when the log had no depth
+  EvidenceGridData grid;  // voxel_size 0 when the log had no depth
 };
 
 }  // namespace patrolmap

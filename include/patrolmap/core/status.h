@@ -27,9 +27,7 @@ class Status {
   static Status Ok() { return Status(); }
   static Status EndOfStream() { return Status(StatusCode::kEndOfStream, "end of stream"); }
   static Status NotFound(std::string message) { return {StatusCode::kNotFound, std::move(message)}; }
-  static Status InvalidArgument(std::string message) {
-    return {StatusCode::kInvalidArgument, std::move(message)};
-  }
+  static Status InvalidArgument(std::string message) { return {StatusCode::kInvalidArgument, std::move(message)}; }
   static Status DataLoss(std::string message) { return {StatusCode::kDataLoss, std::move(message)}; }
   static Status IoError(std::string message) { return {StatusCode::kIoError, std::move(message)}; }
 
@@ -46,17 +44,17 @@ class Status {
 }  // namespace patrolmap
 
 // Aborts with file and line when a programmer invariant is broken.
-#define PATROLMAP_CHECK(condition)                                                      \
-  do {                                                                                  \
-    if (!(condition)) {                                                                 \
+#define PATROLMAP_CHECK(condition)                                                       \
+  do {                                                                                   \
+    if (!(condition)) {                                                                  \
       std::fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #condition); \
-      std::abort();                                                                     \
-    }                                                                                   \
+      std::abort();                                                                      \
+    }                                                                                    \
   } while (false)
 
 // Returns the status from the enclosing function when it is not ok.
-#define PATROLMAP_RETURN_IF_ERROR(expression)       \
-  do {                                              \
-    ::patrolmap::Status status_ = (expression);     \
-    if (!status_.ok()) return status_;              \
+#define PATROLMAP_RETURN_IF_ERROR(expression)   \
+  do {                                          \
+    ::patrolmap::Status status_ = (expression); \
+    if (!status_.ok()) return status_;          \
   } while (false)

@@ -53,7 +53,7 @@ struct TruthObject {
   std::string label;
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   double yaw = 0.0, length = 0.0, width = 0.0, height = 0.0;
-  int detections = 0;  // how often the flight's detector reported it
+  int detections = 0;                // how often the flight's detector reported it
   std::vector<TimestampNs> seen_ns;  // ... and when (ascending)
   bool Contains(const Eigen::Vector3d& point, double margin) const;
 };
@@ -76,7 +76,7 @@ struct Counts {
 
 struct ObjectChangeScore {
   std::map<std::string, Counts> by_state;  // persistent, new, removed, moved
-  int unobserved = 0;                       // reported unobserved (not scored)
+  int unobserved = 0;                      // reported unobserved (not scored)
 };
 
 struct ChangeScoreOptions {
@@ -88,8 +88,9 @@ struct ChangeScoreOptions {
   double min_overlap = 0.3;
 };
 
-ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported, const std::vector<TruthObject>& before,
-                                     const std::vector<TruthObject>& after, const ChangeScoreOptions& options);
+ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported,
+                                     const std::vector<TruthObject>& before, const std::vector<TruthObject>& after,
+                                     const ChangeScoreOptions& options);
 
 struct GeometryScore {
   Counts voxels;
@@ -125,7 +126,8 @@ struct AppearanceScore {
 };
 
 // One entry per compared place in both vectors.
-AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth, const std::vector<std::vector<RegionBoxes>>& regions,
+AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
+                                const std::vector<std::vector<RegionBoxes>>& regions,
                                 const ChangeScoreOptions& options);
 
 }  // namespace patrolmap::eval

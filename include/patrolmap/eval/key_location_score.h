@@ -57,9 +57,9 @@ struct KeyLocationScore {
   int true_positives = 0;
   int false_positives = 0;
   int missed = 0;
-  std::vector<Verdict> verdicts;        // per detection
+  std::vector<Verdict> verdicts;  // per detection
   std::vector<ExpectedSpan> spans;
-  std::vector<int> span_match;          // per span: index of the matching detection or -1
+  std::vector<int> span_match;  // per span: index of the matching detection or -1
   double precision() const { return detected > 0 ? static_cast<double>(true_positives) / detected : 1.0; }
   double recall() const {
     const int found = expected - missed;

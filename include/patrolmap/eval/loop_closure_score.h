@@ -40,16 +40,16 @@ struct LoopClosureRecord {
 };
 
 struct LoopClosureScoreOptions {
-  double radius_m = 5.0;         // same place: camera positions at most this far apart [m]
-  double max_heading_deg = 30.0; // and camera headings at most this different [deg]
-  double min_gap_s = 15.0;       // nodes of one flight closer in time are neighbours, not loop closures [s]
+  double radius_m = 5.0;          // same place: camera positions at most this far apart [m]
+  double max_heading_deg = 30.0;  // and camera headings at most this different [deg]
+  double min_gap_s = 15.0;        // nodes of one flight closer in time are neighbours, not loop closures [s]
 };
 
 struct LoopClosureScore {
   int nodes = 0;
-  int possible = 0;         // query nodes with a possible loop closure
-  int found = 0;            // of those, with at least one true reported closure
-  int reported = 0;         // reported closures
+  int possible = 0;  // query nodes with a possible loop closure
+  int found = 0;     // of those, with at least one true reported closure
+  int reported = 0;  // reported closures
   int true_positives = 0;
   int false_positives = 0;
   std::vector<bool> correct;  // per reported closure

@@ -49,7 +49,7 @@ class EdgeFlowTracker {
   std::vector<float> track_errors_;
   cv::Mat edges_;
   int last_point_count_ = 0;
-  std::vector<cv::Point2f> cell_flow_;             // predicted flow per edge-grid cell
+  std::vector<cv::Point2f> cell_flow_;                 // predicted flow per edge-grid cell
   std::vector<std::vector<float>> cell_dx_, cell_dy_;  // scratch for the medians
   bool has_prediction_ = false;
 };
@@ -58,8 +58,8 @@ class EdgeFlowTracker {
 // frame: returns R such that a direction d1 in the later camera frame is
 // R * d1 in the earlier one. Samples cover (start_ns, end_ns]; each holds its
 // rate over the interval that ends at its timestamp.
-Eigen::Matrix3d IntegrateGyro(const std::vector<ImuSample>& samples, TimestampNs start_ns,
-                              TimestampNs end_ns, const Eigen::Matrix3d& camera_from_imu);
+Eigen::Matrix3d IntegrateGyro(const std::vector<ImuSample>& samples, TimestampNs start_ns, TimestampNs end_ns,
+                              const Eigen::Matrix3d& camera_from_imu);
 
 // Removes the flow a pure rotation would cause: for a vector from p0 to p1 the
 // result runs from p0 to p1 - (H p0 - p0), with H = K R^T K^-1 the homography

@@ -20,9 +20,9 @@ namespace patrolmap::flow {
 
 // What the detector knows about the camera (from the log).
 struct CameraContext {
-  std::optional<CameraIntrinsics> camera;         // at the log's native resolution
-  std::optional<Eigen::Matrix3d> camera_from_imu; // needed for de-rotation
-  double frame_rate_hz = 0.0;                     // the log's nominal rate [Hz]; 0 when unknown (FrameTiming)
+  std::optional<CameraIntrinsics> camera;          // at the log's native resolution
+  std::optional<Eigen::Matrix3d> camera_from_imu;  // needed for de-rotation
+  double frame_rate_hz = 0.0;                      // the log's nominal rate [Hz]; 0 when unknown (FrameTiming)
 };
 
 // Frames smaller than this on a side once downscaled carry no usable flow: they are skipped and counted.

@@ -24,15 +24,15 @@ struct EdgeOptions {
   int max_points = 600;       // cap on tracked edge pixels per frame
   int grid_columns = 8;       // the cap is shared evenly by grid_columns x grid_rows cells
   int grid_rows = 5;
-  int border = 8;             // ignore edge pixels this close to the image border [pixels]
+  int border = 8;  // ignore edge pixels this close to the image border [pixels]
 };
 
 // Pyramidal Lucas-Kanade tracking of the edge pixels into the next processed frame.
 struct TrackerOptions {
-  int window_size = 11;            // LK window side [pixels, at processing scale]
-  int pyramid_levels = 3;          // extra pyramid levels above the base image
-  int max_iterations = 10;         // LK iteration cap per level
-  double epsilon = 0.03;           // LK convergence threshold [pixels]
+  int window_size = 11;               // LK window side [pixels, at processing scale]
+  int pyramid_levels = 3;             // extra pyramid levels above the base image
+  int max_iterations = 10;            // LK iteration cap per level
+  double epsilon = 0.03;              // LK convergence threshold [pixels]
   double min_eigen_threshold = 1e-3;  // reject points with weaker gradient structure
   // Start each point's search from the median flow of its edge-grid cell in the
   // previous processed frame (else from zero). Keeps LK from locking onto a
@@ -46,11 +46,11 @@ struct TrackerOptions {
 
 // Hysteresis voting in the polar (theta, r) domain (equations 1-2, Table I).
 struct VotingOptions {
-  int theta_bins = 36;              // direction cells over (-pi, pi]
-  double r_bin_fraction = 0.02;     // r cell width as a fraction of image width
-  int accept = 3;                   // a cell is accepted once its vote reaches this (Table I)
-  int reject = 2;                   // an accepted cell is dropped when its vote falls under this (Table I)
-  int max_votes = 3;                // vote ceiling: +1 per frame observed, -1 per frame missed
+  int theta_bins = 36;           // direction cells over (-pi, pi]
+  double r_bin_fraction = 0.02;  // r cell width as a fraction of image width
+  int accept = 3;                // a cell is accepted once its vote reaches this (Table I)
+  int reject = 2;                // an accepted cell is dropped when its vote falls under this (Table I)
+  int max_votes = 3;             // vote ceiling: +1 per frame observed, -1 per frame missed
 };
 
 enum class ResponseQuantity {
@@ -63,10 +63,10 @@ enum class ResponseQuantity {
 // frame step), kLineParameter in image widths (r is a position, not a rate).
 struct ResponseOptions {
   ResponseQuantity quantity = ResponseQuantity::kLength;
-  bool derotate_with_imu = true;    // subtract gyro-predicted rotational flow when imu0 exists
-  bool normalise_by_speed = false;  // scale by reference_speed / known speed when the log has it
-  double reference_speed_mps = 2.0; // speed at which normalised and raw responses agree [m/s]
-  double min_speed_mps = 0.5;       // speeds below this are clamped (hovering) [m/s]
+  bool derotate_with_imu = true;     // subtract gyro-predicted rotational flow when imu0 exists
+  bool normalise_by_speed = false;   // scale by reference_speed / known speed when the log has it
+  double reference_speed_mps = 2.0;  // speed at which normalised and raw responses agree [m/s]
+  double min_speed_mps = 0.5;        // speeds below this are clamped (hovering) [m/s]
 };
 
 enum class SmoothingMode {
@@ -83,8 +83,8 @@ struct SmoothingOptions {
 
 // Peaks and valleys of the smoothed response (Table I).
 struct ExtremumOptions {
-  double min_change = 0.02;   // an extremum must differ this much from the previous one [response units]
-  double min_time_s = 2.0;    // and lie this long after the previous key location [s]
+  double min_change = 0.02;  // an extremum must differ this much from the previous one [response units]
+  double min_time_s = 2.0;   // and lie this long after the previous key location [s]
 };
 
 struct KeyLocationOptions {

@@ -37,8 +37,8 @@ class WindowSmoother {
   double MeanOver(std::size_t first, std::size_t last) const;
   void Release(std::vector<FlowSample>* released);
 
-  int behind_ = 0;  // samples before the centre in a full window
-  int ahead_ = 0;   // samples after the centre in a full window
+  int behind_ = 0;                  // samples before the centre in a full window
+  int ahead_ = 0;                   // samples after the centre in a full window
   std::deque<FlowSample> history_;  // last behind_ samples already released, then pending ones
   std::size_t released_in_history_ = 0;
 };

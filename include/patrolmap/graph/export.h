@@ -20,8 +20,8 @@ std::string ToDot(const TopoMap& map);
 std::string ToJson(const TopoMap& map);
 // Ground-truth verdicts for the SVG, as `patrolmap eval` decides them.
 struct SvgTruth {
-  std::vector<bool> loop_closure_correct;     // per loop-closure edge, in Edges() order
-  std::vector<std::pair<int, int>> missed;    // node pairs of the same place that no closure joins
+  std::vector<bool> loop_closure_correct;   // per loop-closure edge, in Edges() order
+  std::vector<std::pair<int, int>> missed;  // node pairs of the same place that no closure joins
 };
 
 // A picture like the paper's Fig. 5 from the layout: each flight's path in its

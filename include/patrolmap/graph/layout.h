@@ -25,9 +25,9 @@ struct LayoutInput {
 LayoutInput LayoutInputOf(const TopoMap& map);
 
 struct LayoutOptions {
-  double heading_weight = 10.0;       // a radian of heading error costs as much as this many layout units
-  double loop_closure_weight = 1.0;   // strength of a loop closure relative to one odometry step
-  double robust_scale = 1.0;          // Cauchy loss scale for loop closures [layout units]
+  double heading_weight = 10.0;      // a radian of heading error costs as much as this many layout units
+  double loop_closure_weight = 1.0;  // strength of a loop closure relative to one odometry step
+  double robust_scale = 1.0;         // Cauchy loss scale for loop closures [layout units]
   int max_iterations = 100;
 };
 

@@ -23,12 +23,12 @@ struct NodeData {
   std::string flight;
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
-  cv::Mat thumbnail;                     // CV_8UC1 key frame, small (for pictures and exports)
-  std::vector<cv::KeyPoint> keypoints;   // features kept so a later flight can be matched
-  cv::Mat descriptors;                   // without the original log (CV_8U or CV_32F rows)
+  cv::Mat thumbnail;                    // CV_8UC1 key frame, small (for pictures and exports)
+  std::vector<cv::KeyPoint> keypoints;  // features kept so a later flight can be matched
+  cv::Mat descriptors;                  // without the original log (CV_8U or CV_32F rows)
   vocab::BowVector bow;
-  std::optional<Eigen::Vector2d> gps;    // latitude, longitude [deg], when the log has them
-  double heading = 0.0;                  // integrated gyro yaw at the node [rad] (0 without an IMU)
+  std::optional<Eigen::Vector2d> gps;                // latitude, longitude [deg], when the log has them
+  double heading = 0.0;                              // integrated gyro yaw at the node [rad] (0 without an IMU)
   Eigen::Vector2d layout = Eigen::Vector2d::Zero();  // 2D position for pictures (scaleless)
 };
 
@@ -37,10 +37,10 @@ const char* ToString(EdgeKind kind);
 
 struct EdgeData {
   EdgeKind kind = EdgeKind::kTraversal;
-  double bow_score = 0.0;        // loop closures: verification scores
+  double bow_score = 0.0;  // loop closures: verification scores
   double matched_fraction = 0.0;
   int inliers = 0;
-  double log_nfa = 0.0;          // a-contrario number of false alarms, log10 (map format 3 on; 0 before)
+  double log_nfa = 0.0;  // a-contrario number of false alarms, log10 (map format 3 on; 0 before)
 };
 
 class TopoMap {
@@ -62,11 +62,11 @@ class TopoMap {
     int a = 0, b = 0;
     EdgeData data;
   };
-  std::vector<Edge> Edges() const;                  // in insertion order
-  std::vector<int> Neighbours(int id) const;        // ascending, each once
-  std::vector<int> NodesOfPlace(int id) const;      // nodes joined to `id` by loop closures, `id` included, ascending
-  std::vector<int> Path(int from, int to) const;    // fewest edges, both ends included; empty when unreachable
-  std::vector<std::string> Flights() const;         // in order of first node
+  std::vector<Edge> Edges() const;                // in insertion order
+  std::vector<int> Neighbours(int id) const;      // ascending, each once
+  std::vector<int> NodesOfPlace(int id) const;    // nodes joined to `id` by loop closures, `id` included, ascending
+  std::vector<int> Path(int from, int to) const;  // fewest edges, both ends included; empty when unreachable
+  std::vector<std::string> Flights() const;       // in order of first node
 
   // What each patrol keeps for change detection (object map, evidence grid,
   // views); at most one record per flight, replaced when set again.

@@ -25,21 +25,21 @@ std::string CleanFlightId(const std::string& raw);
 // What a reader knows about a log before reading frames.
 struct LogInfo {
   std::string path;
-  std::string kind;                          // "euroc", "image-folder", "image-pattern", "video"
-  std::string flight_id;                     // from meta.yaml, else the folder name
-  std::optional<CameraIntrinsics> camera;    // from cam0/sensor.yaml when present
+  std::string kind;                        // "euroc", "image-folder", "image-pattern", "video"
+  std::string flight_id;                   // from meta.yaml, else the folder name
+  std::optional<CameraIntrinsics> camera;  // from cam0/sensor.yaml when present
   // Rotation taking IMU-frame vectors into the camera frame, when both
   // extrinsics are known (EuRoC T_BS of cam0 and imu0).
   std::optional<Eigen::Matrix3d> camera_from_imu;
   // Rotation taking camera-frame vectors into the body (state estimate) frame:
   // EuRoC T_BS of cam0, when cam0/sensor.yaml is present.
   std::optional<Eigen::Matrix3d> body_from_camera;
-  std::int64_t frame_count = -1;             // -1 when unknown (live or some videos)
-  double frame_rate_hz = 0.0;                // nominal; 0 when unknown
+  std::int64_t frame_count = -1;  // -1 when unknown (live or some videos)
+  double frame_rate_hz = 0.0;     // nominal; 0 when unknown
   // Whether frame times come from the log or the user (--fps); false when a rate was assumed, so
   // durations measured in frames are all the log can offer (place.exclude_recent_images).
   bool timed = true;
-  std::string timing;                        // where the times came from, for messages
+  std::string timing;  // where the times came from, for messages
   bool has_imu = false;
   bool has_speed = false;
 };

@@ -31,8 +31,7 @@ Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& op
                         std::unique_ptr<FrameSource>* source);
 
 // Video file through OpenCV VideoCapture; frames converted to grey.
-Status OpenVideo(const std::string& path, const ImageFolderOptions& options,
-                 std::unique_ptr<FrameSource>* source);
+Status OpenVideo(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source);
 
 // Camera device `device` (OpenCV VideoCapture index, /dev/videoN on Linux); frames converted to grey and
 // timed by the clock from the first one; flight id "cameraN".
@@ -52,7 +51,6 @@ Status CheckLogExists(const std::string& path);
 // Picks the reader for `path`: EuRoC when it holds cam0/data.csv (or
 // mav0/cam0/data.csv), a printf pattern when it contains '%', an image folder
 // for other folders, and a video for other files.
-Status OpenLog(const std::string& path, const ImageFolderOptions& options,
-               std::unique_ptr<FrameSource>* source);
+Status OpenLog(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source);
 
 }  // namespace patrolmap::io

@@ -13,14 +13,14 @@
 namespace patrolmap::pipeline {
 
 struct DetectionResult {
-  std::vector<FlowSample> samples;         // one per processed frame
+  std::vector<FlowSample> samples;  // one per processed frame
   std::vector<KeyLocation> key_locations;
-  std::int64_t frames_read = 0;            // frames delivered by the source
-  std::vector<io::SkippedFrame> skipped;   // unreadable frames that were passed over
-  bool derotated = false;                  // flow was de-rotated with the gyro
-  double seconds = 0.0;                    // wall time of the run
-  flow::FrameTiming timing;                // the frame step and smoothing window used for the log's rate
-  int unusable_frames = 0;                 // frames due for processing but too small or without an image
+  std::int64_t frames_read = 0;           // frames delivered by the source
+  std::vector<io::SkippedFrame> skipped;  // unreadable frames that were passed over
+  bool derotated = false;                 // flow was de-rotated with the gyro
+  double seconds = 0.0;                   // wall time of the run
+  flow::FrameTiming timing;               // the frame step and smoothing window used for the log's rate
+  int unusable_frames = 0;                // frames due for processing but too small or without an image
 };
 
 // What a user should know about a detection run, one sentence each: a log without timestamps, a log
@@ -44,8 +44,7 @@ struct PlotTruth {
 // Writes DIR/key_locations.csv, DIR/response.csv and DIR/response.svg (a plot
 // like paper 002 Fig. 3: raw and smoothed response, key locations marked).
 // Each file is written atomically.
-Status WriteDetectionOutputs(const DetectionResult& result, const std::string& folder,
-                             const PlotTruth& truth = {});
+Status WriteDetectionOutputs(const DetectionResult& result, const std::string& folder, const PlotTruth& truth = {});
 
 std::string KeyLocationsCsv(const std::vector<KeyLocation>& key_locations);
 std::string ResponseCsv(const std::vector<FlowSample>& samples);

@@ -21,10 +21,10 @@ struct MapNode {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
   int features = 0;
-  cv::Mat thumbnail;    // the key frame at kThumbnailWidth pixels wide
-  double heading = 0;   // gyro yaw integrated since the start of the flight [rad]
+  cv::Mat thumbnail;                   // the key frame at kThumbnailWidth pixels wide
+  double heading = 0;                  // gyro yaw integrated since the start of the flight [rad]
   std::optional<Eigen::Vector2d> gps;  // latitude, longitude [deg] at the key frame, when the log has GPS
-  int feature_width = 0;  // width of the image its features were found in [pixels]
+  int feature_width = 0;               // width of the image its features were found in [pixels]
 };
 
 constexpr int kThumbnailWidth = 160;

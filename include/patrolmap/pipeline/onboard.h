@@ -35,14 +35,14 @@ struct OnboardOptions {
 };
 
 struct OnboardStats {
-  std::int64_t frames = 0;          // frames given to AddFrame
-  std::int64_t processed = 0;       // of which the flow stage processed
-  int key_frames = 0;               // key locations handed to the place stage
-  int lost_key_frames = 0;          // confirmed after their frame left the ring (not mapped)
-  int max_queue = 0;                // deepest the queue got
-  double flow_seconds = 0.0;        // flow stage, summed over processed frames
-  double max_flow_seconds = 0.0;    // ... its slowest frame
-  double waited_seconds = 0.0;      // the frame thread waiting for room in the queue
+  std::int64_t frames = 0;        // frames given to AddFrame
+  std::int64_t processed = 0;     // of which the flow stage processed
+  int key_frames = 0;             // key locations handed to the place stage
+  int lost_key_frames = 0;        // confirmed after their frame left the ring (not mapped)
+  int max_queue = 0;              // deepest the queue got
+  double flow_seconds = 0.0;      // flow stage, summed over processed frames
+  double max_flow_seconds = 0.0;  // ... its slowest frame
+  double waited_seconds = 0.0;    // the frame thread waiting for room in the queue
 };
 
 class OnboardMapper {

@@ -26,15 +26,15 @@ const char* ToString(FundamentalMethod method);
 bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method);  // ransac, usac, magsac
 
 struct PlaceOptions {
-  int max_features = 800;            // SIFT features kept per key frame (strongest first)
-  bool root_sift = true;             // RootSIFT (Arandjelovic and Zisserman) instead of plain SIFT
-  int candidates = 3;                // BoW candidates verified per query (paper: n = 3)
-  double exclude_recent_s = 20.0;    // nodes of the same flight this recent are not candidates [s]
+  int max_features = 800;          // SIFT features kept per key frame (strongest first)
+  bool root_sift = true;           // RootSIFT (Arandjelovic and Zisserman) instead of plain SIFT
+  int candidates = 3;              // BoW candidates verified per query (paper: n = 3)
+  double exclude_recent_s = 20.0;  // nodes of the same flight this recent are not candidates [s]
   // For logs without timestamps (image collections): nodes of the same flight at most this many images
   // before the query are not candidates (1: the image just before; 0: none excluded).
   int exclude_recent_images = 1;
-  double ratio = 0.8;                // Lowe's ratio test for descriptor matches
-  double min_matched_fraction = 0.1; // matches / features of the smaller frame (paper: 0.5)
+  double ratio = 0.8;                 // Lowe's ratio test for descriptor matches
+  double min_matched_fraction = 0.1;  // matches / features of the smaller frame (paper: 0.5)
   FundamentalMethod method = FundamentalMethod::kUsacMagsac;
   double inlier_threshold_px = 1.5;  // epipolar distance for a RANSAC inlier [pixels]
   // A verified match needs at least min_inliers inliers and an a-contrario number of false alarms
@@ -43,7 +43,7 @@ struct PlaceOptions {
   // 376x240 key frames to megapixel photographs.
   int min_inliers = 15;
   double max_log_nfa = -30.0;  // BENCHMARKS.md: closures far from their place >= -17.2, true ones down to -30.1
-  bool accept_best = false;          // verify every candidate and keep the best (paper: the first that passes)
+  bool accept_best = false;    // verify every candidate and keep the best (paper: the first that passes)
   // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already): a quarter
   // of the memory per node; matching distances are computed from the 8-bit values.
   bool compact_descriptors = true;
@@ -69,18 +69,18 @@ struct KeyFrame {
   std::string flight;
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
-  cv::Mat image;  // CV_8UC1
+  cv::Mat image;      // CV_8UC1
   bool timed = true;  // false: the log has no timestamps, "recent" is counted in images
 };
 
 // The outcome of one verification.
 struct Verification {
-  int node = -1;               // the candidate node
+  int node = -1;  // the candidate node
   double bow_score = 0.0;
-  int matches = 0;             // ratio-test matches
+  int matches = 0;  // ratio-test matches
   double matched_fraction = 0.0;
-  int inliers = 0;             // fundamental-matrix inliers
-  double log_nfa = 0.0;        // log10 of the number of false alarms of the fundamental matrix (0 when none fitted)
+  int inliers = 0;       // fundamental-matrix inliers
+  double log_nfa = 0.0;  // log10 of the number of false alarms of the fundamental matrix (0 when none fitted)
   bool accepted = false;
 };
 
@@ -103,18 +103,18 @@ double LogNumberOfFalseAlarms(const cv::Matx33d& fundamental, const std::vector<
                               const FeatureExtent& to_extent);
 
 struct PlaceResult {
-  int node = -1;                           // the node the key frame became
+  int node = -1;  // the node the key frame became
   int features = 0;
-  std::optional<Verification> match;       // the accepted loop closure, if any
-  std::vector<Verification> candidates;    // every candidate looked at
+  std::optional<Verification> match;     // the accepted loop closure, if any
+  std::vector<Verification> candidates;  // every candidate looked at
   double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
 };
 
 // Verifies two described frames: ratio-test matching (within equal direct-index groups when both are given),
 // the matched-fraction rule, a fundamental matrix by `options.method`, and the inlier and a-contrario rules.
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
-                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
-                        const std::vector<std::uint32_t>* query_groups = nullptr,
+                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
+                        const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups = nullptr,
                         const std::vector<std::uint32_t>* candidate_groups = nullptr);
 
 class PlaceRecognizer {

@@ -35,8 +35,8 @@ struct SimulatedFlight {
   Lighting lighting;                        // of this flight (default: plain texture, no noise)
   double duration_s = 0.0;
   std::function<PlatformState(double)> trajectory;  // state at time t in [0, duration_s]
-  std::vector<WorldObject> objects;    // movable objects (already added to the scene)
-  std::vector<ObjectChange> changes;   // against the previous flight of a patrol series
+  std::vector<WorldObject> objects;                 // movable objects (already added to the scene)
+  std::vector<ObjectChange> changes;                // against the previous flight of a patrol series
 };
 
 // Optional parts of a written log.
@@ -65,9 +65,9 @@ CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& stat
 struct TruthKeyLocation {
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
-  bool opening = false;        // the view axis goes from a near surface to a far one
-  Eigen::Vector2d edge;        // the edge's ground position [m]
-  double depth_before = 0.0;   // view-axis depth just before and after the crossing [m]
+  bool opening = false;       // the view axis goes from a near surface to a far one
+  Eigen::Vector2d edge;       // the edge's ground position [m]
+  double depth_before = 0.0;  // view-axis depth just before and after the crossing [m]
   double depth_after = 0.0;
 };
 
@@ -108,16 +108,16 @@ struct StreetOptions {
   double wall_height_m = 7.0;
   double speed_mps = 2.5;
   double altitude_m = 3.0;
-  bool static_camera = false;  // hover at the start instead of flying
+  bool static_camera = false;     // hover at the start instead of flying
   double mount_angle_deg = 90.0;  // optical axis from the flight direction towards the left [deg]
   // Draw each facade's length (0.6-1.5x), each gap (0.5-1.3x), each near depth
   // (0.8-1.6x) and height (0.7-1.3x) from the seed instead of using them as given.
   bool irregular = false;
   // Disturbances a hand-flown UAV shows (paper 002 §III-A names both compensations):
-  double yaw_wobble_deg = 0.0;     // heading swings by this amplitude ... [deg]
-  double yaw_period_s = 12.0;      // ... with this period [s]
-  double speed_variation = 0.0;    // speed swings by this fraction of speed_mps ...
-  double speed_period_s = 12.0;    // ... with this period [s]
+  double yaw_wobble_deg = 0.0;   // heading swings by this amplitude ... [deg]
+  double yaw_period_s = 12.0;    // ... with this period [s]
+  double speed_variation = 0.0;  // speed swings by this fraction of speed_mps ...
+  double speed_period_s = 12.0;  // ... with this period [s]
   std::uint32_t seed = 1;
 };
 

@@ -23,13 +23,13 @@ struct CameraPose {
 // Illumination and sensor of one flight. The defaults render plain texture
 // values (no shading, gain 1, gamma 1, no noise).
 struct Lighting {
-  double gain = 1.0;            // exposure gain applied to the linear intensity
-  double gamma = 1.0;           // output = 255 * (gain * linear / 255)^(1 / gamma)
-  double sun_azimuth = 0.0;     // direction towards the sun, from +x towards +y [rad]
-  double sun_elevation = 1.57;  // [rad]; walls facing the sun get brighter
-  double ambient = 1.0;         // share of light that reaches every surface (1 = no shading)
-  double noise_sigma = 0.0;     // Gaussian sensor noise [grey levels]
-  std::uint32_t noise_seed = 0; // with the frame number, seeds each frame's noise
+  double gain = 1.0;             // exposure gain applied to the linear intensity
+  double gamma = 1.0;            // output = 255 * (gain * linear / 255)^(1 / gamma)
+  double sun_azimuth = 0.0;      // direction towards the sun, from +x towards +y [rad]
+  double sun_elevation = 1.57;   // [rad]; walls facing the sun get brighter
+  double ambient = 1.0;          // share of light that reaches every surface (1 = no shading)
+  double noise_sigma = 0.0;      // Gaussian sensor noise [grey levels]
+  std::uint32_t noise_seed = 0;  // with the frame number, seeds each frame's noise
 };
 
 // Draws a plausible lighting for flight `flight` of a series from `seed`: gain
@@ -85,9 +85,9 @@ class Renderer {
   const Scene* scene_;
   CameraIntrinsics camera_;
   Lighting lighting_;
-  std::vector<std::uint8_t> exposure_;  // Expose() as a table over linear intensity in quarter steps
+  std::vector<std::uint8_t> exposure_;    // Expose() as a table over linear intensity in quarter steps
   std::vector<Eigen::Vector2d> normals_;  // per wall, unit, to the right of start -> end
-  Eigen::Vector2d sun_;                  // horizontal direction towards the sun, scaled by cos(elevation)
+  Eigen::Vector2d sun_;                   // horizontal direction towards the sun, scaled by cos(elevation)
   float ground_shade_ = 1.0f;
   cv::Mat noise_;
   std::vector<Hit> hits_;  // of the current column, nearest first

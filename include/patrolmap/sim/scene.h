@@ -31,8 +31,8 @@ struct Wall {
 struct Scene {
   std::vector<Wall> walls;
   std::vector<Texture> textures;
-  int ground_texture = -1;            // tiled over the ground; -1 = flat grey
-  double ground_tile_metres = 8.0;    // side of one ground texture tile [m]
+  int ground_texture = -1;          // tiled over the ground; -1 = flat grey
+  double ground_tile_metres = 8.0;  // side of one ground texture tile [m]
   std::uint8_t sky_grey = 215;
   std::uint8_t ground_grey = 110;
   std::vector<std::uint8_t> roof_grey;  // per box id
@@ -40,8 +40,7 @@ struct Scene {
 
 // A procedural facade texture: plaster or brick noise, a grid of windows and
 // doors, and a few signs, all drawn from `seed`. `width_m` x `height_m` metres.
-Texture MakeFacadeTexture(double width_m, double height_m, std::uint32_t seed,
-                          double texels_per_metre = 40.0);
+Texture MakeFacadeTexture(double width_m, double height_m, std::uint32_t seed, double texels_per_metre = 40.0);
 
 // A ground tile texture (gravel noise with patches) drawn from `seed`.
 Texture MakeGroundTexture(double tile_metres, std::uint32_t seed, double texels_per_metre = 20.0);

@@ -23,7 +23,6 @@ double L1Score(const BowVector& a, const BowVector& b);
 // Builds a BowVector from per-descriptor words and per-word weights (idf,
 // indexed by word):
 // term frequency times weight, L1-normalised; words with weight 0 are dropped.
-void MakeBowVector(const std::vector<WordId>& descriptor_words, const float* word_weights,
-                   BowVector* bow);
+void MakeBowVector(const std::vector<WordId>& descriptor_words, const float* word_weights, BowVector* bow);
 
 }  // namespace patrolmap::vocab

@@ -41,10 +41,10 @@ template <typename T>
 using Array = std::vector<T, UninitialisedAllocator<T>>;
 
 struct VocabularyOptions {
-  int branching = 10;          // k: children per node
-  int depth = 4;               // L: levels below the root; up to k^L words
-  int max_iterations = 25;     // cap on Lloyd iterations per k-means (never runs unbounded)
-  std::uint32_t seed = 1;      // k-means++ seeding; training is deterministic for a seed
+  int branching = 10;       // k: children per node
+  int depth = 4;            // L: levels below the root; up to k^L words
+  int max_iterations = 25;  // cap on Lloyd iterations per k-means (never runs unbounded)
+  std::uint32_t seed = 1;   // k-means++ seeding; training is deterministic for a seed
   bool IsValid(std::string* error) const;
 };
 
@@ -101,8 +101,8 @@ class Vocabulary {
   Array<std::uint8_t> centres_;
   float scale_ = 1.0f;
   // Per word:
-  Array<float> idf_;                  // log(N / n_i); 0 for words no training image had
-  Array<std::uint32_t> leaf_;         // node of each word
+  Array<float> idf_;           // log(N / n_i); 0 for words no training image had
+  Array<std::uint32_t> leaf_;  // node of each word
 };
 
 }  // namespace patrolmap::vocab
