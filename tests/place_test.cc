@@ -243,3 +243,34 @@ TEST(PlaceOptions, OutOfRangeValuesNameKeyValueAndRule) {
 
 }  // namespace
 }  // namespace patrolmap::place
+
+namespace patrolmap::place {
+namespace {
+
+// Lowe's ratio test (ratio 0.8): a match is kept when its nearest candidate is clearly nearer than the
+// second nearest. 10 query descriptors have one candidate at 0.1 (the next is some 4 away): kept. 10 have
+// two candidates at 0.50 and 0.52 (ratio 0.96): dropped.
+TEST(VerifyPair, RatioTestKeepsOnlyUnambiguousMatches) {
+  cv::RNG rng(11);
+  cv::Mat query(20, 128, CV_32F), candidate(30, 128, CV_32F);
+  rng.fill(query, cv::RNG::UNIFORM, 0.0, 1.0);
+  std::vector<cv::KeyPoint> query_points, candidate_points;
+  const auto offset = [&rng](double length) {
+    cv::Mat direction(1, 128, CV_32F);
+    rng.fill(direction, cv::RNG::NORMAL, 0.0, 1.0);
+    return cv::Mat(direction * (length / cv::norm(direction)));
+  };
+  for (int i = 0; i < 20; ++i) query_points.emplace_back(cv::Point2f(10.0f * i, 5.0f), 2.0f);
+  for (int i = 0; i < 10; ++i) candidate.row(i) = query.row(i) + offset(0.1);
+  for (int i = 10; i < 20; ++i) {
+    candidate.row(i) = query.row(i) + offset(0.50);
+    candidate.row(i + 10) = query.row(i) + offset(0.52);
+  }
+  for (int j = 0; j < 30; ++j) candidate_points.emplace_back(cv::Point2f(7.0f * j, 9.0f), 2.0f);
+  const Verification v = VerifyPair(PlaceOptions(), query_points, query, candidate_points, candidate);
+  EXPECT_EQ(v.matches, 10);
+  EXPECT_DOUBLE_EQ(v.matched_fraction, 10.0 / 20.0);
+}
+
+}  // namespace
+}  // namespace patrolmap::place
