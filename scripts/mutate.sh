@@ -19,8 +19,11 @@ ctest --test-dir "$scratch/build" -j "$(nproc)" >/dev/null || { echo "the unmuta
 [[ -e "$scratch/shared" || ! -e "$root/../shared" ]] || ln -s "$root/../shared" "$scratch/shared"
 
 tried=0 killed=0 survived=0 unbuilt=0
-while IFS=$'\t' read -r file original mutant what; do
-  [[ -z "$file" || "$file" == \#* ]] && continue
+while IFS= read -r line; do
+  [[ -z "$line" || "$line" == \#* ]] && continue
+  # Split at tabs by hand: read with IFS=tab would merge empty fields.
+  IFS=$'\x1f' read -r file original mutant what <<<"${line//$'\t'/$'\x1f'}"
+  [[ -n "$what" ]] || { echo "malformed line (4 tab-separated fields needed): $line" >&2; continue; }
   tried=$((tried + 1))
   target="$scratch/tree/$file"
   cp "$target" "$scratch/original"
@@ -44,7 +47,7 @@ PY
     result="SURVIVED"
     survived=$((survived + 1))
   else
-    result="killed by $(grep -c -- '\*\*\*\|(Failed)' "$scratch/ctest.log") test(s)"
+    result="killed by $(grep -cE '^[[:space:]]+[0-9]+ - .*\((Failed|SEGFAULT|Subprocess aborted|Timeout|Exception)\)' "$scratch/ctest.log") test(s)"
     killed=$((killed + 1))
   fi
   printf '%-26s %s: %s\n' "$result" "$file" "$what"
