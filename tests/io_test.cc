@@ -264,6 +264,15 @@ TEST(Euroc, NonMonotonicTimestampsAreRejected) {
       << status.message();
 }
 
+// Two frames at one time cannot both be frames of one camera: refused, naming the line (camera tables are
+// strict; other sensor tables may repeat a time).
+TEST(Euroc, EqualCameraTimestampsAreRejected) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n2000,b.png\n2000,c.png\n");
+  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (2000)"), std::string::npos)
+      << status.message();
+}
+
 TEST(Euroc, EmptyCameraTableIsAnError) {
   TempDir dir;
   const Status status = OpenWithFile(dir, "cam0/data.csv", "#timestamp [ns],filename\n");
