@@ -62,7 +62,8 @@ bool KeyLocationOptions::IsValid(std::string* error) const {
 FrameTiming ResolveFrameTiming(const KeyLocationOptions& options, double frame_rate_hz) {
   FrameTiming timing;
   const bool known = std::isfinite(frame_rate_hz) && frame_rate_hz > 0.0;
-  timing.step = known ? std::max(1, static_cast<int>(std::lround(frame_rate_hz / options.frames.rate_hz))) : 1;
+  const double frames_per_step = known ? std::clamp(frame_rate_hz / options.frames.rate_hz, 1.0, 1e6) : 1.0;
+  timing.step = static_cast<int>(std::lround(frames_per_step));
   timing.processed_rate_hz = known ? frame_rate_hz / timing.step : options.frames.rate_hz;
   const double window = std::round(options.smoothing.window_s * timing.processed_rate_hz);
   timing.window = static_cast<int>(std::clamp(window, 1.0, 1e6));

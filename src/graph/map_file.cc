@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "patrolmap/core/checksum.h"
+#include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
 
 namespace patrolmap::graph {
@@ -225,10 +226,7 @@ Status Corrupt(const std::string& path, const std::string& what) {
 
 // Flight ids as readers keep them (io::CleanFlightId): no control characters, commas or double quotes.
 bool ValidFlightId(const std::string& id) {
-  return !id.empty() && id.size() <= 1000 && std::none_of(id.begin(), id.end(), [](char c) {
-    const auto u = static_cast<unsigned char>(c);
-    return u < 0x20 || u == 0x7f || c == ',' || c == '"';
-  });
+  return !id.empty() && id.size() <= 1000 && std::none_of(id.begin(), id.end(), BreaksCsvField);
 }
 
 Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {

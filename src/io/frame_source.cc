@@ -2,11 +2,13 @@
 
 #include <spdlog/spdlog.h>
 
+#include "patrolmap/core/csv.h"
+
 namespace patrolmap::io {
 
 std::string CleanFlightId(const std::string& raw) {
   std::string id;
-  for (unsigned char c : raw) id += (c < 0x20 || c == 0x7f || c == ',' || c == '"') ? '_' : static_cast<char>(c);
+  for (char c : raw) id += BreaksCsvField(c) ? '_' : c;
   if (id.size() > kMaxFlightIdLength) id.resize(kMaxFlightIdLength);
   if (id.empty()) id = "flight";
   if (id != raw) spdlog::warn("flight id '{}' contains characters tables cannot hold; it is '{}' here", raw, id);

@@ -1,6 +1,7 @@
 #include "image_times.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,13 @@ namespace fs = std::filesystem;
 
 namespace patrolmap::io {
 namespace {
+
+// Digits known to fit (at most 11): their value.
+long long ToInteger(const std::string& digits) {
+  long long value = 0;
+  std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  return value;
+}
 
 // The time a file stem names, exactly in nanoseconds: decimal seconds with a fraction, or an integer of
 // at least 10 digits read as seconds, milliseconds, microseconds or nanoseconds by its length.
@@ -24,11 +32,12 @@ bool ParseTime(const std::string& text, TimestampNs* ns) {
   if (dot != std::string::npos) {
     if (fraction.empty() || whole.size() > 11) return false;
     const std::string nanos = (fraction + "000000000").substr(0, 9);
-    *ns = std::stoll(whole) * 1000000000LL + std::stoll(nanos);
+    *ns = ToInteger(whole) * 1000000000LL + ToInteger(nanos);
     return true;
   }
   if (whole.size() < 10 || whole[0] == '0') return false;  // frame numbers such as 000123, not times
-  const long long value = std::stoll(whole);
+  long long value = 0;
+  if (std::from_chars(whole.data(), whole.data() + whole.size(), value).ec != std::errc()) return false;  // > 2^63
   const long long factor = whole.size() >= 18   ? 1
                            : whole.size() >= 15 ? 1000
                            : whole.size() >= 12 ? 1000000

@@ -39,6 +39,13 @@ class CsvReader {
   int line_number_ = 0;
 };
 
+// Characters a CSV row of patrolmap cannot hold inside a field (control characters, commas, double quotes):
+// the one rule flight ids are cleaned with (io::CleanFlightId) and checked against (map files).
+inline bool BreaksCsvField(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return u < 0x20 || u == 0x7f || c == ',' || c == '"';
+}
+
 // Splits `line` at commas, trimming spaces, tabs and a trailing '\r'.
 void SplitCsvLine(std::string_view line, std::vector<std::string_view>* fields);
 
