@@ -575,6 +575,29 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
   EXPECT_LT(DetectAppearanceChange(Describe(scene), Describe(current), shift_only).regions.size(), all.regions.size());
 }
 
+TEST(Appearance, ARegionIsKeptAtItsUnmatchedShareAndDroppedBelowIt) {
+  AppearanceOptions options;  // min_unmatched_share 0.5
+  AppearanceRegion region;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));  // no features: nothing says parallax
+  region.prior_features = 6, region.current_features = 4;
+  region.unmatched_prior_features = 3, region.unmatched_current_features = 2;  // 5 of 10: exactly the share
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  region.unmatched_current_features = 1;  // 4 of 10
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  region.unmatched_prior_features = 0, region.unmatched_current_features = 3;  // 3 of 10: both sides count
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 0.3;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 0.0;  // keeps every region, even one whose features all match
+  region.unmatched_current_features = 0;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 1.0;  // keeps only regions where nothing matches
+  region.unmatched_prior_features = 6, region.unmatched_current_features = 3;
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  region.unmatched_current_features = 4;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+}
+
 TEST(Appearance, UnrelatedImagesAreNotRegistered) {
   const AppearanceChange change = DetectAppearanceChange(Describe(Scene(3)), Describe(Scene(4)), AppearanceOptions{});
   EXPECT_FALSE(change.registered);

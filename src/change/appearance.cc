@@ -119,6 +119,12 @@ double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv:
 
 }  // namespace
 
+bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions& options) {
+  const int features = region.prior_features + region.current_features;
+  const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
+  return features == 0 || unmatched >= options.min_unmatched_share * features;
+}
+
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
                                         const AppearanceOptions& options) {
   AppearanceChange result;
@@ -191,9 +197,7 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
       ++region.current_features;
       region.unmatched_current_features += !matched_current[k];
     }
-    const int features = region.prior_features + region.current_features;
-    const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
-    if (features > 0 && unmatched < options.min_unmatched_share * features) continue;
+    if (!KeepsUnmatchedShare(region, options)) continue;
     if (ShiftedSimilarity(current_f, warped, region.current_box, options.parallax_search_px) >
         options.max_shifted_similarity) {
       continue;  // the same content a few pixels off: parallax, not change

@@ -51,6 +51,11 @@ struct AppearanceChange {
   std::vector<AppearanceRegion> regions;  // largest first
 };
 
+// Whether a changed region is kept by its features: a region without features is; one with features only
+// when at least `min_unmatched_share` of them (prior and current together) found no match in the other
+// key frame. Features that still match show the same things seen from elsewhere (parallax).
+bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions& options);
+
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
                                         const AppearanceOptions& options);
 
