@@ -5,3 +5,5 @@ cd "$(dirname "$0")/.."
 scripts/install_deps.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j "$(nproc)"
+# The unit tests and the fuzzing corpus again under AddressSanitizer + UndefinedBehaviorSanitizer.
+scripts/sanitize.sh

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Builds patrolmap with AddressSanitizer + UndefinedBehaviorSanitizer into build-sanitize/ and runs the unit
+# tests and the fuzzing corpus replays (ctest label "unit") under them. Any finding fails the run: the
+# sanitizers stop the program (-fno-sanitize-recover=all) and the test fails. Part of scripts/test.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+  -DPATROLMAP_SANITIZE=ON -DPATROLMAP_BUILD_TESTS=ON -DPATROLMAP_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-sanitize -j "$(nproc)"
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+ctest --test-dir build-sanitize -L unit --output-on-failure -j "$(nproc)"
