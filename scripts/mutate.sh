@@ -11,7 +11,7 @@ list="${1:-$root/tests/mutations.tsv}"
 scratch="${2:-/tmp/patrolmap_mutate}"
 rm -rf "$scratch/tree" && mkdir -p "$scratch/tree"
 # --touch: fresh modification times, so a build left from an interrupted run recompiles what a mutation changed.
-tar -C "$root" --exclude=./build --exclude=./out --exclude=./.git -cf - . | tar -C "$scratch/tree" --touch -xf -
+tar -C "$root" --exclude="./build*" --exclude=./out --exclude=./.git -cf - . | tar -C "$scratch/tree" --touch -xf -
 cmake -S "$scratch/tree" -B "$scratch/build" -DCMAKE_BUILD_TYPE=Release -DPATROLMAP_BUILD_TESTS=ON \
   -DPATROLMAP_BUILD_BENCHMARKS=OFF >/dev/null || exit 1
 cmake --build "$scratch/build" -j "$(nproc)" >/dev/null || { echo "the unmutated tree does not build" >&2; exit 1; }

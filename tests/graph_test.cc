@@ -6,6 +6,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -218,6 +220,28 @@ TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
   TopoMap nan_weight = TwoFlights();
   nan_weight.mutable_node(3).bow.weights[0] = std::nanf("");
   refused(nan_weight, "features of node 3");
+  TopoMap negative_frame = TwoFlights();
+  negative_frame.mutable_node(4).frame_index = -3;
+  refused(negative_frame, "time, frame, GPS or layout of node 4");
+  TopoMap far_future = TwoFlights();
+  far_future.mutable_node(1).timestamp_ns = std::numeric_limits<TimestampNs>::max();
+  refused(far_future, "time, frame, GPS or layout of node 1");
+  TopoMap off_globe = TwoFlights();
+  off_globe.mutable_node(2).gps = Eigen::Vector2d(1000.0, 8.0);
+  refused(off_globe, "time, frame, GPS or layout of node 2");
+  const auto patrol_refused = [&](const std::function<void(PatrolRecord*)>& damage, const std::string& what) {
+    TopoMap map = TwoFlights();
+    PatrolRecord record = *map.Patrol("b");
+    damage(&record);
+    map.SetPatrol(record);
+    refused(map, what);
+  };
+  patrol_refused([](PatrolRecord* p) { p->views[0].rotation.coeffs().setConstant(std::nan("")); },
+                 "camera or views of patrol b");
+  patrol_refused([](PatrolRecord* p) { p->camera.fx = -1.0; }, "camera or views of patrol b");
+  patrol_refused([](PatrolRecord* p) { p->objects[0].centroid.x() = std::nan(""); }, "object 3 of patrol b");
+  patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = 1e-300; }, "evidence grid of b");
+  patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = std::nan(""); }, "evidence grid of b");
   std::string version_zero = bytes_;
   const std::uint32_t zero = 0;
   std::memcpy(version_zero.data() + 8, &zero, 4);

@@ -125,6 +125,9 @@ TEST(ImageFolder, KittiTimesFileInTheParentFolder) {
   const Status status = OpenImageFolder(dir / "image_0", {}, &source);
   EXPECT_NE(status.message().find("times.txt:2: expected a time in seconds, got 'soon'"), std::string::npos)
       << status.message();
+  WriteText(dir / "times.txt", "0.0\n0.1\n1e11\n");  // 1e20 ns: beyond the valid times
+  EXPECT_NE(OpenImageFolder(dir / "image_0", {}, &source).message().find("times.txt:3: expected a time in seconds"),
+            std::string::npos);
   WriteText(dir / "times.txt", "0.0\n0.1\n");
   EXPECT_NE(OpenImageFolder(dir / "image_0", {}, &source).message().find("2 times for 3 images"), std::string::npos);
 }
@@ -271,6 +274,18 @@ TEST(Euroc, EqualCameraTimestampsAreRejected) {
   const Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n2000,b.png\n2000,c.png\n");
   EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (2000)"), std::string::npos)
       << status.message();
+}
+
+// Times beyond 2^62 ns (146 years) or before the epoch would overflow the differences taken of them.
+TEST(Euroc, TimestampsOutsideTheValidRangeAreRejected) {
+  TempDir dir;
+  Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n9223372036854775807,b.png\n");
+  EXPECT_NE(status.message().find("data.csv:2: timestamp 9223372036854775807 is outside 0..4611686018427387904 ns"),
+            std::string::npos)
+      << status.message();
+  TempDir negative;
+  status = OpenWithFile(negative, "cam0/data.csv", "-5,a.png\n1000,b.png\n");
+  EXPECT_NE(status.message().find("data.csv:1: timestamp -5 is outside"), std::string::npos) << status.message();
 }
 
 TEST(Euroc, EmptyCameraTableIsAnError) {

@@ -229,6 +229,18 @@ bool ValidFlightId(const std::string& id) {
   return !id.empty() && id.size() <= 1000 && std::none_of(id.begin(), id.end(), BreaksCsvField);
 }
 
+bool Finite(std::initializer_list<double> values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+// Node values a reader could have written: a valid time, a frame index from 0, GPS on the globe, a
+// finite layout and heading.
+bool ValidNodeValues(const NodeData& n) {
+  const bool gps_ok = !n.gps || (std::abs((*n.gps)[0]) <= 90.0 && std::abs((*n.gps)[1]) <= 180.0);
+  return ValidTimestamp(n.timestamp_ns) && n.frame_index >= 0 && gps_ok &&
+         Finite({n.layout.x(), n.layout.y(), n.heading});
+}
+
 Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
@@ -244,6 +256,8 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
     n.layout = Eigen::Vector2d(v[2], v[3]);
     n.heading = v[4];
     if (!ValidFlightId(n.flight)) return Corrupt(path, "flight id of node " + std::to_string(i));
+    if (!r->failed() && !ValidNodeValues(n))
+      return Corrupt(path, "time, frame, GPS or layout of node " + std::to_string(i));
     if (!r->failed() &&
         (n.thumbnail.empty() || n.thumbnail.type() != CV_8UC1 || n.thumbnail.cols > 4096 || n.thumbnail.rows > 4096)) {
       return Corrupt(path, "thumbnail of node " + std::to_string(i));
@@ -324,6 +338,41 @@ bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
   return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore);
 }
 
+// A patrol's camera as the pipeline records it (valid, or all zero for a log without one), and views
+// with valid times, finite positions and rotations of about unit norm.
+bool ValidCameraAndViews(const PatrolRecord& p) {
+  const CameraIntrinsics& c = p.camera;
+  constexpr int kMaxImageSide = 100000;
+  const bool unknown = c.fx == 0.0 && c.fy == 0.0 && c.cx == 0.0 && c.cy == 0.0 && c.width == 0 && c.height == 0;
+  const bool camera_ok = unknown || (Finite({c.fx, c.fy, c.cx, c.cy}) && c.valid() && c.width <= kMaxImageSide &&
+                                     c.height <= kMaxImageSide);
+  if (!camera_ok || p.feature_image_width < 0 || p.feature_image_width > kMaxImageSide) return false;
+  return std::all_of(p.views.begin(), p.views.end(), [](const CameraPoseSample& v) {
+    const double norm = v.rotation.coeffs().norm();
+    return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
+  });
+}
+
+bool ValidObject(const MapObject& o) {
+  const auto finite_points =
+      std::all_of(o.points.begin(), o.points.end(), [](const Eigen::Vector3f& x) { return x.allFinite(); });
+  const auto finite_descriptor =
+      std::all_of(o.descriptor.begin(), o.descriptor.end(), [](float x) { return std::isfinite(x); });
+  const auto finite_labels = std::all_of(o.labels.begin(), o.labels.end(), [](const MapObject::LabelEvidence& e) {
+    return std::isfinite(e.confidence_sum) && e.count >= 0;
+  });
+  return o.centroid.allFinite() && o.box_min.allFinite() && o.box_max.allFinite() && Finite({o.confidence, o.height}) &&
+         o.detections >= 0 && finite_points && finite_descriptor && finite_labels && ValidTimestamp(o.first_seen_ns) &&
+         ValidTimestamp(o.last_seen_ns);
+}
+
+// A grid with voxels has a voxel size the grid options allow (change.grid.voxel_size_m, with slack).
+bool ValidVoxelSize(const EvidenceGridData& grid) {
+  constexpr double kMinVoxelM = 1e-3, kMaxVoxelM = 1e3;
+  if (!std::isfinite(grid.voxel_size) || grid.voxel_size < 0.0) return false;
+  return grid.voxels.empty() || (grid.voxel_size >= kMinVoxelM && grid.voxel_size <= kMaxVoxelM);
+}
+
 Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
@@ -343,7 +392,12 @@ Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
     p.grid.voxel_size = r->Value<double>();
     p.grid.voxels = r->Vector<VoxelEvidence>();
     if (r->failed()) break;
-    if (!SortedVoxels(p.grid.voxels) || p.grid.voxel_size < 0.0) return Corrupt(path, "evidence grid of " + p.flight);
+    if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
+    if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
+    for (const MapObject& object : p.objects) {
+      if (!ValidObject(object)) return Corrupt(path, "object " + std::to_string(object.id) + " of patrol " + p.flight);
+    }
+    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid)) return Corrupt(path, "evidence grid of " + p.flight);
     map->SetPatrol(std::move(p));
   }
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();

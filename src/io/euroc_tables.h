@@ -39,6 +39,10 @@ Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow par
     PATROLMAP_RETURN_IF_ERROR(CheckColumns(csv, fields, columns));
     Row row;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseInt64(fields[0], "timestamp [ns]", &row.timestamp_ns));
+    if (!ValidTimestamp(row.timestamp_ns)) {
+      return csv.Error("timestamp " + std::to_string(row.timestamp_ns) + " is outside 0.." +
+                       std::to_string(kMaxTimestampNs) + " ns");
+    }
     PATROLMAP_RETURN_IF_ERROR(CheckIncreasing(csv, previous, row.timestamp_ns, strict));
     PATROLMAP_RETURN_IF_ERROR(parse_row(csv, fields, &row));
     previous = row.timestamp_ns;

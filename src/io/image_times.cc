@@ -32,8 +32,8 @@ bool ParseTime(const std::string& text, TimestampNs* ns) {
   if (dot != std::string::npos) {
     if (fraction.empty() || whole.size() > 11) return false;
     const std::string nanos = (fraction + "000000000").substr(0, 9);
-    *ns = ToInteger(whole) * 1000000000LL + ToInteger(nanos);
-    return true;
+    *ns = ToInteger(whole) * 1000000000LL + ToInteger(nanos);  // at most 11 + 9 digits: below 2^63
+    return ValidTimestamp(*ns);
   }
   if (whole.size() < 10 || whole[0] == '0') return false;  // frame numbers such as 000123, not times
   long long value = 0;
@@ -42,7 +42,7 @@ bool ParseTime(const std::string& text, TimestampNs* ns) {
                            : whole.size() >= 15 ? 1000
                            : whole.size() >= 12 ? 1000000
                                                 : 1000000000;
-  if (factor > 1 && value > std::numeric_limits<long long>::max() / factor) return false;
+  if (value > kMaxTimestampNs / factor) return false;
   *ns = value * factor;
   return true;
 }
@@ -62,7 +62,7 @@ Status ReadTimesFile(const std::string& path, std::size_t expected, std::vector<
     if (line.empty() || line[0] == '#') continue;
     char* end = nullptr;
     const double seconds = std::strtod(line.c_str(), &end);
-    if (end == line.c_str() || !std::isfinite(seconds) || seconds < 0.0 || seconds > 1e11) {
+    if (end == line.c_str() || !std::isfinite(seconds) || seconds < 0.0 || seconds > NsToSeconds(kMaxTimestampNs)) {
       return Status::DataLoss(path + ":" + std::to_string(number) + ": expected a time in seconds, got '" + line + "'");
     }
     times->push_back(SecondsToNs(seconds));

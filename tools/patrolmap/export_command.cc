@@ -35,7 +35,8 @@ Status SvgTruthFromLogs(const graph::TopoMap& map, const std::vector<std::string
   for (int i = 0; i < map.node_count(); ++i) {
     const graph::NodeData& node = map.node(i);
     const auto flight = places.find(node.flight);
-    if (flight == places.end() || node.frame_index >= static_cast<std::int64_t>(flight->second.size())) {
+    if (flight == places.end() || node.frame_index < 0 ||
+        node.frame_index >= static_cast<std::int64_t>(flight->second.size())) {
       return Status::InvalidArgument("no --log holds the places of node " + std::to_string(i) + " (flight '" +
                                      node.flight + "')");
     }

@@ -15,6 +15,11 @@ namespace patrolmap {
 
 using TimestampNs = std::int64_t;
 
+// Timestamps patrolmap accepts lie in [0, kMaxTimestampNs] (2^62 ns: about 146 years after the epoch), so
+// the difference of any two never overflows. Readers refuse others, naming the file and line.
+constexpr TimestampNs kMaxTimestampNs = TimestampNs{1} << 62;
+inline bool ValidTimestamp(TimestampNs ns) { return ns >= 0 && ns <= kMaxTimestampNs; }
+
 inline double NsToSeconds(TimestampNs ns) { return static_cast<double>(ns) * 1e-9; }
 inline TimestampNs SecondsToNs(double seconds) {
   return static_cast<TimestampNs>(seconds * 1e9 + (seconds >= 0 ? 0.5 : -0.5));
