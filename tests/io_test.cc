@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "log_capture.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/patrol_sensors.h"
@@ -14,6 +15,7 @@
 namespace patrolmap::io {
 namespace {
 
+using testing::LogCapture;
 using testing::TempDir;
 using testing::WriteText;
 
@@ -186,6 +188,29 @@ TEST(Video, ReadsGreyFramesAndCountsThem) {
   EXPECT_EQ(frames[3].image.type(), CV_8UC1);
   EXPECT_NEAR(frames[3].image.at<uchar>(10, 10), 120, 6);
   EXPECT_EQ(frames[5].timestamp_ns, 200000000);  // 5 / 25 Hz
+}
+
+// A video cut short (an interrupted copy) is read up to the cut, with a warning that names it and says
+// how many of its header's frames are missing.
+TEST(Video, TruncatedVideoWarnsAndKeepsItsFrames) {
+  TempDir dir;
+  const std::string path = dir / "clip.avi";
+  cv::VideoWriter writer(path, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 25.0, cv::Size(64, 48), true);
+  if (!writer.isOpened()) GTEST_SKIP() << "this OpenCV build cannot write MJPG video";
+  cv::Mat noise(48, 64, CV_8UC3);
+  for (int i = 0; i < 100; ++i) writer.write((cv::randu(noise, 0, 255), noise));
+  writer.release();
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) * 6 / 10);
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(path, {}, &source).ok());
+  LogCapture log;
+  Status end;
+  const std::size_t frames = ReadAll(source.get(), &end).size();
+  EXPECT_GT(frames, 40u);
+  EXPECT_LT(frames, 70u);
+  EXPECT_NE(log.text().find("clip.avi: the video ends after " + std::to_string(frames) + " of the 100 frames"),
+            std::string::npos)
+      << log.text();
 }
 
 TEST(Video, GarbageFileFails) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 
+#include <spdlog/spdlog.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -126,7 +127,10 @@ class VideoSource : public FrameSource {
   Status Next(bool decode_image, Frame* frame) override {
     frame->imu.clear();
     frame->image.release();
-    if (!capture_.grab()) return Status::EndOfStream();
+    if (!capture_.grab()) {
+      WarnIfTruncated();
+      return Status::EndOfStream();
+    }
     frame->index = next_index_++;
     frame->timestamp_ns = SecondsToNs(static_cast<double>(frame->index) / info_.frame_rate_hz);
     if (live_) {
@@ -147,7 +151,20 @@ class VideoSource : public FrameSource {
   const LogInfo& info() const override { return info_; }
 
  private:
+  // A video that ends well before the frame count of its header was cut short (a copy or a recording
+  // interrupted): its frames up to the cut are used, and the user is told once. Containers estimate the
+  // count from the duration, so a shortfall of up to 1 % (at least 2 frames) is not reported.
+  void WarnIfTruncated() {
+    if (live_ || warned_ || info_.frame_count <= 0) return;
+    warned_ = true;
+    const std::int64_t tolerance = std::max<std::int64_t>(2, info_.frame_count / 100);
+    if (next_index_ + tolerance >= info_.frame_count) return;
+    spdlog::warn("{}: the video ends after {} of the {} frames its header lists (truncated?); the rest is missing",
+                 info_.path, next_index_, info_.frame_count);
+  }
+
   LogInfo info_;
+  bool warned_ = false;
   cv::VideoCapture capture_;
   bool live_ = false;
   std::chrono::steady_clock::time_point start_;
