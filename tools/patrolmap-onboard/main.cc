@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "../cli_checks.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
@@ -116,7 +117,10 @@ PatrolRecord AppearanceRecord(const io::LogInfo& info, const pipeline::MapResult
 
 Status Run(const Arguments& arguments) {
   pipeline::Config config;
-  if (arguments.source.rfind("camera:", 0) != 0) PATROLMAP_RETURN_IF_ERROR(io::CheckLogExists(arguments.source));
+  if (arguments.source.rfind("camera:", 0) != 0) {
+    PATROLMAP_RETURN_IF_ERROR(io::CheckLogExists(arguments.source));
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(arguments.out, arguments.source, "flight log"));
+  }
   PATROLMAP_RETURN_IF_ERROR(pipeline::LoadCheckedConfig(arguments.config, &config));
   if (arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   std::string error;
@@ -169,10 +173,10 @@ int main(int argc, char** argv) {
   app.add_option("-c,--config", arguments.config, "YAML configuration (see config/default.yaml)");
   app.add_option("--vocabulary", arguments.vocabulary, "vocabulary file (default: the shipped one)");
   app.add_option("--fps", arguments.fps, "frame rate of a log without timestamps [Hz] (default: its own times)")
-      ->check(CLI::Range(0.001, 10000.0));
+      ->check(patrolmap::tools::FiniteRange(0.001, 10000.0));
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
   app.add_option("--max-seconds", arguments.max_seconds, "stop after this much of the flight [s]; 0: at its end")
-      ->check(CLI::NonNegativeNumber);
+      ->check(patrolmap::tools::FiniteRange(0.0));
   app.add_flag(
       "--inline-places", [&arguments](std::int64_t) { arguments.options.place_worker = false; },
       "run place recognition on the frame thread (the map is the same)");
@@ -182,7 +186,7 @@ int main(int argc, char** argv) {
   app.add_option("--ring-s", arguments.options.ring_s,
                  "seconds of processed frames kept for key locations confirmed late")
       ->capture_default_str()
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(patrolmap::tools::FiniteRange(0.1, 3600.0));
   app.add_flag("-q,--quiet", quiet, "only print errors");
   app.footer("SIGINT or SIGTERM ends the stream; the map is written as if it had ended, and the exit code is 0.");
   try {

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "../cli_checks.h"
 #include "patrolmap/change/report.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/pipeline/config.h"
@@ -20,8 +21,7 @@ inline int Fail(const Status& status) {
 
 using pipeline::LoadCheckedConfig;
 
-// A command-line number check that, unlike CLI::Range, also refuses NaN and infinity.
-CLI::Validator FiniteRange(double low, double high);
+using tools::FiniteRange;
 
 // --fps: the frame rate of image folders, patterns and videos, overriding their own times [Hz].
 void AddFpsOption(CLI::App* app, double* fps);

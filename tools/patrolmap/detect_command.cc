@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/pipeline/detect.h"
@@ -57,6 +58,7 @@ void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionRes
 int RunDetect(const DetectArguments& arguments) {
   pipeline::Config config;
   Status status = io::CheckLogExists(arguments.log);
+  if (status.ok()) status = RefuseOverwritingInput(arguments.out, arguments.log, "flight log");
   if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
   if (status.ok()) status = ApplyOverrides(arguments, &config);  // command-line flags win over the file
   if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;

@@ -45,21 +45,6 @@ int RunDiff(const DiffArguments& arguments) {
 
 }  // namespace
 
-CLI::Validator FiniteRange(double low, double high) {
-  std::ostringstream range;
-  range << "[" << low << ", " << high << "]";
-  const std::string rule = range.str();
-  return CLI::Validator(
-      [low, high, rule](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size()) return "not a number: " + text;
-        if (!std::isfinite(value) || value < low || value > high) return text + " is not a number in " + rule;
-        return "";
-      },
-      "number in " + rule);
-}
-
 void AddFpsOption(CLI::App* app, double* fps) {
   app->add_option("--fps", *fps,
                   "frame rate of an image folder, pattern or video [Hz] (default: from its times: times.txt, "

@@ -116,6 +116,7 @@ int RunMap(const MapArguments& arguments) {
   Status status;
   for (const std::string& log : arguments.logs) {
     if (status.ok()) status = io::CheckLogExists(log);  // a missing log first: it is the likeliest mistake
+    if (status.ok()) status = RefuseOverwritingInput(arguments.out, log, "flight log");
   }
   if (status.ok() && !arguments.prior_map.empty()) {
     status = RefuseOverwritingInput(arguments.out + "/map.pmap", arguments.prior_map, "prior map");

@@ -126,11 +126,11 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
       ->capture_default_str();
   app->add_option("--remove-fraction", arguments->changes.remove_fraction,
                   "series: share of objects removed per flight")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--move-fraction", arguments->changes.move_fraction,
                   "series: share of objects moved 2-6 m per flight")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(FiniteRange(0.0, 1.0))
       ->capture_default_str();
   app->add_option("--added", arguments->changes.added, "series: objects added per flight")
       ->check(CLI::Range(0, 100))
@@ -146,7 +146,7 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
                 "write only groundtruth/key_locations.csv into an existing log of the same options");
   app->add_option("--motion-blur", arguments->log.exposure_s,
                   "exposure time for motion blur [s] (each frame averages 5 renders over it; 0 = sharp)")
-      ->check(CLI::Range(0.0, 0.1))
+      ->check(FiniteRange(0.0, 0.1))
       ->capture_default_str();
 }
 
@@ -157,36 +157,36 @@ void AddStreetOptions(CLI::App* app, sim::StreetOptions* street) {
   app->add_flag("--irregular", street->irregular,
                 "street: draw facade lengths, gaps, depths and heights from the seed");
   app->add_option("--yaw-wobble", street->yaw_wobble_deg, "street: heading swing amplitude [deg]")
-      ->check(CLI::Range(0.0, 45.0))
+      ->check(FiniteRange(0.0, 45.0))
       ->capture_default_str();
   app->add_option("--yaw-period", street->yaw_period_s, "street: period of the heading swing [s]")
-      ->check(CLI::Range(1.0, 600.0))
+      ->check(FiniteRange(1.0, 600.0))
       ->capture_default_str();
   app->add_option("--speed-variation", street->speed_variation, "street: speed swing as a fraction of the speed")
-      ->check(CLI::Range(0.0, 0.9))
+      ->check(FiniteRange(0.0, 0.9))
       ->capture_default_str();
   app->add_option("--speed-period", street->speed_period_s, "street: period of the speed swing [s]")
-      ->check(CLI::Range(1.0, 600.0))
+      ->check(FiniteRange(1.0, 600.0))
       ->capture_default_str();
   app->add_flag("--static", street->static_camera, "street: hover in place for 10 s (no ego-motion)");
 }
 
 void AddRouteOptions(CLI::App* app, sim::RouteOptions* flight) {
   app->add_option("--speed-jitter", flight->speed_jitter, "village: smooth speed variation, fraction of the speed")
-      ->check(CLI::Range(0.0, 0.9))
+      ->check(FiniteRange(0.0, 0.9))
       ->capture_default_str();
   app->add_option("--altitude", flight->altitude_m, "village: flight height [m]")
-      ->check(CLI::Range(0.5, 30.0))
+      ->check(FiniteRange(0.5, 30.0))
       ->capture_default_str();
   app->add_option("--altitude-changes", flight->altitude_changes,
                   "village: sudden climbs or descents during the flight")
       ->check(CLI::Range(0, 20))
       ->capture_default_str();
   app->add_option("--altitude-change", flight->altitude_change_m, "village: size of each altitude change [m]")
-      ->check(CLI::Range(0.1, 10.0))
+      ->check(FiniteRange(0.1, 10.0))
       ->capture_default_str();
   app->add_option("--turn-radius", flight->turn_radius_m, "village: radius of the turns at corners [m]")
-      ->check(CLI::Range(0.5, 50.0))
+      ->check(FiniteRange(0.5, 50.0))
       ->capture_default_str();
 }
 
@@ -204,7 +204,7 @@ Command AddSimulateCommand(CLI::App* app) {
       ->capture_default_str();
   app->add_option("--mount", arguments->mount_deg,
                   "camera mount: angle of the optical axis from the flight direction, towards the left [deg]")
-      ->check(CLI::Range(20.0, 90.0))
+      ->check(FiniteRange(20.0, 90.0))
       ->capture_default_str();
   app->add_option("--speed", arguments->speed_mps, "mean speed [m/s] (default: street 2.5, village 1.3)")
       ->check(FiniteRange(0.1, 50.0));

@@ -1,0 +1,32 @@
+// Command-line checks shared by the programs in tools/.
+#pragma once
+
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace patrolmap::tools {
+
+// A number in [low, high]. Unlike CLI::Range it also refuses NaN and infinity (NaN compares false with
+// both bounds, so a range check alone lets it through).
+inline CLI::Validator FiniteRange(double low, double high = std::numeric_limits<double>::max()) {
+  std::ostringstream range;
+  range << "[" << low << ", " << high << "]";
+  const std::string rule =
+      high == std::numeric_limits<double>::max() ? "finite, at least " + std::to_string(low) : range.str();
+  return CLI::Validator(
+      [low, high, rule](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size()) return "not a number: " + text;
+        if (!std::isfinite(value) || value < low || value > high) return text + " is not a number in " + rule;
+        return "";
+      },
+      "number in " + rule);
+}
+
+}  // namespace patrolmap::tools
