@@ -413,6 +413,33 @@ TEST(Euroc, BadSensorYamlNamesTheFile) {
   status = OpenLog(log, {}, &source);
   EXPECT_EQ(status.code(), StatusCode::kDataLoss);
   EXPECT_NE(status.message().find("sensor.yaml:"), std::string::npos) << status.message();
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3, 4]\nresolution: [32, 24]\nrate_hz: .nan\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("sensor.yaml: 'rate_hz' must be a frame rate above 0"),
+            std::string::npos);
+  std::filesystem::remove(log + "/cam0/sensor.yaml");
+  for (const char* meta : {"frame_rate_hz: -5\n", "frame_rate_hz: [30]\n"}) {
+    WriteText(log + "/meta.yaml", meta);
+    EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: 'frame_rate_hz' must be a frame rate above 0"),
+              std::string::npos)
+        << meta;
+  }
+  WriteText(log + "/meta.yaml", "flight_id: {a: 1}\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: 'flight_id' must be text"), std::string::npos);
+}
+
+// YAML forbids a key twice in one map, and yaml-cpp would keep one silently: refused at any depth, naming
+// the file, line and key (sensor.yaml, meta.yaml and configurations all load this way).
+TEST(Yaml, ARepeatedKeyIsRefusedNamingFileLineAndKey) {
+  TempDir dir;
+  YAML::Node root;
+  WriteText(dir / "a.yaml", "rate_hz: 20\nT_BS:\n  rows: 4\n  rows: 5\n");
+  Status status = LoadYamlFile(dir / "a.yaml", &root);
+  EXPECT_NE(status.message().find("a.yaml:4: key 'rows' appears twice in one map"), std::string::npos)
+      << status.message();
+  WriteText(dir / "b.yaml", "- {x: 1}\n- {x: 1, x: 2}\n");
+  EXPECT_NE(LoadYamlFile(dir / "b.yaml", &root).message().find("b.yaml:2: key 'x' appears twice"), std::string::npos);
+  WriteText(dir / "c.yaml", "a: {x: 1}\nb: {x: 1}\n");  // the same key in two maps is fine
+  EXPECT_TRUE(LoadYamlFile(dir / "c.yaml", &root).ok());
 }
 
 TEST(Euroc, SpeedIsInterpolatedFromTheStateTable) {

@@ -296,11 +296,21 @@ def attack_tables(attack, work, log, rng, rounds):
 
 
 def attack_yaml(attack, work, log):
-    for yaml_file in ["cam0/sensor.yaml", "imu0/sensor.yaml", "meta.yaml"]:
+    """Each file gets the shapes every YAML file must survive, and bad values of the keys patrolmap reads
+    from it (keys it does not read, such as an IMU's noise figures, are not its business)."""
+    t_bs = ["T_BS: 5\n", "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0]\n",
+            "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"]
+    read = {"cam0/sensor.yaml": t_bs + ["intrinsics: [-1, -1, 1, 1]\nresolution: [188, 120]\n",
+                                        "intrinsics: [1, 1, 1, 1]\nresolution: [0, 0]\n", "rate_hz: .nan\n",
+                                        "rate_hz: -5\n", "rate_hz: [1]\n"],
+            "imu0/sensor.yaml": t_bs,
+            "meta.yaml": ["flight_id: [a\n", "flight_id: {a: 1}\n", "frame_rate_hz: .nan\n",
+                          "frame_rate_hz: -5\n"]}
+    for yaml_file, values in read.items():
         original = (log / yaml_file).read_text()
-        for text in ["42\n", "- a\n- b\n", "T_BS: 5\n", "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0]\n",
-                     "intrinsics: [-1, -1, 1, 1]\n", "rate_hz: .nan\n", "rate_hz: -5\n", "flight_id: [a\n",
-                     "\x00\xff\xfe", original + original.splitlines()[-1] + "\n" if original.strip() else "x: 1\nx: 2\n"]:
+        lines = original.splitlines()
+        repeated = "\n".join(lines + lines[-1:]) + "\n"  # the last key twice
+        for text in ["42\n", "- a\n- b\n", "\x00\xff\xfe", repeated] + values:
             (log / yaml_file).write_text(text, errors="surrogateescape")
             attack.judge(f"YAML: {yaml_file}", [attack.patrolmap, "map", str(log), "--out",
                                                 str(work / "yout")], [yaml_file], keep=log / yaml_file)

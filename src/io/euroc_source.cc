@@ -63,6 +63,23 @@ Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* 
   return Status::Ok();
 }
 
+// Reads the optional frame rate `key` of a YAML file into `rate_hz` (unchanged when absent): a finite
+// number above 0, or the file is refused naming the key.
+Status ReadRate(const std::string& path, const YAML::Node& root, const char* key, double* rate_hz) {
+  if (!root[key]) return Status::Ok();
+  double value = 0.0;
+  try {
+    value = root[key].as<double>();
+  } catch (const YAML::Exception&) {
+    value = 0.0;
+  }
+  if (!std::isfinite(value) || value <= 0.0) {
+    return Status::DataLoss(path + ": '" + key + "' must be a frame rate above 0 [Hz]");
+  }
+  *rate_hz = value;
+  return Status::Ok();
+}
+
 // Reads T_BS (body from sensor) of a sensor.yaml; identity when absent.
 Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen::Matrix3d* rotation) {
   rotation->setIdentity();
@@ -93,16 +110,16 @@ Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d*
                           static_cast<int>(resolution[1])};
   if (!camera.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
   info->camera = camera;
-  if (root["rate_hz"]) info->frame_rate_hz = root["rate_hz"].as<double>(0.0);
+  PATROLMAP_RETURN_IF_ERROR(ReadRate(path, root, "rate_hz", &info->frame_rate_hz));
   return ReadBodyFromSensor(path, root, body_from_camera);
 }
 
 Status ReadMeta(const std::string& path, LogInfo* info) {
   YAML::Node root;
   PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
-  if (root["flight_id"]) info->flight_id = CleanFlightId(root["flight_id"].as<std::string>(""));
-  if (root["frame_rate_hz"]) info->frame_rate_hz = root["frame_rate_hz"].as<double>(0.0);
-  return Status::Ok();
+  if (root["flight_id"] && !root["flight_id"].IsScalar()) return Status::DataLoss(path + ": 'flight_id' must be text");
+  if (root["flight_id"]) info->flight_id = CleanFlightId(root["flight_id"].Scalar());
+  return ReadRate(path, root, "frame_rate_hz", &info->frame_rate_hz);
 }
 
 Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<ImuSample>* imu,
