@@ -313,6 +313,20 @@ TEST(Euroc, TimestampsOutsideTheValidRangeAreRejected) {
   EXPECT_NE(status.message().find("data.csv:1: timestamp -5 is outside"), std::string::npos) << status.message();
 }
 
+// A table names files inside its log's data folder; a name that climbs out of it (or is absolute) is
+// refused, naming the line, so a log cannot make patrolmap read files elsewhere.
+TEST(Euroc, FileNamesOutsideTheDataFolderAreRejected) {
+  for (const char* name : {"../../../etc/passwd", "/etc/passwd", "a/../../b.png"}) {
+    TempDir dir;
+    const Status status = OpenWithFile(dir, "cam0/data.csv", std::string("1000,a.png\n2000,") + name + "\n");
+    EXPECT_NE(status.message().find("data.csv:2: file name '" + std::string(name) + "' leaves the log's data folder"),
+              std::string::npos)
+        << status.message();
+  }
+  TempDir inside;
+  EXPECT_TRUE(OpenWithFile(inside, "cam0/data.csv", "1000,a.png\n2000,sub/../b.png\n").ok());
+}
+
 TEST(Euroc, EmptyCameraTableIsAnError) {
   TempDir dir;
   const Status status = OpenWithFile(dir, "cam0/data.csv", "#timestamp [ns],filename\n");

@@ -21,8 +21,9 @@ namespace {
 Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
   const std::string path = log + "/cam0/data.csv";
   const auto parse = [&log](const CsvReader& csv, const std::vector<std::string_view>& fields, ImageEntry* entry) {
-    if (fields[1].empty()) return csv.Error("empty file name");
-    entry->path = log + "/cam0/data/" + std::string(fields[1]);
+    std::string name;
+    PATROLMAP_RETURN_IF_ERROR(ParseFileName(csv, fields[1], &name));
+    entry->path = log + "/cam0/data/" + name;
     return Status::Ok();
   };
   PATROLMAP_RETURN_IF_ERROR(ReadTimedTable(path, 2, parse, entries));

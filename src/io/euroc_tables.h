@@ -1,6 +1,7 @@
 // Internal: helpers for EuRoC-style tables whose first column is a timestamp.
 #pragma once
 
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -49,6 +50,18 @@ Status ReadTimedTable(const std::string& path, std::size_t columns, ParseRow par
     rows->push_back(std::move(row));
   }
   return status.end_of_stream() ? Status::Ok() : status;
+}
+
+// A table's file name, relative to its data folder: refused when empty or when it would leave the folder
+// (absolute, or ".." above it), so a log cannot make patrolmap read files elsewhere.
+inline Status ParseFileName(const CsvReader& csv, std::string_view field, std::string* name) {
+  if (field.empty()) return csv.Error("empty file name");
+  const std::filesystem::path path = std::filesystem::path(std::string(field)).lexically_normal();
+  if (path.is_absolute() || path.empty() || *path.begin() == "..") {
+    return csv.Error("file name '" + std::string(field) + "' leaves the log's data folder");
+  }
+  *name = std::string(field);
+  return Status::Ok();
 }
 
 inline Status ParseVector(const CsvReader& csv, const std::vector<std::string_view>& fields, std::size_t first,

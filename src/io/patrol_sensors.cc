@@ -52,8 +52,9 @@ Status ReadDetectionTable(const std::string& path, std::vector<ObjectObservation
 
 Status ReadDepthTable(const std::string& log, std::vector<DepthEntry>* entries) {
   const auto parse = [&log](const CsvReader& csv, const std::vector<std::string_view>& fields, DepthEntry* entry) {
-    if (fields[1].empty()) return csv.Error("empty file name");
-    entry->path = log + "/depth0/data/" + std::string(fields[1]);
+    std::string name;
+    PATROLMAP_RETURN_IF_ERROR(ParseFileName(csv, fields[1], &name));
+    entry->path = log + "/depth0/data/" + name;
     return Status::Ok();
   };
   return ReadTimedTable(log + "/depth0/data.csv", 2, parse, entries);
