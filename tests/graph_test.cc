@@ -20,6 +20,7 @@
 #include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/graph/topo_map.h"
+#include "recompute_checksums.h"
 #include "test_util.h"
 
 namespace patrolmap::graph {
@@ -341,20 +342,6 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
-// Recomputes every section checksum of a map file's bytes (as far as its section headers can be walked),
-// so damage behind the checksums reaches the parsers.
-void RecomputeSectionChecksums(std::string* bytes) {
-  std::size_t position = 16;  // magic, version, section count
-  while (position + 20 <= bytes->size()) {
-    std::uint64_t length = 0;
-    std::memcpy(&length, bytes->data() + position + 4, 8);
-    if (length > bytes->size() - position - 20) return;
-    const std::uint64_t checksum = Checksum(bytes->data() + position + 20, length);
-    std::memcpy(bytes->data() + position + 12, &checksum, 8);
-    position += 20 + length;
-  }
-}
-
 // A damaged map behind good checksums (paper-free rule of issue 18): truncated at 64 offsets, and 200
 // single-bit flips with the checksums recomputed (fixed seed). Each file loads the same way twice and then
 // survives a save and every export, or fails with a message that names it.
@@ -370,7 +357,7 @@ TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {
     std::string flipped = bytes;
     const std::size_t bit = std::uniform_int_distribution<std::size_t>(0, 8 * bytes.size() - 1)(rng);
     flipped[bit / 8] = static_cast<char>(flipped[bit / 8] ^ (1 << (bit % 8)));
-    RecomputeSectionChecksums(&flipped);
+    testing::RecomputeMapChecksums(&flipped);
     cases.push_back(flipped);
   }
   int loaded = 0, refused = 0;

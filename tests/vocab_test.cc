@@ -12,6 +12,7 @@
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/vocab/database.h"
 #include "patrolmap/vocab/vocabulary.h"
+#include "recompute_checksums.h"
 #include "test_util.h"
 
 namespace patrolmap::vocab {
@@ -200,27 +201,6 @@ TEST_F(VocabularyFileTest, EveryCorruptCaseFailsWithAMessage) {
   EXPECT_EQ(Vocabulary::Load(dir_ / "missing.voc", &loaded).code(), StatusCode::kNotFound);
 }
 
-// Recomputes a vocabulary file's checksum over the layout its (possibly damaged) header describes, when
-// that layout fits the file; otherwise leaves it (the size check refuses such a file first).
-void RecomputeVocabularyChecksum(std::string* bytes) {
-  constexpr std::size_t kHeader = 36;  // magic, version, 5 counts, scale
-  if (bytes->size() < kHeader + 8) return;
-  std::uint32_t fields[6];
-  std::memcpy(fields, bytes->data() + 8, sizeof(fields));
-  const std::uint64_t nodes = fields[4], words = fields[5], dimension = fields[3];
-  const std::uint64_t pieces[] = {4 * nodes, 2 * nodes, 4 * nodes, 4 * nodes, nodes * dimension, 4 * words, 4 * words};
-  std::uint64_t total = kHeader + 8;
-  for (std::uint64_t piece : pieces) total += piece;
-  if (total != bytes->size()) return;
-  std::uint64_t checksum = Checksum(bytes->data() + 8, kHeader - 8);
-  std::size_t position = kHeader;
-  for (std::uint64_t piece : pieces) {
-    checksum = Checksum(bytes->data() + position, piece, checksum);
-    position += piece;
-  }
-  std::memcpy(bytes->data() + position, &checksum, 8);
-}
-
 // Truncations at 64 offsets and 200 single-bit flips with the checksum recomputed (fixed seed): each file
 // loads the same way twice and quantises, or fails with a message that names it.
 TEST_F(VocabularyFileTest, DamageBehindAGoodChecksumLoadsIdenticallyOrFailsNamingTheFile) {
@@ -231,7 +211,7 @@ TEST_F(VocabularyFileTest, DamageBehindAGoodChecksumLoadsIdenticallyOrFailsNamin
     std::string flipped = bytes_;
     const std::size_t bit = std::uniform_int_distribution<std::size_t>(0, 8 * bytes_.size() - 1)(rng);
     flipped[bit / 8] = static_cast<char>(flipped[bit / 8] ^ (1 << (bit % 8)));
-    RecomputeVocabularyChecksum(&flipped);
+    testing::RecomputeVocabularyChecksum(&flipped);
     cases.push_back(flipped);
   }
   const std::string path = dir_ / "damaged.voc";
