@@ -533,6 +533,15 @@ TEST(PatrolSensors, PosesDetectionsAndDepthOfALog) {
   EXPECT_FLOAT_EQ(depth.at<float>(3, 4), 4.5f);
   ASSERT_TRUE(sensors.camera.has_value());
   EXPECT_EQ(sensors.camera->width, 32);
+  // Depth images the table lists but the log lacks are dropped with one warning naming the first.
+  WriteText(log + "/depth0/data.csv", "#t,filename\n1000000000,d.png\n1100000000,gone.png\n1200000000,6\n");
+  LogCapture capture;
+  ASSERT_TRUE(ReadPatrolSensors(log, &sensors).ok());
+  EXPECT_EQ(sensors.depth.size(), 1u);
+  EXPECT_NE(capture.text().find("depth0/data.csv: 2 of the 3 depth images it lists are missing (the first: " + log +
+                                "/depth0/data/gone.png); they are skipped"),
+            std::string::npos)
+      << capture.text();
 }
 
 TEST(PatrolSensors, BadTablesNameFileAndLine) {

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 
+#include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "euroc_tables.h"
@@ -57,7 +58,23 @@ Status ReadDepthTable(const std::string& log, std::vector<DepthEntry>* entries) 
     entry->path = log + "/depth0/data/" + name;
     return Status::Ok();
   };
-  return ReadTimedTable(log + "/depth0/data.csv", 2, parse, entries);
+  PATROLMAP_RETURN_IF_ERROR(ReadTimedTable(log + "/depth0/data.csv", 2, parse, entries));
+  // Depth is read at the grid's rate, so a missing file might never be noticed: each is checked here, and
+  // the missing ones are dropped with one warning that names the first.
+  const std::size_t listed = entries->size();
+  std::string first_missing;
+  entries->erase(std::remove_if(entries->begin(), entries->end(),
+                                [&first_missing](const DepthEntry& entry) {
+                                  if (std::filesystem::is_regular_file(entry.path)) return false;
+                                  if (first_missing.empty()) first_missing = entry.path;
+                                  return true;
+                                }),
+                 entries->end());
+  if (entries->size() < listed) {
+    spdlog::warn("{}/depth0/data.csv: {} of the {} depth images it lists are missing (the first: {}); they are skipped",
+                 log, listed - entries->size(), listed, first_missing);
+  }
+  return Status::Ok();
 }
 
 }  // namespace
