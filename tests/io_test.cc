@@ -107,6 +107,10 @@ TEST(ImageFolder, NumericFileNamesAreTimes) {
     cv::imwrite(ns / (std::to_string(t) + ".png"), TestImage(1));
   ASSERT_TRUE(OpenImageFolder(ns.path(), {}, &source).ok());
   EXPECT_NEAR(source->info().frame_rate_hz, 20.0, 1e-3);
+  TempDir far;  // 13023063657 s is beyond the valid times (fuzzing found the nanoseconds overflowed)
+  for (const char* name : {"13023063657.102.png", "13023063658.102.png"}) cv::imwrite(far / name, TestImage(1));
+  ASSERT_TRUE(OpenImageFolder(far.path(), {}, &source).ok());
+  EXPECT_FALSE(source->info().timed);
   TempDir indices;  // zero-padded frame numbers are indices, not times
   for (const char* name : {"000000.png", "000001.png"}) cv::imwrite(indices / name, TestImage(1));
   ASSERT_TRUE(OpenImageFolder(indices.path(), {}, &source).ok());
@@ -452,6 +456,10 @@ TEST(Yaml, ARepeatedKeyIsRefusedNamingFileLineAndKey) {
       << status.message();
   WriteText(dir / "b.yaml", "- {x: 1}\n- {x: 1, x: 2}\n");
   EXPECT_NE(LoadYamlFile(dir / "b.yaml", &root).message().find("b.yaml:2: key 'x' appears twice"), std::string::npos);
+  WriteText(dir / "d.yaml", "flow:\n  ? {edges: 1}\n  : 2\n");  // a map as a key (fuzzing found it threw)
+  EXPECT_NE(LoadYamlFile(dir / "d.yaml", &root).message().find("d.yaml:2: a key must be a plain name"),
+            std::string::npos)
+      << LoadYamlFile(dir / "d.yaml", &root).message();
   WriteText(dir / "c.yaml", "a: {x: 1}\nb: {x: 1}\n");  // the same key in two maps is fine
   EXPECT_TRUE(LoadYamlFile(dir / "c.yaml", &root).ok());
 }

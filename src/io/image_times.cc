@@ -32,7 +32,9 @@ bool ParseTime(const std::string& text, TimestampNs* ns) {
   if (dot != std::string::npos) {
     if (fraction.empty() || whole.size() > 11) return false;
     const std::string nanos = (fraction + "000000000").substr(0, 9);
-    *ns = ToInteger(whole) * 1000000000LL + ToInteger(nanos);  // at most 11 + 9 digits: below 2^63
+    const long long seconds = ToInteger(whole);
+    if (seconds > kMaxTimestampNs / 1000000000LL) return false;  // beyond the valid times (and 2^63 ns)
+    *ns = seconds * 1000000000LL + ToInteger(nanos);
     return ValidTimestamp(*ns);
   }
   if (whole.size() < 10 || whole[0] == '0') return false;  // frame numbers such as 000123, not times

@@ -8,25 +8,26 @@
 namespace patrolmap::io {
 namespace {
 
-// Finds a key that a map of `node` (at any depth) holds twice: YAML forbids it, and yaml-cpp would keep
-// one of the two silently. Fills `key` and `line` (1-based) and returns true when there is one.
-bool FindRepeatedKey(const YAML::Node& node, std::string* key, int* line) {
+// Checks the keys of every map in `node` (at any depth): each must be a plain name (patrolmap's files use
+// no other kind), and none may appear twice in one map (YAML forbids it, and yaml-cpp would keep one
+// silently). Returns the problem and fills `line` (1-based), or returns "" when the keys are fine.
+std::string CheckKeys(const YAML::Node& node, int* line) {
   if (node.IsSequence()) {
     for (const YAML::Node& item : node) {
-      if (FindRepeatedKey(item, key, line)) return true;
+      std::string problem = CheckKeys(item, line);
+      if (!problem.empty()) return problem;
     }
   }
-  if (!node.IsMap()) return false;
+  if (!node.IsMap()) return "";
   std::set<std::string> keys;
   for (const auto& pair : node) {
-    if (pair.first.IsScalar() && !keys.insert(pair.first.Scalar()).second) {
-      *key = pair.first.Scalar();
-      *line = pair.first.Mark().line + 1;
-      return true;
-    }
-    if (FindRepeatedKey(pair.second, key, line)) return true;
+    *line = pair.first.Mark().line + 1;
+    if (!pair.first.IsScalar()) return "a key must be a plain name, not a map or a list";
+    if (!keys.insert(pair.first.Scalar()).second) return "key '" + pair.first.Scalar() + "' appears twice in one map";
+    std::string problem = CheckKeys(pair.second, line);
+    if (!problem.empty()) return problem;
   }
-  return false;
+  return "";
 }
 
 }  // namespace
@@ -44,11 +45,9 @@ Status LoadYamlFile(const std::string& path, YAML::Node* root) {
   } catch (const YAML::Exception& error) {
     return Status::DataLoss(path + ":" + std::to_string(error.mark.line + 1) + ": " + error.msg);
   }
-  std::string key;
   int line = 0;
-  if (FindRepeatedKey(*root, &key, &line)) {
-    return Status::DataLoss(path + ":" + std::to_string(line) + ": key '" + key + "' appears twice in one map");
-  }
+  const std::string problem = CheckKeys(*root, &line);
+  if (!problem.empty()) return Status::DataLoss(path + ":" + std::to_string(line) + ": " + problem);
   return Status::Ok();
 }
 
