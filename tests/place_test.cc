@@ -1,4 +1,6 @@
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -227,6 +229,35 @@ TEST(LogNumberOfFalseAlarms, ExactGeometryIsMeaningfulAndRandomMatchesAreNot) {
   EXPECT_EQ(LogNumberOfFalseAlarms(horizontal_shift, {from.begin(), from.begin() + 8}, {to.begin(), to.begin() + 8},
                                    vga, vga),
             0.0);
+}
+
+// The NFA by hand for a geometry whose error shows 10 times larger in the second image (it is stretched 10
+// times vertically): p_i = 2 d_i D / A with d_i the larger distance, the second image's, and
+// log NFA = min over k of log10(3 (n - 7) C(n, k) C(k, 7) p_(k)^(k - 7)). Either image's probability alone,
+// or one without the diagonal, would give another number.
+TEST(LogNumberOfFalseAlarms, EqualsTheFormulaWithTheLargerOfTheTwoImagesErrors) {
+  const cv::Matx33d stretch(0, 0, 0, 0, 0, -1, 0, 10, 0);  // x2^T F x1 = 10 y1 - y2
+  const FeatureExtent image{640.0 * 480.0, 800.0};
+  constexpr int n = 12;
+  std::vector<cv::Point2f> from, to;
+  std::vector<double> p;
+  for (int i = 0; i < n; ++i) {
+    const float error = 0.5f * static_cast<float>(i + 1);  // in the second image: 10 times the first's
+    from.emplace_back(50.0f * i, 4.0f * i);
+    to.emplace_back(50.0f * i, 40.0f * i + error);
+    p.push_back(2.0 * error * image.diagonal / image.area);
+  }
+  const auto log_choose = [](int a, int b) {
+    return (std::lgamma(a + 1.0) - std::lgamma(b + 1.0) - std::lgamma(a - b + 1.0)) / std::log(10.0);
+  };
+  double expected = std::numeric_limits<double>::infinity();
+  for (int k = 8; k <= n; ++k) {
+    expected = std::min(
+        expected, std::log10(3.0 * (n - 7)) + log_choose(n, k) + log_choose(k, 7) + (k - 7) * std::log10(p[k - 1]));
+  }
+  EXPECT_NEAR(LogNumberOfFalseAlarms(stretch, from, to, image, image), expected, 1e-6);
+  // Swapping the images (F transposed) measures the same errors.
+  EXPECT_NEAR(LogNumberOfFalseAlarms(stretch.t(), to, from, image, image), expected, 1e-6);
 }
 
 TEST(PlaceOptions, OutOfRangeValuesNameKeyValueAndRule) {
