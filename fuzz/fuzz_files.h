@@ -12,8 +12,8 @@
 #include <string_view>
 #include <vector>
 
-#include <opencv2/core/utils/logger.hpp>
 #include <spdlog/spdlog.h>
+#include <opencv2/core/utils/logger.hpp>
 
 namespace patrolmap::fuzz {
 
