@@ -152,6 +152,33 @@ TEST(PlaceRecognizer, RecentNodesOfTheSameFlightAreNotCandidates) {
   EXPECT_FALSE(recognizer.AddKeyFrame({"b", 0, 4, cv::Mat()}, &result).ok());
 }
 
+// A log without timestamps counts "recent" in images (place.exclude_recent_images): with 2, the image
+// 2 after a node does not see it as a candidate; 3 after does.
+TEST(PlaceRecognizer, WithoutTimesRecentIsCountedInImages) {
+  const cv::Mat one = cv::imread(kOpencvData + "/graf1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat three = cv::imread(kOpencvData + "/graf3.png", cv::IMREAD_GRAYSCALE);
+  if (one.empty() || three.empty()) GTEST_SKIP() << "opencv-doc not installed";
+  PlaceOptions options;
+  options.exclude_recent_images = 2;  // a node is a candidate from 3 images after it
+  const vocab::Vocabulary vocabulary = VocabularyFor({one, three}, options);
+  PlaceRecognizer recognizer(&vocabulary, options);
+  PlaceResult result;
+  const auto add = [&](std::int64_t index, const cv::Mat& image) {
+    KeyFrame key_frame{"a", 0, index, image};
+    key_frame.timed = false;  // the same time everywhere: only the image index can tell recent nodes
+    ASSERT_TRUE(recognizer.AddKeyFrame(key_frame, &result).ok());
+  };
+  add(10, three);
+  add(12, three);  // the same image 2 images later: recent, not a candidate
+  EXPECT_TRUE(result.candidates.empty());
+  EXPECT_FALSE(result.match.has_value());
+  add(13, three);  // node 0 is 3 images back: a candidate, and it verifies; node 1 (1 back) is not
+  ASSERT_TRUE(result.match.has_value());
+  EXPECT_EQ(result.match->node, 0);
+  EXPECT_EQ(result.candidates.size(), 1u);
+  (void)one;
+}
+
 }  // namespace
 }  // namespace patrolmap::place
 
