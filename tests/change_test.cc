@@ -598,6 +598,25 @@ TEST(Appearance, ARegionIsKeptAtItsUnmatchedShareAndDroppedBelowIt) {
   EXPECT_TRUE(KeepsUnmatchedShare(region, options));
 }
 
+// Matches alone do not register a pair: the homography needs min_inliers inliers. Two halves of the scene
+// moved apart (two planes) match everywhere, but one homography fits one half; with min_inliers between
+// the two counts the pair is not registered and yields no region.
+TEST(Appearance, APairNeedsItsInliersNotOnlyItsMatches) {
+  const cv::Mat prior = Scene(5);
+  cv::Mat current = prior.clone();
+  const cv::Rect right(80, 0, 80, 120);
+  Scene(5)(right - cv::Point(20, 0)).copyTo(current(right));  // the right half shows what lay 20 px left
+  const AppearanceChange loose = DetectAppearanceChange(Describe(prior), Describe(current), AppearanceOptions{});
+  ASSERT_TRUE(loose.registered);
+  ASSERT_LT(loose.inliers, 0.8 * loose.matches) << "one homography should not fit both halves";
+  AppearanceOptions strict;
+  strict.min_inliers = (loose.inliers + loose.matches) / 2;
+  const AppearanceChange change = DetectAppearanceChange(Describe(prior), Describe(current), strict);
+  EXPECT_EQ(change.matches, loose.matches);
+  EXPECT_FALSE(change.registered);
+  EXPECT_TRUE(change.regions.empty());
+}
+
 TEST(Appearance, UnrelatedImagesAreNotRegistered) {
   const AppearanceChange change = DetectAppearanceChange(Describe(Scene(3)), Describe(Scene(4)), AppearanceOptions{});
   EXPECT_FALSE(change.registered);
