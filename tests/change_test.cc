@@ -441,6 +441,33 @@ TEST(ObjectStates, AMovedObjectKeepsItsTopHeight) {
   }
 }
 
+// Paper 000's point-pair test after the move: a crate 2 m away of the same label, texture and top height
+// but another shape (a slab 2 m long, 0.2 m deep) is not the crate moved; with no shape rule it would be.
+TEST(ObjectStates, AMovedObjectKeepsItsShape) {
+  const PatrolRecord prior = CratePatrol(10, 1.0);
+  PatrolRecord current = Patrol({{"crate", {12, 0, 0.5}}});
+  MapObject& slab = current.objects[0];
+  for (int i = 0; i <= 20; ++i) {
+    for (int k = 0; k <= 10; ++k) {
+      for (const float y : {-0.1f, 0.1f}) slab.points.emplace_back(11.0f + 0.1f * i, y, 0.1f * k);
+    }
+  }
+  slab.box_min = Eigen::Vector3d(11, -0.1, 0);
+  slab.box_max = Eigen::Vector3d(13, 0.1, 1);
+  const std::vector<ObjectChange> changes = DiffObjects(prior, current, ObjectDiffOptions{});
+  ASSERT_EQ(changes.size(), 2u);
+  const auto count = [&changes](ObjectState state) {
+    return std::count_if(changes.begin(), changes.end(), [state](const ObjectChange& c) { return c.state == state; });
+  };
+  EXPECT_EQ(count(ObjectState::kRemoved), 1);  // the crate
+  EXPECT_EQ(count(ObjectState::kNew), 1);      // the slab
+  ObjectDiffOptions any_shape;
+  any_shape.min_shape_overlap = 0.0;
+  const std::vector<ObjectChange> loose = DiffObjects(prior, current, any_shape);
+  ASSERT_EQ(loose.size(), 1u);
+  EXPECT_EQ(loose[0].state, ObjectState::kMoved);
+}
+
 TEST(ObjectStates, AnObjectSeenFromOneSideBeforeIsPersistentWhenSeenWhole) {
   PatrolRecord prior = Patrol({{"barrel", {10, 0, 0.5}}});
   for (const Eigen::Vector3f& p : CubePoints({10, 0}, 1.0)) {
