@@ -428,6 +428,10 @@ TEST(Layout, OdometryResidualIsTheStepSeenFromTheFirstPoseLessTheMeasuredStep) {
   EXPECT_NEAR(residual[0], 0.0, 1e-12);
   EXPECT_NEAR(residual[1], 1.0, 1e-12);
   EXPECT_NEAR(residual[2], 0.0, 1e-12);
+  // Headings wrap: from 179 to -179 degrees is a turn of +2 degrees, not -358.
+  const double before[3] = {0.0, 0.0, M_PI - 0.0174533}, after[3] = {0.0, 0.0, -M_PI + 0.0174533};
+  OdometryResidual(before, after, Eigen::Vector2d(0.0, 0.0), 0.0349066, 1.0, residual, nullptr, nullptr);
+  EXPECT_NEAR(residual[2], 0.0, 1e-6);
 }
 
 TEST(Layout, LoopClosureClosesTheSquareAndAFalseOneDoesNotFoldIt) {
