@@ -15,9 +15,13 @@ namespace patrolmap::tools {
 // both bounds, so a range check alone lets it through).
 inline CLI::Validator FiniteRange(double low, double high = std::numeric_limits<double>::max()) {
   std::ostringstream range;
-  range << "[" << low << ", " << high << "]";
-  const std::string rule =
-      high == std::numeric_limits<double>::max() ? "finite, at least " + std::to_string(low) : range.str();
+  range << "[" << low << ", ";
+  if (high == std::numeric_limits<double>::max()) {
+    range << "any finite]";
+  } else {
+    range << high << "]";
+  }
+  const std::string rule = range.str();
   return CLI::Validator(
       [low, high, rule](std::string& text) -> std::string {
         char* end = nullptr;
