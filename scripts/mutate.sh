@@ -47,10 +47,12 @@ PY
     unbuilt=$((unbuilt + 1))
     continue
   fi
-  # The test program of the mutated file's stage first (src/STAGE/... -> STAGE_test): seconds, where the
-  # whole suite takes minutes. Only a mutation it misses is given the whole suite.
-  stage_test="$(cut -d/ -f2 <<<"$file")_test"
-  [[ "$file" == src/* && -f "$scratch/tree/tests/$stage_test.cc" ]] || stage_test=""
+  # The test program of the mutated file's stage first (src/STAGE/... -> STAGE_test, built from tests/STAGE/
+  # or tests/STAGE_test.cc): seconds, where the whole suite takes minutes. Only a mutation it misses is given
+  # the whole suite.
+  stage="$(cut -d/ -f2 <<<"$file")"
+  stage_test="${stage}_test"
+  [[ "$file" == src/* && (-f "$scratch/tree/tests/$stage_test.cc" || -d "$scratch/tree/tests/$stage") ]] || stage_test=""
   if [[ -n "$stage_test" ]] && cmake --build "$scratch/build" -j "$(nproc)" --target "$stage_test" >/dev/null 2>&1 &&
     ! timeout 900 "$scratch/build/tests/$stage_test" --gtest_brief=1 >"$scratch/ctest.log" 2>&1; then
     result="killed by $stage_test"

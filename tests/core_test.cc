@@ -2,12 +2,21 @@
 
 #include <gtest/gtest.h>
 
+#include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/types.h"
 #include "test_util.h"
 
 namespace patrolmap {
 namespace {
+
+TEST(Csv, SplitsAndTrims) {
+  std::vector<std::string_view> fields;
+  SplitCsvLine(" 12 ,abc.png\r", &fields);
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_EQ(fields[0], "12");
+  EXPECT_EQ(fields[1], "abc.png");
+}
 
 TEST(WriteFileAtomically, WritesAndReplacesWithoutLeavingTemporaries) {
   testing::TempDir dir;

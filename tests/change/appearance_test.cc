@@ -1,0 +1,160 @@
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "change/fixtures.h"
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/evidence_grid.h"
+#include "patrolmap/change/object_diff.h"
+#include "patrolmap/change/object_map.h"
+
+namespace patrolmap::change {
+namespace {
+
+// A textured scene, its view after a lighting change, and SIFT features of both.
+struct Pair {
+  KeyFrameView prior, current;
+};
+
+KeyFrameView Describe(const cv::Mat& image) {
+  KeyFrameView view;
+  view.image = image;
+  cv::SIFT::create(500)->detectAndCompute(image, cv::noArray(), view.keypoints, view.descriptors);
+  return view;
+}
+
+cv::Mat Scene(int seed) {
+  cv::Mat image(120, 160, CV_8UC1);
+  cv::RNG rng(seed);
+  image.setTo(120);
+  for (int i = 0; i < 90; ++i) {
+    const cv::Point a(rng.uniform(0, 160), rng.uniform(0, 120));
+    cv::rectangle(image, a, a + cv::Point(rng.uniform(3, 18), rng.uniform(3, 18)), cv::Scalar(rng.uniform(0, 255)),
+                  cv::FILLED);
+  }
+  cv::GaussianBlur(image, image, cv::Size(3, 3), 0.7);
+  return image;
+}
+
+cv::Mat Relit(const cv::Mat& image, double gain, double gamma, double shift_px) {
+  cv::Mat moved, out;
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, shift_px, 0, 1, 0);
+  cv::warpAffine(image, moved, m, image.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  moved.convertTo(out, CV_32F, 1.0 / 255);
+  cv::pow(out, gamma, out);
+  out.convertTo(out, CV_8U, 255 * gain);
+  return out;
+}
+
+TEST(Appearance, LightingOnlyGivesNoRegion) {
+  const cv::Mat scene = Scene(1);
+  const AppearanceChange change =
+      DetectAppearanceChange(Describe(scene), Describe(Relit(scene, 0.8, 1.3, 3.0)), AppearanceOptions{});
+  ASSERT_TRUE(change.registered);
+  EXPECT_GT(change.inliers, 30);
+  EXPECT_TRUE(change.regions.empty());
+  EXPECT_NEAR(change.homography.at<double>(0, 2), 3.0, 0.5);
+}
+
+TEST(Appearance, AnAddedObjectIsARegionInBothImages) {
+  const cv::Mat scene = Scene(2);
+  cv::Mat current = Relit(scene, 1.1, 0.9, -2.0);
+  const cv::Rect object(60, 40, 26, 22);
+  current(object).setTo(30);
+  cv::rectangle(current, object, cv::Scalar(220), 2);
+  const AppearanceChange change = DetectAppearanceChange(Describe(scene), Describe(current), AppearanceOptions{});
+  ASSERT_TRUE(change.registered);
+  ASSERT_FALSE(change.regions.empty());
+  const AppearanceRegion& region = change.regions[0];
+  EXPECT_GT((region.current_box & object).area(), 0.6 * object.area());
+  EXPECT_LT(region.current_box.area(), 2.0 * object.area());
+  EXPECT_NEAR(region.prior_box.x, region.current_box.x + 2, 2);  // the prior view is 2 px to the right
+  EXPECT_GT(region.score, 0.0);
+  EXPECT_GT(region.unmatched_prior_features, 0);  // the prior texture under the object no longer matches
+}
+
+TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
+  // A textured block of the scene seen 7 px off the rest (a nearer facade, off the registered plane): its
+  // pixels differ beyond the search radius, but its features match their prior selves.
+  cv::Mat scene = Scene(5);
+  cv::Mat texture(60, 80, CV_8UC1);
+  cv::randu(texture, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+  texture.copyTo(scene(cv::Rect(40, 30, 80, 60)));
+  cv::Mat current = scene.clone();
+  const cv::Rect block(50, 30, 60, 60);
+  scene(block - cv::Point(7, 0)).copyTo(current(block));
+  AppearanceOptions keep_all;
+  keep_all.min_unmatched_share = 0.0;
+  keep_all.max_shifted_similarity = 1.1;
+  const AppearanceChange all = DetectAppearanceChange(Describe(scene), Describe(current), keep_all);
+  ASSERT_TRUE(all.registered);
+  ASSERT_FALSE(all.regions.empty());  // the registration cannot fit both planes: pixels differ somewhere
+  for (const AppearanceRegion& r : all.regions) {
+    EXPECT_GT(r.prior_features + r.current_features, 0);
+    EXPECT_LT(r.unmatched_prior_features + r.unmatched_current_features, 0.5 * (r.prior_features + r.current_features));
+  }
+  EXPECT_TRUE(DetectAppearanceChange(Describe(scene), Describe(current), AppearanceOptions{}).regions.empty());
+  // Each test alone drops them too: the features still match, and the content is there a few pixels off.
+  AppearanceOptions features_only = keep_all, shift_only = keep_all;
+  features_only.min_unmatched_share = 0.5;
+  shift_only.max_shifted_similarity = AppearanceOptions{}.max_shifted_similarity;
+  EXPECT_TRUE(DetectAppearanceChange(Describe(scene), Describe(current), features_only).regions.empty());
+  EXPECT_LT(DetectAppearanceChange(Describe(scene), Describe(current), shift_only).regions.size(), all.regions.size());
+}
+
+TEST(Appearance, ARegionIsKeptAtItsUnmatchedShareAndDroppedBelowIt) {
+  AppearanceOptions options;  // min_unmatched_share 0.5
+  AppearanceRegion region;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));  // no features: nothing says parallax
+  region.prior_features = 6, region.current_features = 4;
+  region.unmatched_prior_features = 3, region.unmatched_current_features = 2;  // 5 of 10: exactly the share
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  region.unmatched_current_features = 1;  // 4 of 10
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  region.unmatched_prior_features = 0, region.unmatched_current_features = 3;  // 3 of 10: both sides count
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 0.3;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 0.0;  // keeps every region, even one whose features all match
+  region.unmatched_current_features = 0;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+  options.min_unmatched_share = 1.0;  // keeps only regions where nothing matches
+  region.unmatched_prior_features = 6, region.unmatched_current_features = 3;
+  EXPECT_FALSE(KeepsUnmatchedShare(region, options));
+  region.unmatched_current_features = 4;
+  EXPECT_TRUE(KeepsUnmatchedShare(region, options));
+}
+
+// Matches alone do not register a pair: the homography needs min_inliers inliers. Two halves of the scene
+// moved apart (two planes) match everywhere, but one homography fits one half; with min_inliers between
+// the two counts the pair is not registered and yields no region.
+TEST(Appearance, APairNeedsItsInliersNotOnlyItsMatches) {
+  const cv::Mat prior = Scene(5);
+  cv::Mat current = prior.clone();
+  const cv::Rect right(80, 0, 80, 120);
+  Scene(5)(right - cv::Point(20, 0)).copyTo(current(right));  // the right half shows what lay 20 px left
+  const AppearanceChange loose = DetectAppearanceChange(Describe(prior), Describe(current), AppearanceOptions{});
+  ASSERT_TRUE(loose.registered);
+  ASSERT_LT(loose.inliers, 0.8 * loose.matches) << "one homography should not fit both halves";
+  AppearanceOptions strict;
+  strict.min_inliers = (loose.inliers + loose.matches) / 2;
+  const AppearanceChange change = DetectAppearanceChange(Describe(prior), Describe(current), strict);
+  EXPECT_EQ(change.matches, loose.matches);
+  EXPECT_FALSE(change.registered);
+  EXPECT_TRUE(change.regions.empty());
+}
+
+TEST(Appearance, UnrelatedImagesAreNotRegistered) {
+  const AppearanceChange change = DetectAppearanceChange(Describe(Scene(3)), Describe(Scene(4)), AppearanceOptions{});
+  EXPECT_FALSE(change.registered);
+  EXPECT_TRUE(change.regions.empty());
+  EXPECT_FALSE(DetectAppearanceChange(KeyFrameView{}, KeyFrameView{}, AppearanceOptions{}).registered);
+}
+
+}  // namespace
+}  // namespace patrolmap::change

@@ -1,0 +1,175 @@
+#include <cmath>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "change/fixtures.h"
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/evidence_grid.h"
+#include "patrolmap/change/object_diff.h"
+#include "patrolmap/change/object_map.h"
+
+namespace patrolmap::change {
+namespace {
+
+using testing_fixtures::kCamera;
+using testing_fixtures::LookingAlongX;
+
+// Paper 004's occupancy: a voxel is occupied when most rays that reached it ended there, and (against a
+// single stray return) at least two did. Seen 1, 2 and 3 times.
+TEST(EvidenceGrid, AVoxelIsOccupiedFromTwoHitsThatOutnumberThePasses) {
+  VoxelEvidence voxel;
+  EXPECT_FALSE(IsOccupied(nullptr));
+  voxel.hits = 1;
+  EXPECT_FALSE(IsOccupied(&voxel));  // one hit: a stray return
+  voxel.hits = 2;
+  EXPECT_TRUE(IsOccupied(&voxel));
+  voxel.passes = 2;
+  EXPECT_FALSE(IsOccupied(&voxel));  // as many rays passed as ended
+  voxel.hits = 3;
+  EXPECT_TRUE(IsOccupied(&voxel));
+}
+
+const VoxelEvidence* At(const EvidenceGridData& grid, int x, int y, int z) {
+  return FindVoxel(grid, Eigen::Vector3i(x, y, z));
+}
+
+TEST(EvidenceGrid, RayPassesVoxelsBeforeItsEndAndHitsTheLast) {
+  EvidenceGridOptions options;
+  options.voxel_size_m = 0.2;
+  EvidenceGrid grid(options);
+  grid.TraceRay(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 0.0), true);  // voxels 0..5 along x
+  grid.TraceRay(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.62, 0.0, 0.0), false);
+  const EvidenceGridData data = grid.ToData();
+  ASSERT_EQ(data.voxels.size(), 6u);
+  for (int x = 0; x < 5; ++x) EXPECT_EQ(At(data, x, 0, 0)->passes, x <= 3 ? 2 : 1) << x;
+  EXPECT_EQ(At(data, 5, 0, 0)->hits, 1);
+  EXPECT_EQ(At(data, 5, 0, 0)->passes, 0);
+  EXPECT_EQ(At(data, 3, 0, 0)->hits, 0);  // the second ray ended without a return
+  EXPECT_EQ(At(data, 0, 1, 0), nullptr);
+  EXPECT_TRUE(
+      std::is_sorted(data.voxels.begin(), data.voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
+        return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+      }));
+}
+
+TEST(EvidenceGrid, DiagonalRayVisitsAConnectedChainOfVoxels) {
+  EvidenceGrid grid(EvidenceGridOptions{});
+  grid.TraceRay(Eigen::Vector3d(0.05, 0.03, 0.01), Eigen::Vector3d(2.13, 1.57, -0.91), true);
+  const EvidenceGridData data = grid.ToData();
+  // From voxel (0,0,0) to (11,8,-5): 11 + 8 + 5 steps, each into a face neighbour.
+  EXPECT_EQ(data.voxels.size(), 25u);
+  EXPECT_EQ(At(data, 11, 8, -5)->hits, 1);
+}
+
+TEST(EvidenceGrid, MemoryBoundDropsNewVoxelsAndCountsThem) {
+  EvidenceGridOptions options;
+  options.max_voxels = 3;
+  EvidenceGrid grid(options);
+  grid.TraceRay(Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 0.0, 0.0), true);
+  EXPECT_EQ(grid.voxel_count(), 3u);
+  EXPECT_EQ(grid.dropped_updates(), 8);
+}
+
+// Depth of a flat wall at x = 10 seen by a camera at the origin looking along +x.
+cv::Mat WallDepth(const CameraIntrinsics& camera, double distance) {
+  cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(distance));
+  return depth;
+}
+
+
+TEST(EvidenceGrid, DepthImageRaysEndOnTheWall) {
+  EvidenceGridOptions options;
+  options.rays_per_row = 16;
+  EvidenceGrid grid(options);
+  grid.Integrate(WallDepth(kCamera, 10.0), kCamera, LookingAlongX(Eigen::Vector3d(0, 0, 2)));
+  const EvidenceGridData data = grid.ToData();
+  int wall_hits = 0, other_hits = 0, behind = 0, halfway_passes = 0;
+  for (const VoxelEvidence& v : data.voxels) {
+    (v.x == 50 ? wall_hits : other_hits) += v.hits;
+    behind += v.x > 50;
+    if (v.x == 25) halfway_passes += v.passes;
+  }
+  EXPECT_EQ(wall_hits, 16 * 12);  // every sampled pixel (16 rays a row: every 4th of 64 x 48) ends in the wall
+  EXPECT_EQ(other_hits, 0);
+  EXPECT_EQ(behind, 0);
+  EXPECT_GE(halfway_passes, 16 * 12);
+}
+
+EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& cells) {
+  EvidenceGridData grid;
+  grid.voxel_size = 0.2;
+  for (const auto& [v, counts] : cells) {
+    grid.voxels.push_back(
+        {v.x(), v.y(), v.z(), static_cast<std::uint16_t>(counts.first), static_cast<std::uint16_t>(counts.second)});
+  }
+  std::sort(grid.voxels.begin(), grid.voxels.end(), [](const VoxelEvidence& a, const VoxelEvidence& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  return grid;
+}
+
+TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  for (int x = 0; x < 4; ++x) {
+    for (int y = 0; y < 4; ++y) {
+      for (int z = 1; z < 4; ++z) {
+        before.push_back({{x, y, z}, {0, 10}});  // free before
+        after.push_back({{x, y, z}, {8, 1}});    // occupied after: a new box
+      }
+    }
+  }
+  for (int y = 0; y < 10; ++y) {  // a wall, occupied in both
+    before.push_back({{20, y, 1}, {9, 0}});
+    after.push_back({{20, y, 1}, {7, 1}});
+  }
+  before.push_back({{40, 0, 1}, {0, 2}});  // seen too rarely in one patrol: unobserved
+  after.push_back({{40, 0, 1}, {5, 0}});
+  after.push_back({{50, 0, 1}, {5, 0}});   // never seen before: unobserved
+  before.push_back({{60, 0, 1}, {0, 9}});  // an outlier voxel, below the region size
+  after.push_back({{60, 0, 1}, {9, 0}});
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_EQ(change.regions[0].voxels, 48);
+  EXPECT_EQ(change.regions[0].appeared, 48);
+  EXPECT_EQ(change.regions[0].vanished, 0);
+  EXPECT_NEAR(change.regions[0].centroid.x(), 0.3, 1e-9);
+  EXPECT_NEAR(change.regions[0].centroid.z(), 0.4, 1e-9);
+  EXPECT_EQ(change.changed_voxels.size(), 48u);
+  EXPECT_EQ(change.compared_voxels, 48 + 10 + 1);
+}
+
+TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  const auto removed_box = [&](int x0, int length) {
+    for (int x = x0; x < x0 + length; ++x) {
+      for (int z = 1; z < 3; ++z) {
+        before.push_back({{x, 0, z}, {6, 0}});
+        after.push_back({{x, 0, z}, {0, 6}});
+      }
+    }
+  };
+  removed_box(0, 6);    // 12 voxels
+  removed_box(50, 20);  // a 4 m long object: clustering by centroid distance splits it, the cleanup joins it
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  ASSERT_EQ(change.regions.size(), 2u);
+  EXPECT_EQ(change.regions[0].voxels, 40);
+  EXPECT_EQ(change.regions[0].vanished, 40);
+  EXPECT_EQ(change.regions[1].voxels, 12);
+}
+
+TEST(GeometryChange, DifferentVoxelSizesCannotBeCompared) {
+  EvidenceGridData a, b;
+  a.voxel_size = 0.2, b.voxel_size = 0.25;
+  GeometryChange change;
+  EXPECT_FALSE(DiffGrids(a, b, GeometryDiffOptions{}, &change));
+  EXPECT_FALSE(DiffGrids(EvidenceGridData{}, EvidenceGridData{}, GeometryDiffOptions{}, &change));
+}
+
+}  // namespace
+}  // namespace patrolmap::change

@@ -1,0 +1,56 @@
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "patrolmap/core/checksum.h"
+
+#include "graph/fixtures.h"
+#include "patrolmap/graph/export.h"
+#include "patrolmap/graph/layout.h"
+#include "patrolmap/graph/map_file.h"
+#include "patrolmap/graph/topo_map.h"
+#include "recompute_checksums.h"
+#include "sample_map.h"
+#include "test_util.h"
+
+namespace patrolmap::graph {
+namespace {
+
+using testing::TwoFlights;
+
+TEST(TopoMap, QueriesUsersNeed) {
+  const TopoMap map = TwoFlights();
+  EXPECT_EQ(map.node_count(), 7);
+  EXPECT_EQ(map.edge_count(), 8);  // 3 + 2 traversals, 3 loop closures
+  EXPECT_EQ(map.loop_closure_count(), 3);
+  EXPECT_EQ(map.Neighbours(1), (std::vector<int>{0, 2, 4, 5}));
+  EXPECT_EQ(map.NodesOfPlace(4), (std::vector<int>{1, 4, 5}));
+  EXPECT_EQ(map.NodesOfPlace(0), (std::vector<int>{0}));
+  EXPECT_EQ(map.Path(0, 6), (std::vector<int>{0, 1, 5, 6}));  // over the loop closure 1~5: 3 edges, not 4
+  EXPECT_EQ(map.Path(2, 2), (std::vector<int>{2}));
+  EXPECT_EQ(map.Flights(), (std::vector<std::string>{"a", "b"}));
+  TopoMap split;
+  split.AddNode({});
+  split.AddNode({});
+  EXPECT_TRUE(split.Path(0, 1).empty());
+}
+
+TEST(TopoMapDeathTest, LoopClosureOntoItselfAborts) {
+  TopoMap map = TwoFlights();
+  EXPECT_DEATH(map.AddEdge(2, 2, {EdgeKind::kLoopClosure, 0, 0, 0}), "check failed");
+}
+
+}  // namespace
+}  // namespace patrolmap::graph

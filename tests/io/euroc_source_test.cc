@@ -1,0 +1,286 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "io/fixtures.h"
+#include "log_capture.h"
+#include "patrolmap/core/csv.h"
+#include "patrolmap/io/natural_sort.h"
+#include "patrolmap/io/patrol_sensors.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/io/yaml_file.h"
+#include "test_util.h"
+
+namespace patrolmap::io {
+namespace {
+
+using testing::TempDir;
+using testing::WriteText;
+using testing_fixtures::MakeEurocLog;
+using testing_fixtures::ReadAll;
+
+TEST(Euroc, ReadsFramesImuAndSensorYaml) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 4);
+  // EuRoC's own sensor.yaml starts with an OpenCV directive that is not YAML.
+  WriteText(log + "/cam0/sensor.yaml",
+            "%YAML:1.0\nT_BS:\n  cols: 4\n  rows: 4\n  data: [0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"
+            "rate_hz: 20\nresolution: [32, 24]\nintrinsics: [30.0, 31.0, 15.5, 11.5]\n");
+  WriteText(log + "/imu0/data.csv",
+            "#timestamp,wx,wy,wz,ax,ay,az\n"
+            "1000000000,0,0,0.1,0,0,9.8\n1020000000,0,0,0.2,0,0,9.8\n1050000000,0,0,0.3,0,0,9.8\n"
+            "1070000000,0,0,0.4,0,0,9.8\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  const LogInfo& info = source->info();
+  EXPECT_EQ(info.kind, "euroc");
+  EXPECT_EQ(info.frame_count, 4);
+  ASSERT_TRUE(info.camera.has_value());
+  EXPECT_DOUBLE_EQ(info.camera->fy, 31.0);
+  ASSERT_TRUE(info.camera_from_imu.has_value());
+  EXPECT_NEAR((*info.camera_from_imu)(0, 1), 1.0, 1e-12);  // transpose of T_BS's rotation
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 4u);
+  EXPECT_EQ(frames[0].imu.size(), 1u);  // t <= 1.00 s
+  EXPECT_EQ(frames[1].imu.size(), 2u);  // 1.00 s < t <= 1.05 s
+  EXPECT_EQ(frames[2].imu.size(), 1u);
+  EXPECT_EQ(frames[3].imu.size(), 0u);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 30);
+}
+
+TEST(Euroc, AcceptsTheMav0Folder) {
+  TempDir dir;
+  MakeEurocLog(dir / "flight/mav0", 2);
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(dir / "flight", {}, &source).ok());
+  EXPECT_EQ(source->info().frame_count, 2);
+}
+
+// Writes a 3-frame log, replaces `file` (relative to the log) with `text`, and returns what opening says.
+Status OpenWithFile(const TempDir& dir, const std::string& file, const std::string& text) {
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/" + file, text);
+  std::unique_ptr<FrameSource> source;
+  return OpenLog(log, {}, &source);
+}
+
+TEST(Euroc, MalformedLineNamesFileAndLine) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "#timestamp [ns],filename\n1000,a.png\n2000x,b.png\n");
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find("cam0/data.csv:3: column 'timestamp [ns]': not an integer: '2000x'"),
+            std::string::npos)
+      << status.message();
+}
+
+TEST(Euroc, MissingColumnIsAnError) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "1000\n");
+  EXPECT_NE(status.message().find("data.csv:1: expected at least 2 columns"), std::string::npos) << status.message();
+}
+
+TEST(Euroc, NonMonotonicTimestampsAreRejected) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n3000,b.png\n2000,c.png\n");
+  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (3000)"), std::string::npos)
+      << status.message();
+}
+
+// Two frames at one time cannot both be frames of one camera: refused, naming the line (camera tables are
+// strict; other sensor tables may repeat a time).
+TEST(Euroc, EqualCameraTimestampsAreRejected) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n2000,b.png\n2000,c.png\n");
+  EXPECT_NE(status.message().find("data.csv:3: timestamp 2000 is not after the previous one (2000)"), std::string::npos)
+      << status.message();
+}
+
+// Times beyond 2^62 ns (146 years) or before the epoch would overflow the differences taken of them.
+TEST(Euroc, TimestampsOutsideTheValidRangeAreRejected) {
+  TempDir dir;
+  Status status = OpenWithFile(dir, "cam0/data.csv", "1000,a.png\n9223372036854775807,b.png\n");
+  EXPECT_NE(status.message().find("data.csv:2: timestamp 9223372036854775807 is outside 0..4611686018427387904 ns"),
+            std::string::npos)
+      << status.message();
+  TempDir negative;
+  status = OpenWithFile(negative, "cam0/data.csv", "-5,a.png\n1000,b.png\n");
+  EXPECT_NE(status.message().find("data.csv:1: timestamp -5 is outside"), std::string::npos) << status.message();
+}
+
+// A table names files inside its log's data folder; a name that climbs out of it (or is absolute) is
+// refused, naming the line, so a log cannot make patrolmap read files elsewhere.
+TEST(Euroc, FileNamesOutsideTheDataFolderAreRejected) {
+  for (const char* name : {"../../../etc/passwd", "/etc/passwd", "a/../../b.png"}) {
+    TempDir dir;
+    const Status status = OpenWithFile(dir, "cam0/data.csv", std::string("1000,a.png\n2000,") + name + "\n");
+    EXPECT_NE(status.message().find("data.csv:2: file name '" + std::string(name) + "' leaves the log's data folder"),
+              std::string::npos)
+        << status.message();
+  }
+  TempDir inside;
+  EXPECT_TRUE(OpenWithFile(inside, "cam0/data.csv", "1000,a.png\n2000,sub/../b.png\n").ok());
+}
+
+TEST(Euroc, EmptyCameraTableIsAnError) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "cam0/data.csv", "#timestamp [ns],filename\n");
+  EXPECT_NE(status.message().find("cam0/data.csv: no frames listed"), std::string::npos) << status.message();
+}
+
+TEST(Euroc, MalformedImuLineIsAnError) {
+  TempDir dir;
+  const Status status = OpenWithFile(dir, "imu0/data.csv", "1000,0,0,0,0,0,9.8\n2000,0,0,zero,0,0,9.8\n");
+  EXPECT_NE(status.message().find("imu0/data.csv:2: column 'w_RS_S [rad s^-1]': not a number: 'zero'"),
+            std::string::npos)
+      << status.message();
+}
+
+TEST(Euroc, UnreadableImageInTheMiddleIsCountedAndSkipped) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 5);
+  WriteText(log + "/cam0/data/1100000000.png", "truncated png");  // frame 2 corrupt
+  std::filesystem::remove(log + "/cam0/data/1150000000.png");     // frame 3 missing
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  EXPECT_TRUE(end.end_of_stream());
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(frames[2].index, 4);
+  EXPECT_EQ(frames[2].image.at<uchar>(0, 0), 50);
+  ASSERT_EQ(source->skipped().size(), 2u);
+  EXPECT_EQ(source->skipped()[0].index, 2);
+  EXPECT_NE(source->skipped()[0].reason.find("1100000000.png"), std::string::npos);
+}
+
+TEST(Euroc, SkippingDecodeReturnsEmptyImagesButKeepsOrder) {
+  TempDir dir;
+  MakeEurocLog(dir / "flight", 3);
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(dir / "flight", {}, &source).ok());
+  Frame frame;
+  ASSERT_TRUE(source->Next(false, &frame).ok());
+  EXPECT_TRUE(frame.image.empty());
+  ASSERT_TRUE(source->Next(true, &frame).ok());
+  EXPECT_EQ(frame.index, 1);
+  EXPECT_EQ(frame.image.at<uchar>(0, 0), 20);
+}
+
+TEST(Euroc, SensorYamlOfTheWrongShapeIsRefusedNotThrown) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  std::unique_ptr<FrameSource> source;
+  for (const char* yaml : {"5\n", "- 1\n- 2\n", "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS: 5\n",
+                           "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS:\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, "
+                           "0, 0, 1, 0, 0, 0, 0, 1]\n"}) {
+    WriteText(log + "/cam0/sensor.yaml", yaml);
+    const Status status = OpenLog(log, {}, &source);
+    EXPECT_EQ(status.code(), StatusCode::kDataLoss) << yaml;
+    EXPECT_NE(status.message().find("sensor.yaml"), std::string::npos) << status.message();
+  }
+  std::filesystem::remove(log + "/cam0/sensor.yaml");
+  WriteText(log + "/meta.yaml", "just a scalar\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: expected a map"), std::string::npos);
+}
+
+TEST(Euroc, NonFiniteNumbersInTablesAreRefused) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 2);
+  WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az\n1000000000,0,0,nan,0,0,9.8\n");
+  std::unique_ptr<FrameSource> source;
+  Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("imu0/data.csv:2:"), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find("not a finite number"), std::string::npos) << status.message();
+  std::filesystem::remove(log + "/imu0/data.csv");
+  WriteText(log + "/gps0/data.csv", "#t,lat,lon,alt\n1000000000,1000,8,400\n");
+  status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("gps0/data.csv:2: latitude must lie in [-90, 90]"), std::string::npos)
+      << status.message();
+}
+
+TEST(FlightId, CharactersThatBreakTablesAreReplaced) {
+  EXPECT_EQ(CleanFlightId("x,y\nz\"w"), "x_y_z_w");
+  EXPECT_EQ(CleanFlightId(""), "flight");
+  EXPECT_EQ(CleanFlightId("x</script>"), "x</script>");  // HTML writers escape it
+  EXPECT_EQ(CleanFlightId(std::string(500, 'a')).size(), kMaxFlightIdLength);
+}
+
+TEST(Euroc, BadSensorYamlNamesTheFile) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 1);
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3]\nresolution: [32, 24]\n");
+  std::unique_ptr<FrameSource> source;
+  Status status = OpenLog(log, {}, &source);
+  EXPECT_NE(status.message().find("sensor.yaml: 'intrinsics' must have 4 numbers"), std::string::npos)
+      << status.message();
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3\n");
+  status = OpenLog(log, {}, &source);
+  EXPECT_EQ(status.code(), StatusCode::kDataLoss);
+  EXPECT_NE(status.message().find("sensor.yaml:"), std::string::npos) << status.message();
+  WriteText(log + "/cam0/sensor.yaml", "intrinsics: [1, 2, 3, 4]\nresolution: [32, 24]\nrate_hz: .nan\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("sensor.yaml: 'rate_hz' must be a frame rate above 0"),
+            std::string::npos);
+  std::filesystem::remove(log + "/cam0/sensor.yaml");
+  for (const char* meta : {"frame_rate_hz: -5\n", "frame_rate_hz: [30]\n"}) {
+    WriteText(log + "/meta.yaml", meta);
+    EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: 'frame_rate_hz' must be a frame rate above 0"),
+              std::string::npos)
+        << meta;
+  }
+  WriteText(log + "/meta.yaml", "flight_id: {a: 1}\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("meta.yaml: 'flight_id' must be text"), std::string::npos);
+}
+
+TEST(Euroc, SpeedIsInterpolatedFromTheStateTable) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/state_groundtruth_estimate0/data.csv",
+            "1000000000,0,0,0,1,0,0,0,3,4,0\n1100000000,0,0,0,1,0,0,0,0,1,0\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_TRUE(frames[1].speed_mps.has_value());
+  EXPECT_DOUBLE_EQ(*frames[0].speed_mps, 5.0);
+  EXPECT_DOUBLE_EQ(*frames[1].speed_mps, 3.0);  // halfway between 5 and 1
+  EXPECT_DOUBLE_EQ(*frames[2].speed_mps, 1.0);
+}
+
+TEST(Euroc, GpsIsInterpolatedAtFrameTimes) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  WriteText(log + "/gps0/data.csv", "#t,lat,lon,alt\n1000000000,47.0,8.0,500\n1100000000,47.0002,8.0004,510\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_TRUE(frames[1].gps.has_value());
+  EXPECT_NEAR(frames[1].gps->x(), 47.0001, 1e-12);
+  EXPECT_NEAR(frames[1].gps->y(), 8.0002, 1e-12);
+  EXPECT_NEAR(frames[1].gps->z(), 505.0, 1e-9);
+  WriteText(log + "/gps0/data.csv", "1000000000,47.0,8.0\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("gps0/data.csv:1: expected at least 4 columns"),
+            std::string::npos);
+}
+
+TEST(Euroc, RealSensorYamlFromSharedData) {
+  const std::string path = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/sensorLeft.yaml";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data not present";
+  YAML::Node root;
+  ASSERT_TRUE(LoadYamlFile(path, &root).ok());
+  EXPECT_DOUBLE_EQ(root["intrinsics"][0].as<double>(), 458.654);
+}
+
+}  // namespace
+}  // namespace patrolmap::io
