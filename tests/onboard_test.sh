@@ -15,7 +15,7 @@ output=$("$onboard" "$sample" --fast --vocabulary "$vocabulary" --out "$work/fas
 check "fast replay runs" grep -qE "421 frames .* 3 key frames \(0 lost from the ring\), 3 nodes" <<<"$output"
 check "same nodes as patrolmap map" cmp -s "$work/offline/nodes.csv" "$work/fast/nodes.csv"
 check "same key locations" cmp -s "$work/offline/key_locations.csv" "$work/fast/key_locations.csv"
-"$onboard" "$sample" --fast --inline-places --vocabulary "$vocabulary" --out "$work/inline" >/dev/null 2>&1
+"$onboard" "$sample" --fast --inline --vocabulary "$vocabulary" --out "$work/inline" >/dev/null 2>&1
 check "inline places: the same map file" cmp -s "$work/fast/map.pmap" "$work/inline/map.pmap"
 check "the map loads" grep -qE "1 flights, 3 nodes" <<<"$("$bin" info "$work/fast/map.pmap" 2>&1)"
 

@@ -354,8 +354,8 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 
 #include "patrolmap/eval/loop_closure_score.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/flight_pass.h"
 #include "patrolmap/pipeline/map.h"
-#include "patrolmap/pipeline/onboard.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -391,6 +391,18 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
   ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, vocabulary).ok());
 }
 
+// Maps `log` through the per-frame pass into `result` (after the nodes it holds).
+FlightRun MapThroughPass(const std::filesystem::path& log, const Config& config, const FlightPassOptions& options,
+                         place::PlaceRecognizer* recognizer, MapResult* result) {
+  std::unique_ptr<io::FrameSource> source;
+  FlightRun run;
+  EXPECT_TRUE(io::OpenLog(log, config.input, &source).ok());
+  io::PatrolSensors sensors;
+  EXPECT_TRUE(ReadFlightSensors(source->info(), &sensors).ok());
+  EXPECT_TRUE(RunFlight(source.get(), config, std::move(sensors), options, {}, recognizer, result, nullptr, &run).ok());
+  return run;
+}
+
 // Every processed frame (every 5th) of both flights is a node. Mapped together, and as a patrol against flight 1's
 // saved map: the results must agree exactly. Loop closures of the second flight against the first are scored against
 // the simulator's places.
@@ -402,11 +414,9 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   ASSERT_NO_FATAL_FAILURE(TwoStreetFlights(dir.path(), config, &vocabulary));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   MapResult result;
-  KeyFrameSelection every;  // every processed frame: every 5th of the 30 fps logs
-  for (std::int64_t frame = 0; frame < 1000; frame += 5) every.frames.push_back(frame);
-  for (const char* flight : {"street-1", "street-2"}) {
-    ASSERT_TRUE(RecognisePlaces(dir / flight, config, every, &recognizer, &result).ok());
-  }
+  FlightPassOptions every;  // every processed frame: every 5th of the 30 fps logs
+  every.node_every = 5;
+  for (const char* flight : {"street-1", "street-2"}) MapThroughPass(dir / flight, config, every, &recognizer, &result);
   const graph::TopoMap map = BuildTopoMap(result, recognizer);
   EXPECT_EQ(map.node_count(), 68);
   EXPECT_EQ(map.loop_closure_count(), static_cast<int>(result.loop_closures.size()));
@@ -431,14 +441,14 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   // file alone gives the same nodes and loop closures.
   MapResult first_only;
   place::PlaceRecognizer first_recognizer(&vocabulary, config.place);
-  ASSERT_TRUE(RecognisePlaces(dir / "street-1", config, every, &first_recognizer, &first_only).ok());
+  MapThroughPass(dir / "street-1", config, every, &first_recognizer, &first_only);
   ASSERT_TRUE(graph::SaveMap(BuildTopoMap(first_only, first_recognizer), dir / "first.pmap").ok());
   graph::TopoMap prior;
   ASSERT_TRUE(graph::LoadMap(dir / "first.pmap", &prior).ok());
   place::PlaceRecognizer patrol_recognizer(&vocabulary, config.place);
   ASSERT_TRUE(SeedRecognizer(prior, "first.pmap", vocabulary, &patrol_recognizer).ok());
   MapResult patrol;
-  ASSERT_TRUE(RecognisePlaces(dir / "street-2", config, every, &patrol_recognizer, &patrol).ok());
+  MapThroughPass(dir / "street-2", config, every, &patrol_recognizer, &patrol);
   const graph::TopoMap extended = BuildTopoMap(patrol, patrol_recognizer, &prior);
   EXPECT_EQ(extended.node_count(), map.node_count());
   EXPECT_EQ(extended.loop_closure_count(), map.loop_closure_count());
@@ -450,76 +460,6 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
     EXPECT_EQ(joint[i].data.inliers, patrolled[i].data.inliers);
   }
   EXPECT_EQ(score.false_positives, 0);
-}
-
-// Maps each flight's key locations through the onboard mapper (frames one by one, as live) into `result`.
-void MapOnboard(const std::filesystem::path& log, const Config& config, const OnboardOptions& options,
-                place::PlaceRecognizer* recognizer, MapResult* result, OnboardStats* stats) {
-  std::unique_ptr<io::FrameSource> source;
-  ASSERT_TRUE(io::OpenLog(log, config.input, &source).ok());
-  OnboardMapper mapper(config, source->info(), recognizer, options);
-  Frame frame;
-  while (source->Next(mapper.NeedsImage(), &frame).ok()) ASSERT_TRUE(mapper.AddFrame(frame).ok());
-  ASSERT_TRUE(mapper.Finish(result).ok());
-  *stats = mapper.stats();
-}
-
-// The onboard mapper gives the map `patrolmap map` gives (key locations from the whole log, then the place
-// stage), whether place recognition runs on its worker thread or inline.
-TEST(OnboardEndToEnd, SameMapAsOfflineOnAWorkerOrInline) {
-  testing::TempDir dir;
-  Config config;
-  vocab::Vocabulary vocabulary;
-  ASSERT_NO_FATAL_FAILURE(TwoStreetFlights(dir.path(), config, &vocabulary));
-  place::PlaceRecognizer offline_recognizer(&vocabulary, config.place);
-  MapResult offline;
-  for (const char* flight : {"street-1", "street-2"}) {
-    std::unique_ptr<io::FrameSource> source;
-    ASSERT_TRUE(io::OpenLog(dir / flight, config.input, &source).ok());
-    DetectionResult detection;
-    ASSERT_TRUE(RunDetection(source.get(), config.flow, &detection).ok());
-    KeyFrameSelection selection;
-    for (const KeyLocation& k : detection.key_locations) selection.frames.push_back(k.frame_index);
-    ASSERT_TRUE(RecognisePlaces(dir / flight, config, selection, &offline_recognizer, &offline).ok());
-  }
-  ASSERT_GE(offline.nodes.size(), 4u);
-  for (const bool worker : {true, false}) {
-    OnboardOptions options;
-    options.place_worker = worker;
-    options.queue_capacity = 1;
-    place::PlaceRecognizer recognizer(&vocabulary, config.place);
-    MapResult onboard;
-    OnboardStats stats;
-    for (const char* flight : {"street-1", "street-2"}) {
-      ASSERT_NO_FATAL_FAILURE(MapOnboard(dir / flight, config, options, &recognizer, &onboard, &stats));
-      EXPECT_EQ(stats.lost_key_frames, 0);
-    }
-    ASSERT_EQ(onboard.nodes.size(), offline.nodes.size()) << worker;
-    for (std::size_t i = 0; i < onboard.nodes.size(); ++i) {
-      EXPECT_EQ(onboard.nodes[i].frame_index, offline.nodes[i].frame_index);
-      EXPECT_EQ(onboard.nodes[i].flight, offline.nodes[i].flight);
-      EXPECT_EQ(onboard.nodes[i].features, offline.nodes[i].features);
-      EXPECT_EQ(onboard.nodes[i].heading, offline.nodes[i].heading);
-    }
-    ASSERT_EQ(onboard.loop_closures.size(), offline.loop_closures.size()) << worker;
-    for (std::size_t i = 0; i < onboard.loop_closures.size(); ++i) {
-      EXPECT_EQ(onboard.loop_closures[i].query_node, offline.loop_closures[i].query_node);
-      EXPECT_EQ(onboard.loop_closures[i].matched_node, offline.loop_closures[i].matched_node);
-      EXPECT_EQ(onboard.loop_closures[i].verification.inliers, offline.loop_closures[i].verification.inliers);
-    }
-  }
-  // A ring of one frame cannot hold a frame until its key location is confirmed: those are lost, counted.
-  OnboardOptions tiny;
-  tiny.ring_s = 0.1;  // under one processed frame: the ring holds 1
-  place::PlaceRecognizer recognizer(&vocabulary, config.place);
-  MapResult result;
-  OnboardStats stats;
-  ASSERT_NO_FATAL_FAILURE(MapOnboard(dir / "street-1", config, tiny, &recognizer, &result, &stats));
-  EXPECT_GT(stats.lost_key_frames, 0);
-  EXPECT_EQ(result.nodes.size(), static_cast<std::size_t>(stats.key_frames));  // every key frame handed on is a node
-  const auto first_flight = std::count_if(offline.nodes.begin(), offline.nodes.end(),
-                                          [](const MapNode& n) { return n.flight == "street-1"; });
-  EXPECT_EQ(static_cast<long>(result.nodes.size()) + stats.lost_key_frames, first_flight);
 }
 
 }  // namespace

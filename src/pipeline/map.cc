@@ -16,10 +16,6 @@
 namespace patrolmap::pipeline {
 namespace {
 
-bool Selected(const KeyFrameSelection& selection, std::int64_t frame) {
-  return selection.every_frame || std::binary_search(selection.frames.begin(), selection.frames.end(), frame);
-}
-
 cv::Mat Thumbnail(const cv::Mat& image) {
   cv::Mat thumbnail;
   const double scale = static_cast<double>(kThumbnailWidth) / image.cols;
@@ -66,41 +62,6 @@ Status PlaceStage::Add(const KeyFrameInput& input) {
   const auto matched = frame_of_.find(place.match->node);
   result_->loop_closures.push_back({place.node, place.match->node, key_frame.frame_index,
                                     matched == frame_of_.end() ? -1 : matched->second, *place.match});
-  return Status::Ok();
-}
-
-Status RecognisePlaces(const std::string& log, const Config& config, const KeyFrameSelection& selection,
-                       place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress) {
-  std::unique_ptr<io::FrameSource> source;
-  PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
-  const double scale = config.flow.frames.scale;
-  PlaceStage places(recognizer, result);
-  Frame frame;
-  Status status;
-  std::int64_t next = 0;
-  KeyFrameInput input;
-  input.key_frame.flight = source->info().flight_id;
-  input.key_frame.timed = source->info().timed;
-  YawIntegrator yaw;
-  std::size_t described = 0;
-  while ((status = source->Next(Selected(selection, next), &frame)).ok()) {
-    next = frame.index + 1;
-    yaw.Add(frame.imu);
-    if (frame.image.empty() || !Selected(selection, frame.index)) continue;
-    ++described;
-    if (scale < 1.0)
-      cv::resize(frame.image, input.key_frame.image, cv::Size(), scale, scale, cv::INTER_AREA);
-    else
-      input.key_frame.image = frame.image;
-    input.key_frame.timestamp_ns = frame.timestamp_ns;
-    input.key_frame.frame_index = frame.index;
-    input.heading = yaw.yaw();
-    input.gps = frame.gps;
-    PATROLMAP_RETURN_IF_ERROR(places.Add(input));
-    if (progress) progress(frame.index, source->info().frame_count);
-  }
-  if (!status.end_of_stream()) return status;
-  if (selection.every_frame && described == 0) return Status::DataLoss(log + ": no frame could be read");
   return Status::Ok();
 }
 

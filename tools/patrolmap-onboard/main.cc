@@ -18,8 +18,10 @@
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
+#include "patrolmap/pipeline/change.h"
+#include "patrolmap/pipeline/change_events.h"
 #include "patrolmap/pipeline/detect.h"
-#include "patrolmap/pipeline/onboard.h"
+#include "patrolmap/pipeline/flight_pass.h"
 
 namespace patrolmap::onboard {
 namespace {
@@ -39,7 +41,8 @@ struct Arguments {
   double fps = 0.0;
   bool fast = false;
   double max_seconds = 0.0;
-  pipeline::OnboardOptions options;
+  pipeline::FlightPassOptions options;
+  pipeline::ChangeEventOptions events;
 };
 
 Status OpenSource(const Arguments& arguments, const pipeline::Config& config,
@@ -53,66 +56,54 @@ Status OpenSource(const Arguments& arguments, const pipeline::Config& config,
   }
 }
 
-// How the stream went: wall time and how far behind the log's clock the frame thread fell.
-struct Pace {
-  double seconds = 0.0;
-  double max_lag_seconds = 0.0;
-  bool interrupted = false;
-};
-
-// Feeds the stream to the mapper until it ends, --max-seconds of it have passed or a stop is requested;
-// a log is replayed at its own rate unless --fast.
-Status Stream(const Arguments& arguments, io::FrameSource* source, pipeline::OnboardMapper* mapper, Pace* pace) {
-  const bool paced = !arguments.fast && source->info().kind != "camera";
-  const Clock::time_point start = Clock::now();
-  Clock::time_point last_report = start;
-  Frame frame;
-  Status status;
-  std::optional<TimestampNs> first_ns;
-  while (!stop_requested.load() && (status = source->Next(mapper->NeedsImage(), &frame)).ok()) {
-    if (!first_ns) first_ns = frame.timestamp_ns;
-    const double flight_s = NsToSeconds(frame.timestamp_ns - *first_ns);
-    if (arguments.max_seconds > 0.0 && flight_s > arguments.max_seconds) break;
-    const Clock::time_point due =
-        start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(flight_s));
-    if (paced) std::this_thread::sleep_until(due);
-    PATROLMAP_RETURN_IF_ERROR(mapper->AddFrame(frame));
-    if (paced)
-      pace->max_lag_seconds =
-          std::max(pace->max_lag_seconds, std::chrono::duration<double>(Clock::now() - due).count());
-    if (Clock::now() - last_report > std::chrono::seconds(5)) {
-      last_report = Clock::now();
-      spdlog::info("{:.0f} s of flight, {} frames, {} key frames", flight_s, mapper->stats().frames,
-                   mapper->stats().key_frames);
-    }
-  }
-  pace->interrupted = stop_requested.load();
-  pace->seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  return status.ok() || status.end_of_stream() ? Status::Ok() : status;
-}
-
-void PrintSummary(const Arguments& arguments, const pipeline::OnboardStats& s, const pipeline::MapResult& result,
-                  const Pace& pace) {
+void PrintSummary(const Arguments& arguments, const pipeline::FlightRun& run, const pipeline::MapResult& result) {
+  const pipeline::FlightPassStats& s = run.result.stats;
+  const pipeline::DriveResult& pace = run.drive;
   std::printf(
       "%s%lld frames in %.1f s (%.1f frames/s), %lld processed: flow %.2f ms per processed frame (slowest "
-      "%.1f ms); %d key frames (%d lost from the ring), %zu nodes, %zu loop closures; place queue at most "
-      "%d deep, frame thread waited %.2f s for it, fell at most %.3f s behind the log's clock; outputs in %s\n",
+      "%.1f ms); %d key frames (%d lost from the ring), %zu nodes, %zu loop closures; place queue at most %d "
+      "deep, change queue %d, frame thread waited %.2f s for them, fell at most %.3f s behind the log's clock; "
+      "outputs in %s\n",
       pace.interrupted ? "interrupted: " : "", static_cast<long long>(s.frames), pace.seconds,
       pace.seconds > 0 ? s.frames / pace.seconds : 0.0, static_cast<long long>(s.processed),
       s.processed ? 1e3 * s.flow_seconds / s.processed : 0.0, 1e3 * s.max_flow_seconds, s.key_frames, s.lost_key_frames,
-      result.nodes.size(), result.loop_closures.size(), s.max_queue, s.waited_seconds, pace.max_lag_seconds,
-      arguments.out.c_str());
+      result.nodes.size(), result.loop_closures.size(), s.place_queue.max_depth, s.change_queue.max_depth,
+      s.place_queue.waited_seconds + s.change_queue.waited_seconds, pace.max_lag_seconds, arguments.out.c_str());
 }
 
-// The patrol record of a flight mapped onboard: no objects or evidence grid (they need the whole log), but
-// the camera and the width its key-frame features were found at, which a later `patrolmap patrol` or `diff`
-// needs to compare the flight's key frames.
-PatrolRecord AppearanceRecord(const io::LogInfo& info, const pipeline::MapResult& result) {
-  PatrolRecord record;
-  record.flight = info.flight_id;
-  if (info.camera) record.camera = *info.camera;
-  record.feature_image_width = pipeline::FeatureWidth(result, info.flight_id);
-  return record;
+// Opens DIR/events.jsonl when there is a prior flight to compare with.
+Status OpenMonitor(const Arguments& arguments, const graph::TopoMap& prior, const pipeline::Config& config,
+                   const io::PatrolSensors& sensors, std::unique_ptr<pipeline::ChangeMonitor>* monitor) {
+  const std::vector<std::string> flights = prior.Flights();
+  if (flights.empty()) return Status::Ok();
+  return pipeline::ChangeMonitor::Open(&prior, flights.back(), config, arguments.events, sensors.poses,
+                                       arguments.out + "/events.jsonl", monitor);
+}
+
+// The flight's map, its change report against the prior's last flight, and the final events.
+Status WriteOutputs(const Arguments& arguments, const pipeline::Config& config, const graph::TopoMap& prior,
+                    const pipeline::MapResult& result, const place::PlaceRecognizer& recognizer,
+                    const graph::TopoMap::VocabularyTag& tag, pipeline::FlightRun* run,
+                    pipeline::ChangeMonitor* monitor) {
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(arguments.out + "/key_locations.csv",
+                                                pipeline::KeyLocationsCsv(run->result.detection.key_locations)));
+  graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
+  map.set_vocabulary(tag);
+  if (!result.nodes.empty()) map.SetPatrol(std::move(run->result.record));
+  change::ChangeReport report;
+  bool compared = false;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::ReportLastFlight(prior, map, config.change, arguments.out, &report, &compared));
+  if (monitor != nullptr && compared) PATROLMAP_RETURN_IF_ERROR(monitor->Close(report, map));
+  if (compared) {
+    std::printf(
+        "changes since %s: %d of %zu places, %d new, %d removed, %d moved objects, %zu geometry regions; "
+        "%d events in %s/events.jsonl\n",
+        report.prior_flight.c_str(), report.ChangedPlaces(), report.places.size(),
+        report.ObjectsIn(change::ObjectState::kNew), report.ObjectsIn(change::ObjectState::kRemoved),
+        report.ObjectsIn(change::ObjectState::kMoved), report.geometry.regions.size(),
+        monitor != nullptr ? monitor->events() : 0, arguments.out.c_str());
+  }
+  return pipeline::SaveMapRun(&map, arguments.out);
 }
 
 Status Run(const Arguments& arguments) {
@@ -124,7 +115,7 @@ Status Run(const Arguments& arguments) {
   PATROLMAP_RETURN_IF_ERROR(pipeline::LoadCheckedConfig(arguments.config, &config));
   if (arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   std::string error;
-  if (!arguments.options.IsValid(&error)) return Status::InvalidArgument(error);
+  if (!arguments.options.IsValid(&error) || !arguments.events.IsValid(&error)) return Status::InvalidArgument(error);
   graph::TopoMap prior;
   if (!arguments.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(arguments.out + "/map.pmap", arguments.prior_map, "prior map"));
@@ -136,24 +127,29 @@ Status Run(const Arguments& arguments) {
   PATROLMAP_RETURN_IF_ERROR(pipeline::CheckVocabulary(prior, arguments.prior_map, vocabulary, vocabulary_path));
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(arguments, config, &source));
+  io::PatrolSensors sensors;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::ReadFlightSensors(source->info(), &sensors));
+  PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(arguments.out));
+  std::unique_ptr<pipeline::ChangeMonitor> monitor;
+  PATROLMAP_RETURN_IF_ERROR(OpenMonitor(arguments, prior, config, sensors, &monitor));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   PATROLMAP_RETURN_IF_ERROR(pipeline::SeedRecognizer(prior, arguments.prior_map, vocabulary, &recognizer));
+  pipeline::DriveOptions drive;
+  drive.paced = !arguments.fast && source->info().kind != "camera";
+  drive.max_seconds = arguments.max_seconds;
+  drive.stop = &stop_requested;
+  drive.report = [](const pipeline::FlightPassStats& stats, double flight_s) {
+    spdlog::info("{:.0f} s of flight, {} frames, {} key frames", flight_s, stats.frames, stats.key_frames);
+  };
   pipeline::MapResult result;
-  Pace pace;
-  {
-    pipeline::OnboardMapper mapper(config, source->info(), &recognizer, arguments.options);
-    PATROLMAP_RETURN_IF_ERROR(Stream(arguments, source.get(), &mapper, &pace));
-    if (pace.interrupted) spdlog::info("stop requested: writing the map");
-    PATROLMAP_RETURN_IF_ERROR(mapper.Finish(&result));
-    PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(arguments.out));
-    PATROLMAP_RETURN_IF_ERROR(
-        WriteFileAtomically(arguments.out + "/key_locations.csv", pipeline::KeyLocationsCsv(mapper.key_locations())));
-    graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
-    map.set_vocabulary(pipeline::TagOf(vocabulary, vocabulary_path));
-    if (!result.nodes.empty()) map.SetPatrol(AppearanceRecord(source->info(), result));
-    PATROLMAP_RETURN_IF_ERROR(pipeline::SaveMapRun(&map, arguments.out));
-    PrintSummary(arguments, mapper.stats(), result, pace);
-  }
+  pipeline::FlightRun run;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::RunFlight(source.get(), config, std::move(sensors), arguments.options, drive,
+                                                &recognizer, &result, monitor.get(), &run));
+  if (run.drive.interrupted) spdlog::info("stop requested: writing the map");
+  for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
+  PATROLMAP_RETURN_IF_ERROR(WriteOutputs(arguments, config, prior, result, recognizer,
+                                         pipeline::TagOf(vocabulary, vocabulary_path), &run, monitor.get()));
+  PrintSummary(arguments, run, result);
   return Status::Ok();
 }
 
@@ -168,7 +164,9 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_option("source", arguments.source, "a flight log (any form patrolmap map reads) or camera:N")->required();
   app.add_option("--map", arguments.prior_map, "map of earlier flights to close loops against (map.pmap)");
-  app.add_option("-o,--out", arguments.out, "output folder: map.pmap, nodes.csv, loop_closures.csv, key_locations.csv")
+  app.add_option("-o,--out", arguments.out,
+                 "output folder: map.pmap, nodes.csv, loop_closures.csv, key_locations.csv; with --map events.jsonl, "
+                 "changes.json, changes.html")
       ->capture_default_str();
   app.add_option("-c,--config", arguments.config, "YAML configuration (see config/default.yaml)");
   app.add_option("--vocabulary", arguments.vocabulary, "vocabulary file (default: the shipped one)");
@@ -178,17 +176,30 @@ int main(int argc, char** argv) {
   app.add_option("--max-seconds", arguments.max_seconds, "stop after this much of the flight [s]; 0: at its end")
       ->check(patrolmap::tools::FiniteRange(0.0));
   app.add_flag(
-      "--inline-places", [&arguments](std::int64_t) { arguments.options.place_worker = false; },
-      "run place recognition on the frame thread (the map is the same)");
-  app.add_option("--queue", arguments.options.queue_capacity, "key frames waiting for place recognition at most")
+      "--inline", [&arguments](std::int64_t) { arguments.options.workers = false; },
+      "run place recognition and the change stage on the frame thread (the map and report are the same)");
+  app.add_option("--queue", arguments.options.queue_capacity,
+                 "inputs waiting for place recognition, and for the change stage, at most")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_option("--ring-s", arguments.options.ring_s,
                  "seconds of processed frames kept for key locations confirmed late")
       ->capture_default_str()
       ->check(patrolmap::tools::FiniteRange(0.1, 3600.0));
+  app.add_option("--events-interval-s", arguments.events.interval_s,
+                 "with --map: flight time between checks of the object map and the grid for events [s]")
+      ->capture_default_str()
+      ->check(patrolmap::tools::FiniteRange(0.1, 3600.0));
+  app.add_option("--events-settle-s", arguments.events.settle_s,
+                 "with --map: the last views an object check leaves out (their detections may still come) [s]")
+      ->capture_default_str()
+      ->check(patrolmap::tools::FiniteRange(0.0, 3600.0));
   app.add_flag("-q,--quiet", quiet, "only print errors");
-  app.footer("SIGINT or SIGTERM ends the stream; the map is written as if it had ended, and the exit code is 0.");
+  app.footer(
+      "With --map, the flight is compared with the map's last flight as it goes: each change found is appended to "
+      "OUT/events.jsonl as one JSON line, and OUT/changes.json and OUT/changes.html are written at the end, as "
+      "patrolmap patrol writes them. SIGINT or SIGTERM ends the stream; the map and the report are written as if "
+      "it had ended, and the exit code is 0.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

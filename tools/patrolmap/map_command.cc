@@ -10,6 +10,7 @@
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/change.h"
 #include "patrolmap/pipeline/detect.h"
+#include "patrolmap/pipeline/flight_pass.h"
 #include "patrolmap/pipeline/map.h"
 #include "progress.h"
 
@@ -26,35 +27,52 @@ struct MapArguments {
   bool every_frame = false;
 };
 
-// Key frames of `log` from the flow stage; its outputs go to OUT, or to
-// OUT/<flight> when several logs are mapped together.
-Status SelectKeyFrames(const MapArguments& arguments, const std::string& log, const pipeline::Config& config,
-                       pipeline::KeyFrameSelection* selection) {
-  selection->every_frame = arguments.every_frame;
-  selection->frames.clear();
+// What the patrol record of a flight holds, on the log.
+void LogRecord(const pipeline::FlightResult& flight) {
+  const PatrolRecord& record = flight.record;
+  const pipeline::PatrolRecordStats& stats = flight.record_stats;
+  if (record.has_objects) {
+    const auto confirmed =
+        std::count_if(record.objects.begin(), record.objects.end(), [](const MapObject& o) { return o.confirmed; });
+    spdlog::info("{}: {} objects ({} more seen too rarely) from {} detections ({:.3f} ms per association)",
+                 record.flight, confirmed, record.objects.size() - static_cast<std::size_t>(confirmed),
+                 stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
+  }
+  if (record.grid.voxel_size > 0) {
+    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s", record.flight,
+                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds);
+  }
+}
+
+// One flight through the per-frame pass: its nodes and loop closures into `result`, its patrol record into
+// `record`, and its detect outputs to OUT, or to OUT/<flight> when several logs are mapped together.
+Status MapFlight(const MapArguments& arguments, const std::string& log, const pipeline::Config& config,
+                 place::PlaceRecognizer* recognizer, pipeline::MapResult* result, PatrolRecord* record) {
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
-  if (arguments.every_frame) {
-    if (!source->info().timed) {
-      spdlog::warn(
-          "{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} "
-          "before a query are not its candidates",
-          log, config.place.exclude_recent_images);
-    }
-    return Status::Ok();
+  io::PatrolSensors sensors;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::ReadFlightSensors(source->info(), &sensors));
+  if (arguments.every_frame && !source->info().timed) {
+    spdlog::warn(
+        "{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} before a "
+        "query are not its candidates",
+        log, config.place.exclude_recent_images);
   }
-  pipeline::DetectionResult detection;
-  {
-    Progress progress("detect");
-    PATROLMAP_RETURN_IF_ERROR(pipeline::RunDetection(
-        source.get(), config.flow, &detection, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
-  }
-  for (const std::string& warning : pipeline::DetectionWarnings(source->info(), detection, config.flow)) {
-    spdlog::warn("{}", warning);
-  }
-  for (const KeyLocation& node : detection.key_locations) selection->frames.push_back(node.frame_index);
+  pipeline::FlightPassOptions options;
+  options.node_every = arguments.every_frame ? 1 : 0;
+  options.keep_samples = !arguments.every_frame;
+  Progress progress("map");
+  pipeline::DriveOptions drive;
+  drive.progress = [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); };
+  pipeline::FlightRun run;
+  PATROLMAP_RETURN_IF_ERROR(
+      pipeline::RunFlight(source.get(), config, std::move(sensors), options, drive, recognizer, result, nullptr, &run));
+  for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
+  LogRecord(run.result);
+  *record = std::move(run.result.record);
+  if (arguments.every_frame) return Status::Ok();
   const bool several = arguments.logs.size() > 1;
-  return pipeline::WriteDetectionOutputs(detection,
+  return pipeline::WriteDetectionOutputs(run.result.detection,
                                          several ? arguments.out + "/" + source->info().flight_id : arguments.out);
 }
 
@@ -68,50 +86,19 @@ void PrintSummary(const MapArguments& arguments, const pipeline::MapResult& resu
       arguments.out.c_str());
 }
 
-// The patrol record of `log` (object map, evidence grid, views) for change detection.
-Status RecordPatrol(const std::string& log, const pipeline::Config& config, const pipeline::MapResult& result,
-                    graph::TopoMap* map) {
-  PatrolRecord record;
-  pipeline::PatrolRecordStats stats;
-  Progress progress("patrol record");
-  PATROLMAP_RETURN_IF_ERROR(pipeline::BuildPatrolRecord(
-      log, config, &record, &stats, [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); }));
-  record.feature_image_width = pipeline::FeatureWidth(result, record.flight);
-  if (record.has_objects) {
-    const auto confirmed =
-        std::count_if(record.objects.begin(), record.objects.end(), [](const MapObject& o) { return o.confirmed; });
-    spdlog::info("{}: {} objects ({} more seen too rarely) from {} detections ({:.3f} ms per association)",
-                 record.flight, confirmed, record.objects.size() - static_cast<std::size_t>(confirmed),
-                 stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
-  }
-  if (record.grid.voxel_size > 0) {
-    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s", record.flight,
-                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds);
-    if (stats.dropped_voxel_updates > 0) {
-      spdlog::warn("{}: change.grid.max_voxels reached; {} voxel updates dropped", record.flight,
-                   stats.dropped_voxel_updates);
-    }
-  }
-  map->SetPatrol(std::move(record));
-  return Status::Ok();
-}
-
 // The change report between the prior map's last flight and the new one.
 Status ReportChanges(const graph::TopoMap& prior, const graph::TopoMap& map, const pipeline::Config& config,
                      const std::string& out) {
-  const std::vector<std::string> before = prior.Flights(), after = map.Flights();
-  if (before.empty() || after.size() <= before.size()) return Status::Ok();
   change::ChangeReport report;
-  PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, before.back(), after.back(), config.change, &report));
-  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(report, map, out));
-  PrintChangeSummary(report, out);
+  bool compared = false;
+  PATROLMAP_RETURN_IF_ERROR(pipeline::ReportLastFlight(prior, map, config.change, out, &report, &compared));
+  if (compared) PrintChangeSummary(report, out);
   return Status::Ok();
 }
 
 int RunMap(const MapArguments& arguments) {
   pipeline::Config config;
   vocab::Vocabulary vocabulary;
-  pipeline::KeyFrameSelection selection;
   graph::TopoMap prior;
   Status status;
   for (const std::string& log : arguments.logs) {
@@ -132,18 +119,14 @@ int RunMap(const MapArguments& arguments) {
   status = pipeline::SeedRecognizer(prior, arguments.prior_map, vocabulary, &recognizer);
   if (!status.ok()) return Fail(status);
   pipeline::MapResult result;
+  std::vector<PatrolRecord> records(arguments.logs.size());
   for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
-    status = SelectKeyFrames(arguments, arguments.logs[i], config, &selection);
-    Progress progress("places");
-    if (status.ok()) {
-      status = pipeline::RecognisePlaces(arguments.logs[i], config, selection, &recognizer, &result,
-                                         [&progress](std::int64_t d, std::int64_t t) { progress.Update(d, t); });
-    }
+    status = MapFlight(arguments, arguments.logs[i], config, &recognizer, &result, &records[i]);
   }
   graph::TopoMap map = pipeline::BuildTopoMap(result, recognizer, &prior);
   map.set_vocabulary(pipeline::TagOf(vocabulary, vocabulary_path));
-  for (std::size_t i = 0; status.ok() && i < arguments.logs.size(); ++i) {
-    status = RecordPatrol(arguments.logs[i], config, result, &map);
+  for (PatrolRecord& record : records) {
+    if (status.ok()) map.SetPatrol(std::move(record));
   }
   // The change report first: the map file, which may replace an earlier one, is written last, once
   // everything else has succeeded.

@@ -44,14 +44,6 @@ struct MapResult {
   double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
 };
 
-// Which frames become nodes: the detector's key locations, or every processed frame.
-struct KeyFrameSelection {
-  bool every_frame = false;
-  std::vector<std::int64_t> frames;  // ascending, when not every_frame
-};
-
-using MapProgress = std::function<void(std::int64_t, std::int64_t)>;
-
 // Integrates the gyro's yaw rate about the measured up axis (the accelerometer's mean direction), so the IMU
 // may be mounted any way round: the heading a node keeps.
 class YawIntegrator {
@@ -79,17 +71,14 @@ class PlaceStage {
  public:
   PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result);
   Status Add(const KeyFrameInput& input);
+  const MapResult& result() const { return *result_; }
+  const place::PlaceRecognizer& recognizer() const { return *recognizer_; }
 
  private:
   place::PlaceRecognizer* recognizer_;
   MapResult* result_;
   std::map<int, std::int64_t> frame_of_;  // node -> frame index
 };
-
-// Reads `log` again, describes each selected frame at the flow stage's scale
-// and passes it through `recognizer` (which may already hold earlier flights).
-Status RecognisePlaces(const std::string& log, const Config& config, const KeyFrameSelection& selection,
-                       place::PlaceRecognizer* recognizer, MapResult* result, const MapProgress& progress = {});
 
 // The topological map of a mapping run: the nodes with their thumbnails and
 // features, traversal edges between consecutive nodes of a flight, and the

@@ -1,0 +1,81 @@
+// Change events while flying (DESIGN.md, front ends: patrolmap-onboard --map): the flight is compared with
+// the prior map's last flight as it goes, and each change found is appended to DIR/events.jsonl as one JSON
+// line, so a ground station can follow:
+//   appearance   a loop closure onto a prior node whose key frames differ (change/appearance)
+//   object_new, object_removed, object_moved
+//                the object map so far against the prior one (change/object_diff), every interval_s of
+//                flight; views of the last settle_s do not count yet (the detections they bring may still
+//                be coming)
+//   geometry     a changed region of the evidence grid so far (change/evidence_grid), every interval_s
+// Each line carries a stable id, the flight time, the position (the camera's, or the object's or region's)
+// and a confidence. A line is written with one write() to a file opened for appending, so it is there whole
+// or not at all, even when the process is killed. When the flight ends, the changes of the final report that
+// no event announced follow, marked "final": true (the report in changes.json is the reference).
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "patrolmap/change/report.h"
+#include "patrolmap/core/status.h"
+#include "patrolmap/graph/topo_map.h"
+#include "patrolmap/pipeline/config.h"
+#include "patrolmap/pipeline/map.h"
+#include "patrolmap/pipeline/patrol_recorder.h"
+
+namespace patrolmap::pipeline {
+
+struct ChangeEventOptions {
+  double interval_s = 5.0;  // flight time between checks of the object map and the grid [s]
+  double settle_s = 5.0;    // the last views left out of the check for removed objects [s]
+  bool IsValid(std::string* error) const;
+};
+
+class ChangeMonitor {
+ public:
+  // Compares with flight `prior_flight` of `prior` (both outlive the monitor); appends to `path`.
+  static Status Open(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
+                     const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, const std::string& path,
+                     std::unique_ptr<ChangeMonitor>* monitor);
+  ~ChangeMonitor();
+  ChangeMonitor(const ChangeMonitor&) = delete;
+  ChangeMonitor& operator=(const ChangeMonitor&) = delete;
+
+  // Place stage's thread: a new node of the flight and its loop closure (may be null).
+  void OnNode(const MapNode& node, const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer);
+  // Change stage's thread: after each step of the patrol record.
+  void OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
+  // After the flight: the final report's changes that no event announced. `map` holds both flights.
+  Status Close(const change::ChangeReport& report, const graph::TopoMap& map);
+
+  int events() const;
+  const Status& status() const { return status_; }  // the first failed write, if any
+
+  struct Event;  // one line of the file
+
+ private:
+  ChangeMonitor(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
+                const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, int fd);
+  void Send(const Event& event, bool final_event);
+  void CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
+
+  const graph::TopoMap* prior_;
+  std::string prior_flight_;
+  const PatrolRecord* prior_record_;
+  Config config_;
+  ChangeEventOptions options_;
+  std::vector<CameraPoseSample> poses_;
+  int fd_;
+  std::string path_;
+  TimestampNs first_ns_ = 0, next_check_ns_ = 0;
+  bool started_ = false;
+  mutable std::mutex mutex_;  // the file, sent_ and status_ (two stage threads write)
+  std::set<std::string> sent_;
+  int events_ = 0;
+  Status status_;
+};
+
+}  // namespace patrolmap::pipeline

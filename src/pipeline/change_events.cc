@@ -1,0 +1,217 @@
+#include "patrolmap/pipeline/change_events.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/object_diff.h"
+#include "patrolmap/core/option_check.h"
+#include "patrolmap/io/patrol_sensors.h"
+
+namespace patrolmap::pipeline {
+
+using nlohmann::json;
+
+struct ChangeMonitor::Event {
+  std::string id, type;
+  TimestampNs timestamp_ns = 0;
+  std::optional<Eigen::Vector3d> position;
+  double confidence = 0.0;
+  json details = json::object();
+};
+
+namespace {
+
+using Event = ChangeMonitor::Event;
+
+constexpr double kRegionCellM = 2.0;  // geometry events: one per region centroid in a cell this wide
+
+std::string GeometryId(const Eigen::Vector3d& centroid) {
+  const Eigen::Vector3d cell = (centroid / kRegionCellM).array().floor();
+  return "geometry-" + std::to_string(static_cast<long long>(cell.x())) + "_" +
+         std::to_string(static_cast<long long>(cell.y())) + "_" + std::to_string(static_cast<long long>(cell.z()));
+}
+
+std::string ObjectId(const change::ObjectChange& change) {
+  return "object-p" + std::to_string(change.prior_id) + "-c" + std::to_string(change.current_id);
+}
+
+std::string AppearanceId(int prior_node, int node) {
+  return "appearance-" + std::to_string(prior_node) + "-" + std::to_string(node);
+}
+
+json Position(const Eigen::Vector3d& p) { return json::array({p.x(), p.y(), p.z()}); }
+
+bool Reported(change::ObjectState state) {
+  return state == change::ObjectState::kNew || state == change::ObjectState::kRemoved ||
+         state == change::ObjectState::kMoved;
+}
+
+// The key frame of a node as the appearance comparison needs it (as pipeline::CompareFlights builds it).
+change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
+                            int feature_width) {
+  change::KeyFrameView view{thumbnail, std::move(keypoints), std::move(descriptors), 1.0};
+  if (feature_width > 0 && !thumbnail.empty()) view.feature_scale = static_cast<double>(feature_width) / thumbnail.cols;
+  return view;
+}
+
+Event ObjectEvent(const change::ObjectChange& change, TimestampNs timestamp_ns) {
+  Event event;
+  event.id = ObjectId(change);
+  event.type = std::string("object_") + change::ToString(change.state);
+  event.timestamp_ns = timestamp_ns;
+  event.position = change.after ? change.after : change.before;
+  event.confidence = change.confidence;
+  event.details = {{"label", change.label}};
+  return event;
+}
+
+Event GeometryEvent(const change::GeometryRegion& region, TimestampNs timestamp_ns) {
+  Event event;
+  event.id = GeometryId(region.centroid);
+  event.type = "geometry";
+  event.timestamp_ns = timestamp_ns;
+  event.position = region.centroid;
+  event.confidence = std::min(1.0, region.score);
+  event.details = {{"voxels", region.voxels}, {"appeared", region.appeared}, {"vanished", region.vanished}};
+  return event;
+}
+
+Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns, const std::vector<CameraPoseSample>& poses,
+                      const change::AppearanceChange& appearance) {
+  Event event;
+  event.id = AppearanceId(prior_node, node);
+  event.type = "appearance";
+  event.timestamp_ns = timestamp_ns;
+  if (const auto pose = io::PoseAt(poses, timestamp_ns)) event.position = pose->position;
+  event.confidence = std::min(1.0, appearance.regions.front().score);
+  event.details = {{"node", node}, {"prior_node", prior_node}, {"regions", appearance.regions.size()}};
+  return event;
+}
+
+}  // namespace
+
+bool ChangeEventOptions::IsValid(std::string* error) const {
+  return OptionCheck(error)
+      .AboveAtMost("events interval (--events-interval-s)", interval_s, 0.0, 3600.0)
+      .InRange("events settle time (--events-settle-s)", settle_s, 0.0, 3600.0)
+      .ok();
+}
+
+Status ChangeMonitor::Open(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
+                           const ChangeEventOptions& options, std::vector<CameraPoseSample> poses,
+                           const std::string& path, std::unique_ptr<ChangeMonitor>* monitor) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidArgument(error);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0) return Status::IoError(path + ": cannot open for appending: " + std::strerror(errno));
+  monitor->reset(new ChangeMonitor(prior, prior_flight, config, options, std::move(poses), fd));
+  (*monitor)->path_ = path;
+  return Status::Ok();
+}
+
+ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
+                             const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, int fd)
+    : prior_(prior),
+      prior_flight_(prior_flight),
+      prior_record_(prior->Patrol(prior_flight)),
+      config_(config),
+      options_(options),
+      poses_(std::move(poses)),
+      fd_(fd) {}
+
+ChangeMonitor::~ChangeMonitor() { ::close(fd_); }
+
+int ChangeMonitor::events() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_;
+}
+
+void ChangeMonitor::Send(const Event& event, bool final_event) {
+  json line = {{"id", event.id},
+               {"type", event.type},
+               {"time_ns", event.timestamp_ns},
+               {"position", event.position ? Position(*event.position) : json(nullptr)},
+               {"confidence", event.confidence}};
+  line.update(event.details);
+  if (final_event) line["final"] = true;
+  const std::string text = line.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!sent_.insert(event.id).second || !status_.ok()) return;
+  // One write() a line: whole or not at all, even if the process dies now.
+  const ssize_t written = ::write(fd_, text.data(), text.size());
+  if (written != static_cast<ssize_t>(text.size())) {
+    status_ = Status::IoError(path_ + ": cannot append an event: " + std::strerror(errno));
+    return;
+  }
+  ++events_;
+}
+
+void ChangeMonitor::OnNode(const MapNode& node, const MapLoopClosure* closure,
+                           const place::PlaceRecognizer& recognizer) {
+  if (closure == nullptr || closure->matched_node >= prior_->node_count()) return;
+  const graph::NodeData& before = prior_->node(closure->matched_node);
+  if (before.flight != prior_flight_) return;
+  place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
+  const change::AppearanceChange appearance = change::DetectAppearanceChange(
+      ViewOf(before.thumbnail, before.keypoints, before.descriptors,
+             prior_record_ != nullptr ? prior_record_->feature_image_width : 0),
+      ViewOf(node.thumbnail, std::move(features.keypoints), std::move(features.descriptors), node.feature_width),
+      config_.change.appearance);
+  if (appearance.regions.empty()) return;
+  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns, poses_, appearance);
+  if (node.gps) event.details["gps"] = json::array({node.gps->x(), node.gps->y()});
+  Send(event, false);
+}
+
+void ChangeMonitor::OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder) {
+  if (prior_record_ == nullptr) return;
+  if (!started_) {
+    started_ = true;
+    first_ns_ = timestamp_ns;
+    next_check_ns_ = timestamp_ns + SecondsToNs(options_.interval_s);
+  }
+  if (timestamp_ns < next_check_ns_) return;
+  next_check_ns_ = timestamp_ns + SecondsToNs(options_.interval_s);
+  CheckRecord(timestamp_ns, recorder);
+}
+
+void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder) {
+  const bool grids = prior_record_->grid.voxel_size > 0;
+  const PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), grids);
+  if (prior_record_->has_objects && now.has_objects) {
+    for (const change::ObjectChange& change : change::DiffObjects(*prior_record_, now, config_.change.objects)) {
+      if (Reported(change.state)) Send(ObjectEvent(change, timestamp_ns), false);
+    }
+  }
+  change::GeometryChange geometry;
+  if (grids && now.grid.voxel_size > 0 &&
+      change::DiffGrids(prior_record_->grid, now.grid, config_.change.geometry, &geometry)) {
+    for (const change::GeometryRegion& region : geometry.regions) Send(GeometryEvent(region, timestamp_ns), false);
+  }
+}
+
+Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map) {
+  for (const change::PlaceChange& place : report.places) {
+    if (place.appearance.regions.empty()) continue;
+    const TimestampNs t = map.node(place.current_node).timestamp_ns;
+    Send(AppearanceEvent(place.prior_node, place.current_node, t, poses_, place.appearance), true);
+  }
+  const TimestampNs end_ns = poses_.empty() ? 0 : poses_.back().timestamp_ns;
+  for (const change::ObjectChange& change : report.objects) {
+    if (Reported(change.state)) Send(ObjectEvent(change, end_ns), true);
+  }
+  for (const change::GeometryRegion& region : report.geometry.regions) Send(GeometryEvent(region, end_ns), true);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (status_.ok() && ::fsync(fd_) != 0) status_ = Status::IoError(path_ + ": " + std::strerror(errno));
+  return status_;
+}
+
+}  // namespace patrolmap::pipeline
