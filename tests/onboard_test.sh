@@ -46,6 +46,60 @@ import json, sys
 a, b = (json.load(open('$work/patrol_' + p + '/changes.json'))['places'] for p in ('offline1', 'onboard1'))
 sys.exit(0 if a == b and len(a) >= 1 and all(p['registered'] for p in a) else 1)"
 
+# Change detection onboard: on village patrols with detections and depth, the onboard map (objects and grid
+# too) is byte for byte the one `patrolmap patrol` writes, on workers or inline, and so is the change report;
+# events.jsonl holds whole JSON lines, one per id, and announces every change of the report.
+for seed in 1 2 3; do
+  series="$work/village$seed"
+  "$bin" -q simulate --route l-shape --flights 2 --detections --depth --resolution 376x240 --seed "$seed" --out "$series"
+  "$bin" -q map "$series/flight_1" --vocabulary "$vocabulary" --out "$series/m1"
+  "$bin" -q patrol "$series/flight_2" --map "$series/m1/map.pmap" --vocabulary "$vocabulary" --out "$series/p" >/dev/null
+  "$onboard" -q "$series/flight_2" --map "$series/m1/map.pmap" --fast --vocabulary "$vocabulary" --out "$series/o" >/dev/null
+  "$onboard" -q "$series/flight_2" --map "$series/m1/map.pmap" --fast --inline --vocabulary "$vocabulary" \
+    --out "$series/oi" >/dev/null
+  check "seed $seed: workers and inline give the same map, objects and grid" cmp -s "$series/o/map.pmap" "$series/oi/map.pmap"
+  check "seed $seed: onboard map is patrolmap patrol's" cmp -s "$series/o/map.pmap" "$series/p/map.pmap"
+  check "seed $seed: the same change report" /usr/bin/python3 - "$series/p/changes.json" "$series/o/changes.json" <<'PY'
+import json, sys
+def strip(value):  # timing_s differs from run to run
+    if isinstance(value, dict):
+        return {k: strip(v) for k, v in value.items() if k != "timing_s"}
+    if isinstance(value, list):
+        return [strip(v) for v in value]
+    return value
+a, b = (strip(json.load(open(path))) for path in sys.argv[1:3])
+sys.exit(0 if a == b and (a["objects"] or a["geometry"]["regions"]) else 1)
+PY
+  check "seed $seed: events announce every change of the report" /usr/bin/python3 - "$series/o/events.jsonl" \
+    "$series/p/changes.json" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+events = [json.loads(line) for line in lines]
+ids = [e["id"] for e in events]
+report = json.load(open(sys.argv[2]))
+wanted = {"object-p%d-c%d" % (o.get("prior_id", -1), o.get("current_id", -1))
+          for o in report["objects"] if o["state"] in ("new", "removed", "moved")}
+ok = len(ids) == len(set(ids)) and wanted <= set(ids) and all("time_ns" in e and "confidence" in e for e in events)
+sys.exit(0 if ok else 1)
+PY
+done
+
+# Killed (SIGKILL) at random moments while it writes events: every line present is whole JSON.
+for attempt in 1 2 3 4 5; do
+  rm -rf "$work/killed"
+  "$onboard" -q "$work/village1/flight_2" --map "$work/village1/m1/map.pmap" --fast --events-interval-s 0.5 \
+    --vocabulary "$vocabulary" --out "$work/killed" >/dev/null 2>&1 &
+  pid=$!
+  sleep "$(/usr/bin/python3 -c "import random; print(round(random.uniform(1.0, 3.0), 2))")"
+  kill -KILL "$pid" 2>/dev/null
+  wait "$pid" 2>/dev/null
+  check "SIGKILL $attempt: every event line parses" /usr/bin/python3 -c "
+import json, sys
+text = open('$work/killed/events.jsonl').read()
+[json.loads(line) for line in text.splitlines()]
+sys.exit(0 if not text or text.endswith('\n') else 1)"
+done
+
 output=$("$onboard" "$work/nothing" --vocabulary "$vocabulary" --out "$work/o" 2>&1)
 check "missing log exits 1" test $? -eq 1
 check "missing log is named" grep -q "$work/nothing" <<<"$output"

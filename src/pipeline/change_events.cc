@@ -110,7 +110,7 @@ Status ChangeMonitor::Open(const graph::TopoMap* prior, const std::string& prior
                            const std::string& path, std::unique_ptr<ChangeMonitor>* monitor) {
   std::string error;
   if (!options.IsValid(&error)) return Status::InvalidArgument(error);
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
   if (fd < 0) return Status::IoError(path + ": cannot open for appending: " + std::strerror(errno));
   monitor->reset(new ChangeMonitor(prior, prior_flight, config, options, std::move(poses), fd));
   (*monitor)->path_ = path;
@@ -186,16 +186,27 @@ void ChangeMonitor::OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder&
 void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder) {
   const bool grids = prior_record_->grid.voxel_size > 0;
   const PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), grids);
+  std::vector<Event> candidates;
   if (prior_record_->has_objects && now.has_objects) {
     for (const change::ObjectChange& change : change::DiffObjects(*prior_record_, now, config_.change.objects)) {
-      if (Reported(change.state)) Send(ObjectEvent(change, timestamp_ns), false);
+      if (Reported(change.state)) candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }
   change::GeometryChange geometry;
   if (grids && now.grid.voxel_size > 0 &&
       change::DiffGrids(prior_record_->grid, now.grid, config_.change.geometry, &geometry)) {
-    for (const change::GeometryRegion& region : geometry.regions) Send(GeometryEvent(region, timestamp_ns), false);
+    for (const change::GeometryRegion& region : geometry.regions) {
+      candidates.push_back(GeometryEvent(region, timestamp_ns));
+    }
   }
+  // A change is sent once two checks in a row found it: a region or object state of a grid or map still
+  // being built at the camera's position often lasts one check only.
+  std::set<std::string> seen;
+  for (const Event& event : candidates) {
+    seen.insert(event.id);
+    if (seen_before_.count(event.id) != 0) Send(event, false);
+  }
+  seen_before_ = std::move(seen);
 }
 
 Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map) {

@@ -7,10 +7,11 @@
 //                flight; views of the last settle_s do not count yet (the detections they bring may still
 //                be coming)
 //   geometry     a changed region of the evidence grid so far (change/evidence_grid), every interval_s
-// Each line carries a stable id, the flight time, the position (the camera's, or the object's or region's)
-// and a confidence. A line is written with one write() to a file opened for appending, so it is there whole
-// or not at all, even when the process is killed. When the flight ends, the changes of the final report that
-// no event announced follow, marked "final": true (the report in changes.json is the reference).
+// An object or geometry change is sent when two checks in a row find it.
+// The file is started afresh by each run. Each line carries a stable id, the flight time, the position (the camera's,
+// or the object's or region's) and a confidence. A line is written with one write() to a file opened for appending, so
+// it is there whole or not at all, even when the process is killed. When the flight ends, the changes of the final
+// report that no event announced follow, marked "final": true (the report in changes.json is the reference).
 #pragma once
 
 #include <memory>
@@ -72,7 +73,8 @@ class ChangeMonitor {
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;
   bool started_ = false;
-  mutable std::mutex mutex_;  // the file, sent_ and status_ (two stage threads write)
+  std::set<std::string> seen_before_;  // ids the previous check found (change thread)
+  mutable std::mutex mutex_;           // the file, sent_ and status_ (two stage threads write)
   std::set<std::string> sent_;
   int events_ = 0;
   Status status_;
