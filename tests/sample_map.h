@@ -57,6 +57,7 @@ inline graph::TopoMap TwoFlights() {
   record.objects.push_back(object);
   record.grid.voxel_size = 0.2;
   record.grid.voxels = {{-3, 0, 1, 2, 7}, {-3, 1, 0, 0, 4}, {5, -2, 2, 9, 1}};
+  record.grid.evicted_voxels = 11;
   map.SetPatrol(record);
   return map;
 }

@@ -117,7 +117,15 @@ const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector
   return &*it;
 }
 
-EvidenceGrid::EvidenceGrid(const EvidenceGridOptions& options) : options_(options), slots_(1 << 16) {}
+std::size_t EvidenceGrid::MaxVoxels(const EvidenceGridOptions& options) {
+  const double bytes = options.memory_mb * 1024.0 * 1024.0;
+  std::size_t slots = 2;
+  while (2.0 * static_cast<double>(2 * slots * sizeof(Slot)) <= bytes) slots *= 2;  // room for a copy
+  return slots / 2;
+}
+
+EvidenceGrid::EvidenceGrid(const EvidenceGridOptions& options)
+    : options_(options), max_voxels_(MaxVoxels(options)), slots_(std::min<std::size_t>(1 << 16, 2 * max_voxels_)) {}
 
 EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
   const int bits = __builtin_ctzll(slots_.size());
@@ -127,7 +135,7 @@ EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
     Slot& slot = slots_[i];
     if (slot.key == key) return &slot;
     if (slot.key == 0) {
-      if (static_cast<long long>(size_) >= options_.max_voxels) return nullptr;
+      if (size_ >= max_voxels_) return Evict() ? Find(key) : nullptr;
       if (2 * (size_ + 1) > slots_.size()) {
         Grow();
         return Find(key);
@@ -140,16 +148,50 @@ EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
   }
 }
 
+// Puts a slot's key into the (not full) table; its counts are the caller's to copy.
+EvidenceGrid::Slot* EvidenceGrid::Insert(std::uint64_t key) {
+  const int bits = __builtin_ctzll(slots_.size());
+  std::size_t i = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+  const std::size_t mask = slots_.size() - 1;
+  while (slots_[i].key != 0) i = (i + 1) & mask;
+  slots_[i].key = key;
+  ++size_;
+  return &slots_[i];
+}
+
 void EvidenceGrid::Grow() {
   std::vector<Slot> old(slots_.size() * 2);
   old.swap(slots_);
   size_ = 0;
   for (const Slot& slot : old) {
-    if (slot.key == 0) continue;
-    Slot* moved = Find(slot.key);
-    moved->hits = slot.hits;
-    moved->passes = slot.passes;
+    if (slot.key != 0) *Insert(slot.key) = slot;
   }
+}
+
+// Drops the least recently observed quarter of the voxels (those last reached by the oldest depth images),
+// never one the current image reached. False when there is none to drop.
+bool EvidenceGrid::Evict() {
+  std::vector<std::uint32_t> stamps;
+  for (const Slot& slot : slots_) {
+    if (slot.key != 0 && slot.stamp < stamp_) stamps.push_back(slot.stamp);
+  }
+  if (stamps.empty()) return false;
+  const std::size_t count = std::min(stamps.size(), std::max<std::size_t>(1, size_ / 4));
+  std::nth_element(stamps.begin(), stamps.begin() + (count - 1), stamps.end());
+  const std::uint32_t oldest_kept = stamps[count - 1] + 1;
+  stamps = std::vector<std::uint32_t>();
+  std::vector<Slot> old(slots_.size());
+  old.swap(slots_);
+  size_ = 0;
+  for (const Slot& slot : old) {
+    if (slot.key == 0) continue;
+    if (slot.stamp < oldest_kept) {
+      ++evicted_;
+      continue;
+    }
+    *Insert(slot.key) = slot;
+  }
+  return true;
 }
 
 void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit) {
@@ -177,6 +219,7 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
     if (slot == nullptr) return void(++dropped_);
     std::uint16_t& counter = is_hit ? slot->hits : slot->passes;
     if (counter < std::numeric_limits<std::uint16_t>::max()) ++counter;
+    slot->stamp = stamp_;
   };
   while (remaining-- > 0) {
     count(voxel, false);
@@ -189,6 +232,7 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
 
 void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose) {
   constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
+  ++stamp_;
   const int step =
       std::max(1, static_cast<int>(std::lround(static_cast<double>(depth_m.cols) / options_.rays_per_row)));
   for (int y = step / 2; y < depth_m.rows; y += step) {
@@ -208,6 +252,7 @@ void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& cam
 EvidenceGridData EvidenceGrid::ToData() const {
   EvidenceGridData data;
   data.voxel_size = options_.voxel_size_m;
+  data.evicted_voxels = evicted_;
   data.voxels.reserve(size_);
   for (const Slot& slot : slots_) {
     if (slot.key == 0) continue;
@@ -237,6 +282,8 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
                GeometryChange* change) {
   *change = GeometryChange();
   if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size) return false;
+  change->evicted_prior = before.evicted_voxels;
+  change->evicted_current = after.evicted_voxels;
   const double size = before.voxel_size;
   change->voxel_size = size;
   std::vector<Eigen::Vector3i> changed;

@@ -76,6 +76,7 @@ json GeometryJson(const GeometryChange& g) {
   }
   return {{"voxel_size", g.voxel_size},
           {"compared_voxels", g.compared_voxels},
+          {"evicted_voxels", {{"prior", g.evicted_prior}, {"current", g.evicted_current}}},
           {"changed_voxels", g.changed_voxels.size()},
           {"regions", regions}};
 }
@@ -214,6 +215,12 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
          << " unobserved.";
   }
   if (report.geometry_compared) html << " Geometry: " << report.geometry.regions.size() << " changed regions.";
+  if (report.geometry_compared && (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0)) {
+    html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped their least "
+            "recently observed voxels: "
+         << report.geometry.evicted_prior << " of the prior patrol, " << report.geometry.evicted_current
+         << " of this one; no geometry change can be found where they were.";
+  }
   html << "</p>\n";
   if (report.objects_compared || report.geometry_compared) {
     html << "<h2>Plan</h2>\n<p>Grey: the current flight; dots: objects (blue persistent, green new, red removed, "

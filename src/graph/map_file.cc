@@ -15,7 +15,8 @@ namespace patrolmap::graph {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
-constexpr std::uint32_t kVersion = 3;  // 2: PTRL section (patrol records); 3: VOCB section (vocabulary)
+// 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped
+constexpr std::uint32_t kVersion = 4;
 constexpr std::uint32_t kOldestVersion = 1;
 constexpr int kDescriptorWidth = 128;  // SIFT
 
@@ -201,6 +202,7 @@ std::string PatrolSection(const TopoMap& map) {
     for (const MapObject& o : p.objects) WriteObject(o, &w);
     w.Value(p.grid.voxel_size);
     w.Vector(p.grid.voxels);
+    w.Value<std::int64_t>(p.grid.evicted_voxels);
   }
   return std::move(w.bytes());
 }
@@ -373,7 +375,7 @@ bool ValidVoxelSize(const EvidenceGridData& grid) {
   return grid.voxels.empty() || (grid.voxel_size >= kMinVoxelM && grid.voxel_size <= kMaxVoxelM);
 }
 
-Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
+Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
     PatrolRecord p;
@@ -391,13 +393,16 @@ Status ParsePatrols(const std::string& path, Reader* r, TopoMap* map) {
     for (std::uint32_t k = 0; k < objects && !r->failed(); ++k) p.objects.push_back(ReadObject(r));
     p.grid.voxel_size = r->Value<double>();
     p.grid.voxels = r->Vector<VoxelEvidence>();
+    if (version >= 4) p.grid.evicted_voxels = r->Value<std::int64_t>();
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
     for (const MapObject& object : p.objects) {
       if (!ValidObject(object)) return Corrupt(path, "object " + std::to_string(object.id) + " of patrol " + p.flight);
     }
-    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid)) return Corrupt(path, "evidence grid of " + p.flight);
+    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid) || p.grid.evicted_voxels < 0) {
+      return Corrupt(path, "evidence grid of " + p.flight);
+    }
     map->SetPatrol(std::move(p));
   }
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();
@@ -428,7 +433,7 @@ Status ParseSection(const std::string& path, std::uint32_t version, const std::s
   if (tag == "NODE" && once(&seen->nodes)) return ParseNodes(path, &reader, map);
   if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, version, &reader, map);
   if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, &reader, map);
-  if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, &reader, map);
+  if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, version, &reader, map);
   if (tag == "VOCB" && once(&seen->vocabulary)) return ParseVocabulary(path, &reader, map);
   return Corrupt(path, "unexpected or repeated section " + tag);
 }

@@ -232,9 +232,12 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
                        " key location(s) were confirmed after their frame left the ring of recent frames and are "
                        "not in the map; raise the ring (--ring-s)");
   }
-  if (result.record_stats.dropped_voxel_updates > 0) {
-    warnings.push_back(info.path + ": the evidence grid reached change.grid.max_voxels; " +
-                       std::to_string(result.record_stats.dropped_voxel_updates) + " voxel updates were dropped");
+  const PatrolRecordStats& grid = result.record_stats;
+  if (grid.evicted_voxels > 0 || grid.dropped_voxel_updates > 0) {
+    warnings.push_back(info.path + ": the evidence grid reached change.grid.memory_mb; " +
+                       std::to_string(grid.evicted_voxels) + " least recently observed voxels and " +
+                       std::to_string(grid.dropped_voxel_updates) +
+                       " updates were dropped (no geometry change can be found there; raise change.grid.memory_mb)");
   }
   return warnings;
 }

@@ -65,13 +65,50 @@ TEST(EvidenceGrid, DiagonalRayVisitsAConnectedChainOfVoxels) {
   EXPECT_EQ(At(data, 11, 8, -5)->hits, 1);
 }
 
-TEST(EvidenceGrid, MemoryBoundDropsNewVoxelsAndCountsThem) {
+TEST(EvidenceGrid, TheMemoryBudgetCountsSixteenByteSlotsHalfUsedAndACopy) {
+  EvidenceGridOptions options;  // 256 MB: 8,388,608 slots of 16 bytes, twice that while copying
+  EXPECT_EQ(EvidenceGrid::MaxVoxels(options), 4194304u);
+  options.memory_mb = 1024.0 / (1024 * 1024);  // 1 kB: 32 slots
+  EXPECT_EQ(EvidenceGrid::MaxVoxels(options), 16u);
+}
+
+TEST(EvidenceGrid, AFullGridDropsTheUpdatesOfTheImageThatFilledIt) {
   EvidenceGridOptions options;
-  options.max_voxels = 3;
+  options.memory_mb = 256.0 / (1024 * 1024);  // 4 voxels
   EvidenceGrid grid(options);
-  grid.TraceRay(Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 0.0, 0.0), true);
-  EXPECT_EQ(grid.voxel_count(), 3u);
-  EXPECT_EQ(grid.dropped_updates(), 8);
+  grid.TraceRay(Eigen::Vector3d::Zero(), Eigen::Vector3d(2.0, 0.0, 0.0), true);  // 11 voxels, one image
+  EXPECT_EQ(grid.voxel_count(), 4u);
+  EXPECT_EQ(grid.dropped_updates(), 7);
+  EXPECT_EQ(grid.evicted_voxels(), 0);
+}
+
+// One ray a depth image: 1 m along the camera's axis, 6 voxels of 0.2 m.
+void IntegrateOneRay(EvidenceGrid* grid, double y) {
+  const CameraIntrinsics one_pixel{1.0, 1.0, 0.0, 0.0, 1, 1};
+  grid->Integrate(cv::Mat(1, 1, CV_32FC1, cv::Scalar(1.0)), one_pixel, LookingAlongX(Eigen::Vector3d(0, y, 0)));
+}
+
+TEST(EvidenceGrid, AFullGridDropsTheLeastRecentlyObservedVoxels) {
+  EvidenceGridOptions options;
+  options.memory_mb = 1024.0 / (1024 * 1024);  // 16 voxels
+  options.rays_per_row = 1;
+  EvidenceGrid grid(options);
+  IntegrateOneRay(&grid, 0.0);
+  IntegrateOneRay(&grid, 1.0);
+  EXPECT_EQ(grid.voxel_count(), 12u);
+  IntegrateOneRay(&grid, 2.0);  // full after 4 of its 6 voxels: the first image's 6 go
+  EXPECT_EQ(grid.evicted_voxels(), 6);
+  EXPECT_EQ(grid.dropped_updates(), 0);
+  const EvidenceGridData data = grid.ToData();
+  EXPECT_EQ(data.voxels.size(), 12u);
+  EXPECT_EQ(At(data, 5, 0, 0), nullptr);  // the first ray's hit
+  EXPECT_EQ(At(data, 5, 5, 0)->hits, 1);  // the second's
+  EXPECT_EQ(At(data, 5, 10, 0)->hits, 1);
+  IntegrateOneRay(&grid, 1.0);  // seen again: the second image's voxels are now the newest
+  IntegrateOneRay(&grid, 3.0);
+  EXPECT_EQ(grid.evicted_voxels(), 12);
+  EXPECT_NE(At(grid.ToData(), 5, 5, 0), nullptr);
+  EXPECT_EQ(At(grid.ToData(), 5, 10, 0), nullptr);
 }
 
 // Depth of a flat wall at x = 10 seen by a camera at the origin looking along +x.
@@ -79,7 +116,6 @@ cv::Mat WallDepth(const CameraIntrinsics& camera, double distance) {
   cv::Mat depth(camera.height, camera.width, CV_32FC1, cv::Scalar(distance));
   return depth;
 }
-
 
 TEST(EvidenceGrid, DepthImageRaysEndOnTheWall) {
   EvidenceGridOptions options;

@@ -84,6 +84,7 @@ TEST(MapFile, RoundTripKeepsEverything) {
   ASSERT_EQ(p.grid.voxels.size(), 3u);
   EXPECT_EQ(p.grid.voxels[2].hits, 9);
   EXPECT_EQ(p.grid.voxels[0].passes, 7);
+  EXPECT_EQ(p.grid.evicted_voxels, 11);
   // Saving again gives the same bytes.
   ASSERT_TRUE(SaveMap(loaded, dir / "again.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "m.pmap"), testing::ReadText(dir / "again.pmap"));
@@ -168,6 +169,7 @@ TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
   patrol_refused([](PatrolRecord* p) { p->camera.fx = -1.0; }, "camera or views of patrol b");
   patrol_refused([](PatrolRecord* p) { p->objects[0].centroid.x() = std::nan(""); }, "object 3 of patrol b");
   patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = 1e-300; }, "evidence grid of b");
+  patrol_refused([](PatrolRecord* p) { p->grid.evicted_voxels = -1; }, "evidence grid of b");
   patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = std::nan(""); }, "evidence grid of b");
   std::string version_zero = bytes_;
   const std::uint32_t zero = 0;

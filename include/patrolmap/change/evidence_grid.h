@@ -29,20 +29,34 @@ class EvidenceGrid {
   void TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit);
 
   std::size_t voxel_count() const { return size_; }
-  long long dropped_updates() const { return dropped_; }  // updates lost to the memory bound
+  // The most voxels options.memory_mb holds: the table is a power of two of 16-byte slots, at most half of
+  // them used, and growing or shedding voxels copies it once.
+  static std::size_t MaxVoxels(const EvidenceGridOptions& options);
+  // Voxels dropped when the grid was full: the least recently observed quarter each time, never one the
+  // current depth image reached. Their evidence is lost; a later patrol compares nothing there.
+  long long evicted_voxels() const { return evicted_; }
+  // Updates lost because the current depth image alone filled the grid.
+  long long dropped_updates() const { return dropped_; }
   EvidenceGridData ToData() const;
 
  private:
   struct Slot {
     std::uint64_t key = 0;  // 0 = empty
     std::uint16_t hits = 0, passes = 0;
+    std::uint32_t stamp = 0;  // the depth image that last reached it (Integrate calls)
   };
+  static_assert(sizeof(Slot) == 16, "MaxVoxels counts 16-byte slots");
   Slot* Find(std::uint64_t key);
+  Slot* Insert(std::uint64_t key);
   void Grow();
+  bool Evict();
 
   EvidenceGridOptions options_;
+  std::size_t max_voxels_;
   std::vector<Slot> slots_;
   std::size_t size_ = 0;
+  std::uint32_t stamp_ = 0;
+  long long evicted_ = 0;
   long long dropped_ = 0;
 };
 
@@ -66,7 +80,9 @@ struct GeometryRegion {
 
 struct GeometryChange {
   double voxel_size = 0.0;
-  long long compared_voxels = 0;                // observed enough in both patrols
+  long long compared_voxels = 0;  // observed enough in both patrols
+  // Voxels each patrol's grid dropped at its memory budget (change.grid.memory_mb): nothing is compared there.
+  long long evicted_prior = 0, evicted_current = 0;
   std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions
   std::vector<GeometryRegion> regions;          // largest first
 };

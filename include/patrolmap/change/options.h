@@ -66,7 +66,10 @@ struct EvidenceGridOptions {
   int rays_per_row = 94;      // depth pixels traced per image row (every width/94-th pixel, and
                               // every as many rows): 94 is every 8th pixel at 752 px
   double rate_hz = 5.0;       // depth frames integrated per second of flight
-  int max_voxels = 40000000;  // memory bound (16 bytes a voxel); further voxels are not created
+  // Memory of the grid's table at most, the copy made while it grows or sheds voxels included [MB]: 256 MB
+  // hold 4.2 million voxels (16 bytes a slot, at most half the slots used). When full, the least recently
+  // observed quarter of the voxels is dropped (EvidenceGrid); the patrol record counts them.
+  double memory_mb = 256.0;
 };
 
 // Geometry change between two evidence grids (paper 004).

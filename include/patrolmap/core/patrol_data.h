@@ -87,6 +87,7 @@ inline bool VoxelBefore(const VoxelEvidence& a, const VoxelEvidence& b) {
 struct EvidenceGridData {
   double voxel_size = 0.0;  // [m]; 0 when the patrol had no depth
   std::vector<VoxelEvidence> voxels;
+  long long evicted_voxels = 0;  // dropped when the grid's memory budget was reached (oldest first)
 };
 
 // Calls visit(a_voxel, b_voxel) for every voxel both grids hold, in order (a merge of the sorted lists).

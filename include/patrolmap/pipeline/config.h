@@ -112,7 +112,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
   visitor->Field("change.grid.rays_per_row", &change.grid.rays_per_row);
   visitor->Field("change.grid.rate_hz", &change.grid.rate_hz);
-  visitor->Field("change.grid.max_voxels", &change.grid.max_voxels);
+  visitor->Field("change.grid.memory_mb", &change.grid.memory_mb);
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
   visitor->Field("change.geometry.max_free_occupancy", &change.geometry.max_free_occupancy);
   visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);

@@ -30,6 +30,7 @@ struct PatrolRecordStats {
   int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
+  long long evicted_voxels = 0;  // the grid's least recently observed voxels, dropped at its memory budget
 };
 
 // One step of the change stage: the detections of a frame, or one depth image for the grid.
