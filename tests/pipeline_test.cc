@@ -397,9 +397,7 @@ FlightRun MapThroughPass(const std::filesystem::path& log, const Config& config,
   std::unique_ptr<io::FrameSource> source;
   FlightRun run;
   EXPECT_TRUE(io::OpenLog(log, config.input, &source).ok());
-  io::PatrolSensors sensors;
-  EXPECT_TRUE(ReadFlightSensors(source->info(), &sensors).ok());
-  EXPECT_TRUE(RunFlight(source.get(), config, std::move(sensors), options, {}, recognizer, result, nullptr, &run).ok());
+  EXPECT_TRUE(RunFlight(source.get(), config, options, {}, recognizer, result, nullptr, &run).ok());
   return run;
 }
 

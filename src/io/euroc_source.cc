@@ -10,6 +10,7 @@
 #include "image_list_source.h"
 #include "image_times.h"
 #include "patrolmap/core/csv.h"
+#include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/io/yaml_file.h"
 
@@ -186,8 +187,11 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   if (!imu.empty() && !info.camera_from_imu) {
     spdlog::warn("{}: imu0 present but cam0/sensor.yaml missing: camera-IMU rotation unknown", log);
   }
+  PatrolSensors sensors;
+  PATROLMAP_RETURN_IF_ERROR(
+      ReadSensorTables(log, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), &sensors));
   *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu), std::move(speeds),
-                                              std::move(gps));
+                                              std::move(gps), std::move(sensors));
   return Status::Ok();
 }
 

@@ -1,31 +1,41 @@
 #include "image_list_source.h"
 
 #include <algorithm>
+#include <limits>
 
 #include <opencv2/imgcodecs.hpp>
 
 namespace patrolmap::io {
 
 ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries, std::vector<ImuSample> imu,
-                                 std::vector<SpeedSample> speeds, std::vector<GpsSample> gps)
+                                 std::vector<SpeedSample> speeds, std::vector<GpsSample> gps, PatrolSensors sensors)
     : info_(std::move(info)),
       entries_(std::move(entries)),
       imu_(std::move(imu)),
       speeds_(std::move(speeds)),
-      gps_(std::move(gps)) {
+      gps_(std::move(gps)),
+      sensors_(std::move(sensors)) {
   info_.frame_count = static_cast<std::int64_t>(entries_.size());
   info_.has_imu = !imu_.empty();
+  info_.has_poses = !sensors_.poses.empty();
+  info_.has_detections = !sensors_.detections.empty();
+  info_.has_depth = !sensors_.depth.empty();
   info_.has_speed = !speeds_.empty();
 }
 
 Status ImageListSource::Next(bool decode_image, Frame* frame) {
   frame->imu.clear();
+  frame->poses.clear();
+  frame->depth.clear();
   while (next_entry_ < entries_.size()) {
     const std::int64_t index = static_cast<std::int64_t>(next_entry_);
     const ImageEntry& entry = entries_[next_entry_++];
     AppendImuUpTo(entry.timestamp_ns, &frame->imu);
+    // After the last frame nothing else comes: the samples left come with it.
+    AttachSensors(next_entry_ == entries_.size() ? std::numeric_limits<TimestampNs>::max() : entry.timestamp_ns, frame);
+    frame->pose = PoseAt(sensors_.poses, entry.timestamp_ns);
     frame->image.release();
-    if (decode_image && !Decode(index, entry.path, &frame->image)) continue;
+    if ((decode_image || !frame->detections.empty()) && !Decode(index, entry.path, &frame->image)) continue;
     frame->timestamp_ns = entry.timestamp_ns;
     frame->index = index;
     frame->speed_mps = SpeedAt(entry.timestamp_ns);
@@ -49,6 +59,26 @@ bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Ma
     return false;
   }
   return true;
+}
+
+void ImageListSource::AttachSensors(TimestampNs timestamp_ns, Frame* frame) {
+  const std::vector<CameraPoseSample>& poses = sensors_.poses;
+  for (; next_pose_ < poses.size() && poses[next_pose_].timestamp_ns <= timestamp_ns; ++next_pose_) {
+    frame->poses.push_back(poses[next_pose_]);
+  }
+  const std::vector<DepthEntry>& depth = sensors_.depth;
+  for (; next_depth_ < depth.size() && depth[next_depth_].timestamp_ns <= timestamp_ns; ++next_depth_) {
+    frame->depth.push_back(
+        {depth[next_depth_].timestamp_ns, depth[next_depth_].path, PoseAt(poses, depth[next_depth_].timestamp_ns)});
+  }
+  // Detections between frames belong to none and are dropped; those of a skipped frame go with it.
+  const std::vector<ObjectObservation>& detections = sensors_.detections;
+  frame->detections.clear();
+  const TimestampNs frame_ns = std::min(timestamp_ns, entries_[next_entry_ - 1].timestamp_ns);
+  while (next_detection_ < detections.size() && detections[next_detection_].timestamp_ns < frame_ns) ++next_detection_;
+  while (next_detection_ < detections.size() && detections[next_detection_].timestamp_ns == frame_ns) {
+    frame->detections.push_back(detections[next_detection_++]);
+  }
 }
 
 void ImageListSource::AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples) {

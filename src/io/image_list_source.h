@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "patrolmap/io/frame_source.h"
+#include "patrolmap/io/patrol_sensors.h"
 
 namespace patrolmap::io {
 
@@ -28,13 +29,15 @@ class ImageListSource : public FrameSource {
  public:
   // `imu` and `speeds` must be sorted by time (the EuRoC reader checks this).
   ImageListSource(LogInfo info, std::vector<ImageEntry> entries, std::vector<ImuSample> imu = {},
-                  std::vector<SpeedSample> speeds = {}, std::vector<GpsSample> gps = {});
+                  std::vector<SpeedSample> speeds = {}, std::vector<GpsSample> gps = {}, PatrolSensors sensors = {});
 
   Status Next(bool decode_image, Frame* frame) override;
   const LogInfo& info() const override { return info_; }
 
  private:
   void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);
+  // Poses and depth images up to `timestamp_ns` into `frame`, and the detections at exactly that time.
+  void AttachSensors(TimestampNs timestamp_ns, Frame* frame);
   std::optional<double> SpeedAt(TimestampNs timestamp_ns) const;
   std::optional<Eigen::Vector3d> GpsAt(TimestampNs timestamp_ns) const;
   bool Decode(std::int64_t index, const std::string& path, cv::Mat* image);
@@ -44,6 +47,8 @@ class ImageListSource : public FrameSource {
   std::vector<ImuSample> imu_;
   std::vector<SpeedSample> speeds_;
   std::vector<GpsSample> gps_;
+  PatrolSensors sensors_;
+  std::size_t next_pose_ = 0, next_detection_ = 0, next_depth_ = 0;
   std::size_t next_entry_ = 0;
   std::size_t next_imu_ = 0;
   cv::Size first_size_;

@@ -89,11 +89,12 @@ Status ReadPatrolSensors(const std::string& log, PatrolSensors* sensors) {
   if (info.kind != "euroc") return Status::Ok();
   std::string root = log;
   if (!fs::exists(root + "/cam0/data.csv") && fs::exists(root + "/mav0/cam0/data.csv")) root += "/mav0";
+  return ReadSensorTables(root, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), sensors);
+}
+
+Status ReadSensorTables(const std::string& root, const Eigen::Matrix3d& body_from_camera, PatrolSensors* sensors) {
   const std::string state = root + "/state_groundtruth_estimate0/data.csv";
-  if (fs::exists(state)) {
-    PATROLMAP_RETURN_IF_ERROR(
-        ReadPoseTable(state, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), &sensors->poses));
-  }
+  if (fs::exists(state)) PATROLMAP_RETURN_IF_ERROR(ReadPoseTable(state, body_from_camera, &sensors->poses));
   if (fs::exists(root + "/objects0/data.csv")) {
     PATROLMAP_RETURN_IF_ERROR(ReadDetectionTable(root + "/objects0/data.csv", &sensors->detections));
   }

@@ -13,7 +13,6 @@
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/object_diff.h"
 #include "patrolmap/core/option_check.h"
-#include "patrolmap/io/patrol_sensors.h"
 
 namespace patrolmap::pipeline {
 
@@ -84,13 +83,13 @@ Event GeometryEvent(const change::GeometryRegion& region, TimestampNs timestamp_
   return event;
 }
 
-Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns, const std::vector<CameraPoseSample>& poses,
-                      const change::AppearanceChange& appearance) {
+Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns,
+                      const std::optional<Eigen::Vector3d>& position, const change::AppearanceChange& appearance) {
   Event event;
   event.id = AppearanceId(prior_node, node);
   event.type = "appearance";
   event.timestamp_ns = timestamp_ns;
-  if (const auto pose = io::PoseAt(poses, timestamp_ns)) event.position = pose->position;
+  event.position = position;
   event.confidence = std::min(1.0, appearance.regions.front().score);
   event.details = {{"node", node}, {"prior_node", prior_node}, {"regions", appearance.regions.size()}};
   return event;
@@ -106,25 +105,24 @@ bool ChangeEventOptions::IsValid(std::string* error) const {
 }
 
 Status ChangeMonitor::Open(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
-                           const ChangeEventOptions& options, std::vector<CameraPoseSample> poses,
-                           const std::string& path, std::unique_ptr<ChangeMonitor>* monitor) {
+                           const ChangeEventOptions& options, const std::string& path,
+                           std::unique_ptr<ChangeMonitor>* monitor) {
   std::string error;
   if (!options.IsValid(&error)) return Status::InvalidArgument(error);
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
   if (fd < 0) return Status::IoError(path + ": cannot open for appending: " + std::strerror(errno));
-  monitor->reset(new ChangeMonitor(prior, prior_flight, config, options, std::move(poses), fd));
+  monitor->reset(new ChangeMonitor(prior, prior_flight, config, options, fd));
   (*monitor)->path_ = path;
   return Status::Ok();
 }
 
 ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
-                             const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, int fd)
+                             const ChangeEventOptions& options, int fd)
     : prior_(prior),
       prior_flight_(prior_flight),
       prior_record_(prior->Patrol(prior_flight)),
       config_(config),
       options_(options),
-      poses_(std::move(poses)),
       fd_(fd) {}
 
 ChangeMonitor::~ChangeMonitor() { ::close(fd_); }
@@ -154,8 +152,9 @@ void ChangeMonitor::Send(const Event& event, bool final_event) {
   ++events_;
 }
 
-void ChangeMonitor::OnNode(const MapNode& node, const MapLoopClosure* closure,
-                           const place::PlaceRecognizer& recognizer) {
+void ChangeMonitor::OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose,
+                           const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer) {
+  if (pose) node_positions_[node.node] = pose->position;
   if (closure == nullptr || closure->matched_node >= prior_->node_count()) return;
   const graph::NodeData& before = prior_->node(closure->matched_node);
   if (before.flight != prior_flight_) return;
@@ -166,13 +165,15 @@ void ChangeMonitor::OnNode(const MapNode& node, const MapLoopClosure* closure,
       ViewOf(node.thumbnail, std::move(features.keypoints), std::move(features.descriptors), node.feature_width),
       config_.change.appearance);
   if (appearance.regions.empty()) return;
-  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns, poses_, appearance);
+  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns,
+                                pose ? std::optional<Eigen::Vector3d>(pose->position) : std::nullopt, appearance);
   if (node.gps) event.details["gps"] = json::array({node.gps->x(), node.gps->y()});
   Send(event, false);
 }
 
 void ChangeMonitor::OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder) {
   if (prior_record_ == nullptr) return;
+  last_ns_ = std::max(last_ns_, timestamp_ns);
   if (!started_) {
     started_ = true;
     first_ns_ = timestamp_ns;
@@ -213,9 +214,12 @@ Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::Top
   for (const change::PlaceChange& place : report.places) {
     if (place.appearance.regions.empty()) continue;
     const TimestampNs t = map.node(place.current_node).timestamp_ns;
-    Send(AppearanceEvent(place.prior_node, place.current_node, t, poses_, place.appearance), true);
+    const auto at = node_positions_.find(place.current_node);
+    const std::optional<Eigen::Vector3d> position =
+        at == node_positions_.end() ? std::nullopt : std::optional<Eigen::Vector3d>(at->second);
+    Send(AppearanceEvent(place.prior_node, place.current_node, t, position, place.appearance), true);
   }
-  const TimestampNs end_ns = poses_.empty() ? 0 : poses_.back().timestamp_ns;
+  const TimestampNs end_ns = last_ns_;
   for (const change::ObjectChange& change : report.objects) {
     if (Reported(change.state)) Send(ObjectEvent(change, end_ns), true);
   }

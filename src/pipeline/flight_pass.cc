@@ -34,9 +34,8 @@ bool FlightPassOptions::IsValid(std::string* error) const {
       .ok();
 }
 
-FlightPass::FlightPass(const Config& config, const io::LogInfo& info, io::PatrolSensors sensors,
-                       place::PlaceRecognizer* recognizer, MapResult* places, const FlightPassOptions& options,
-                       ChangeMonitor* monitor)
+FlightPass::FlightPass(const Config& config, const io::LogInfo& info, place::PlaceRecognizer* recognizer,
+                       MapResult* places, const FlightPassOptions& options, ChangeMonitor* monitor)
     : options_(options),
       info_(info),
       detector_(config.flow, {info.camera, info.camera_from_imu, info.frame_rate_hz}),
@@ -44,7 +43,7 @@ FlightPass::FlightPass(const Config& config, const io::LogInfo& info, io::Patrol
       scale_(config.flow.frames.scale),
       monitor_(monitor),
       places_(recognizer, places),
-      recorder_(config, std::move(sensors)),
+      recorder_(config, info),
       place_queue_([this](KeyFrameInput&& input) { return AddPlace(std::move(input)); }, options.workers,
                    options.queue_capacity),
       change_queue_([this](ChangeWork&& work) { return AddChange(std::move(work)); }, options.workers,
@@ -55,9 +54,7 @@ FlightPass::~FlightPass() {
   change_queue_.Close();
 }
 
-bool FlightPass::NeedsImage() const {
-  return options_.node_every > 0 || detector_.NeedsImage() || recorder_.WantsImages();
-}
+bool FlightPass::NeedsImage() const { return options_.node_every > 0 || detector_.NeedsImage(); }
 
 Status FlightPass::AddFrame(const Frame& frame) {
   ++stats_.frames;
@@ -108,6 +105,7 @@ void FlightPass::Remember(const Frame& frame, const cv::Mat& image) {
   image.copyTo(slot.image);
   slot.heading = yaw_.yaw();
   slot.gps = frame.gps;
+  slot.pose = frame.pose;
 }
 
 Status FlightPass::HandKeyLocation(const KeyLocation& key_location) {
@@ -130,6 +128,7 @@ Status FlightPass::HandSlot(const Slot& slot) {
   input.key_frame.image = slot.image.clone();  // the slot is reused; the queue keeps its own copy
   input.heading = slot.heading;
   input.gps = slot.gps;
+  input.pose = slot.pose;
   ++stats_.key_frames;
   return place_queue_.Push(std::move(input));
 }
@@ -141,7 +140,7 @@ Status FlightPass::AddPlace(KeyFrameInput&& input) {
   if (monitor_ == nullptr) return Status::Ok();
   const MapResult& result = places_.result();
   const MapLoopClosure* closure = result.loop_closures.size() > closures ? &result.loop_closures.back() : nullptr;
-  monitor_->OnNode(result.nodes.back(), closure, places_.recognizer());
+  monitor_->OnNode(result.nodes.back(), input.pose, closure, places_.recognizer());
   return Status::Ok();
 }
 
@@ -212,14 +211,6 @@ Status Drive(io::FrameSource* source, FlightPass* pass, const DriveOptions& opti
   return status.ok() || status.end_of_stream() ? Status::Ok() : status;
 }
 
-Status ReadFlightSensors(const io::LogInfo& info, io::PatrolSensors* sensors) {
-  *sensors = io::PatrolSensors();
-  sensors->flight_id = info.flight_id;
-  sensors->camera = info.camera;
-  if (info.kind != "euroc") return Status::Ok();
-  return io::ReadPatrolSensors(info.path, sensors);
-}
-
 namespace {
 
 std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& config, const FlightPassOptions& options,
@@ -244,13 +235,13 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
 
 }  // namespace
 
-Status RunFlight(io::FrameSource* source, const Config& config, io::PatrolSensors sensors,
-                 const FlightPassOptions& options, const DriveOptions& drive, place::PlaceRecognizer* recognizer,
-                 MapResult* places, ChangeMonitor* monitor, FlightRun* run) {
+Status RunFlight(io::FrameSource* source, const Config& config, const FlightPassOptions& options,
+                 const DriveOptions& drive, place::PlaceRecognizer* recognizer, MapResult* places,
+                 ChangeMonitor* monitor, FlightRun* run) {
   const io::LogInfo& info = source->info();
   const std::size_t nodes_before = places->nodes.size();
   {
-    FlightPass pass(config, info, std::move(sensors), recognizer, places, options, monitor);
+    FlightPass pass(config, info, recognizer, places, options, monitor);
     PATROLMAP_RETURN_IF_ERROR(Drive(source, &pass, drive, &run->drive));
     PATROLMAP_RETURN_IF_ERROR(pass.Finish(&run->result));
   }

@@ -10,70 +10,64 @@ namespace {
 
 constexpr double kViewRateHz = 5.0;  // views kept for visibility
 
-void SampleViews(const std::vector<CameraPoseSample>& poses, std::vector<CameraPoseSample>* views) {
-  const TimestampNs step = SecondsToNs(1.0 / kViewRateHz);
-  TimestampNs next = std::numeric_limits<TimestampNs>::min();
-  for (const CameraPoseSample& pose : poses) {
-    if (pose.timestamp_ns < next) continue;
-    views->push_back(pose);
-    next = pose.timestamp_ns + step;
-  }
-}
-
 }  // namespace
 
-PatrolRecorder::PatrolRecorder(const Config& config, io::PatrolSensors sensors)
+PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
     : config_(config),
-      sensors_(std::move(sensors)),
-      mapper_(config.change.object_map, sensors_.camera.value_or(CameraIntrinsics())),
+      mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
-      next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
-  base_.flight = sensors_.flight_id;
-  if (sensors_.camera) base_.camera = *sensors_.camera;
-  if (sensors_.poses.empty() || !sensors_.camera) return;
-  SampleViews(sensors_.poses, &base_.views);
-  base_.has_objects = !sensors_.detections.empty();
-  active_ = base_.has_objects || !sensors_.depth.empty();
-  stats_.detections = static_cast<int>(sensors_.detections.size());
-}
-
-void PatrolRecorder::CollectDepth(TimestampNs until_ns, std::vector<ChangeWork>* work) {
-  const std::vector<io::DepthEntry>& depth = sensors_.depth;
-  for (; next_depth_ < depth.size() && depth[next_depth_].timestamp_ns <= until_ns; ++next_depth_) {
-    ChangeWork step;
-    step.kind = ChangeWork::Kind::kGrid;
-    step.timestamp_ns = depth[next_depth_].timestamp_ns;
-    step.pose = io::PoseAt(sensors_.poses, step.timestamp_ns);
-    step.depth_path = depth[next_depth_].path;
-    work->push_back(std::move(step));
-  }
+      next_grid_ns_(std::numeric_limits<TimestampNs>::min()),
+      next_view_ns_(std::numeric_limits<TimestampNs>::min()) {
+  base_.flight = info.flight_id;
+  if (info.camera) base_.camera = *info.camera;
+  if (!info.has_poses || !info.camera) return;
+  base_.has_objects = info.has_detections;
+  has_depth_ = info.has_depth;
+  active_ = base_.has_objects || has_depth_;
 }
 
 void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) {
   if (!active_) return;
-  CollectDepth(frame.timestamp_ns, work);
-  const std::vector<io::DepthEntry>& depth = sensors_.depth;
-  // Detections between frames belong to none and are dropped; those at the frame's time are its own.
-  const std::vector<ObjectObservation>& all = sensors_.detections;
-  while (next_detection_ < all.size() && all[next_detection_].timestamp_ns < frame.timestamp_ns) ++next_detection_;
-  if (next_detection_ == all.size() || all[next_detection_].timestamp_ns != frame.timestamp_ns) return;
-  ChangeWork step;
-  step.kind = ChangeWork::Kind::kObjects;
-  step.timestamp_ns = frame.timestamp_ns;
-  while (next_detection_ < all.size() && all[next_detection_].timestamp_ns == frame.timestamp_ns) {
-    step.detections.push_back(all[next_detection_++]);
+  const TimestampNs step = SecondsToNs(1.0 / kViewRateHz);
+  for (const CameraPoseSample& pose : frame.poses) {
+    if (pose.timestamp_ns < next_view_ns_) continue;
+    pending_views_.push_back(pose);
+    next_view_ns_ = pose.timestamp_ns + step;
   }
-  step.pose = io::PoseAt(sensors_.poses, frame.timestamp_ns);
-  if (!step.pose) return;
-  const auto at = std::lower_bound(depth.begin(), depth.end(), frame.timestamp_ns,
-                                   [](const io::DepthEntry& e, TimestampNs t) { return e.timestamp_ns < t; });
-  if (at != depth.end() && at->timestamp_ns == frame.timestamp_ns) step.depth_path = at->path;
-  step.image = frame.image.clone();  // the source reuses its buffer
-  work->push_back(std::move(step));
+  const std::size_t first = work->size();
+  if (has_depth_) {
+    for (const DepthSample& depth : frame.depth) {
+      ChangeWork step_work;
+      step_work.kind = ChangeWork::Kind::kGrid;
+      step_work.timestamp_ns = depth.timestamp_ns;
+      step_work.pose = depth.pose;
+      step_work.depth_path = depth.path;
+      work->push_back(std::move(step_work));
+    }
+  }
+  if (base_.has_objects && !frame.detections.empty() && frame.pose) {
+    ChangeWork objects;
+    objects.kind = ChangeWork::Kind::kObjects;
+    objects.timestamp_ns = frame.timestamp_ns;
+    objects.detections = frame.detections;
+    objects.pose = frame.pose;
+    for (const DepthSample& depth : frame.depth) {
+      if (depth.timestamp_ns == frame.timestamp_ns) objects.depth_path = depth.path;
+    }
+    objects.image = frame.image.clone();  // the source reuses its buffer
+    work->push_back(std::move(objects));
+  }
+  if (work->size() > first) (*work)[first].views = std::move(pending_views_), pending_views_.clear();
 }
 
 void PatrolRecorder::CollectRest(std::vector<ChangeWork>* work) {
-  if (active_) CollectDepth(std::numeric_limits<TimestampNs>::max(), work);
+  if (pending_views_.empty()) return;
+  ChangeWork views;
+  views.kind = ChangeWork::Kind::kViews;
+  views.timestamp_ns = pending_views_.back().timestamp_ns;
+  views.views = std::move(pending_views_);
+  pending_views_.clear();
+  work->push_back(std::move(views));
 }
 
 bool PatrolRecorder::ReadDepth(const std::string& path, cv::Mat* depth) {
@@ -86,8 +80,10 @@ bool PatrolRecorder::ReadDepth(const std::string& path, cv::Mat* depth) {
 }
 
 void PatrolRecorder::Apply(const ChangeWork& work) {
+  base_.views.insert(base_.views.end(), work.views.begin(), work.views.end());
   if (!work.pose) return;
   if (work.kind == ChangeWork::Kind::kObjects) {
+    stats_.detections += static_cast<int>(work.detections.size());
     depth_.release();
     if (!work.depth_path.empty()) ReadDepth(work.depth_path, &depth_);
     mapper_.AddFrame(work.detections, *work.pose, depth_, work.image);
@@ -114,14 +110,14 @@ PatrolRecord PatrolRecorder::Snapshot(TimestampNs until_ns, bool with_grid) cons
                                   [until_ns](const CameraPoseSample& v) { return v.timestamp_ns > until_ns; }),
                      record.views.end());
   if (record.has_objects) record.objects = mapper_.Finish();
-  if (with_grid && !sensors_.depth.empty()) record.grid = grid_.ToData();
+  if (with_grid && has_depth_) record.grid = grid_.ToData();
   return record;
 }
 
 void PatrolRecorder::Finish(PatrolRecord* record, PatrolRecordStats* stats) {
   *record = base_;
   if (active_ && record->has_objects) record->objects = mapper_.Finish();
-  if (active_ && !sensors_.depth.empty()) record->grid = grid_.ToData();
+  if (active_ && has_depth_) record->grid = grid_.ToData();
   stats_.associations = mapper_.associations();
   stats_.association_seconds = mapper_.association_seconds();
   stats_.skipped_detections = mapper_.skipped();

@@ -76,6 +76,49 @@ TEST(PatrolSensors, PosesDetectionsAndDepthOfALog) {
       << capture.text();
 }
 
+// The EuRoC reader hands each frame the samples that belong to it: the poses and depth images since the
+// previous frame (those after the last frame with the last), the pose at its time, and the detections at
+// exactly its time (it then decodes the image even when not asked: the object map needs it).
+TEST(PatrolSensors, TheirSamplesComeWithTheFrames) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);  // frames at 1.00, 1.05 and 1.10 s
+  WriteText(log + "/cam0/sensor.yaml", "rate_hz: 20\nresolution: [32, 24]\nintrinsics: [20, 20, 15.5, 11.5]\n");
+  WriteText(log + "/state_groundtruth_estimate0/data.csv",
+            "1000000000,0,0,2,1,0,0,0,0,0,0\n1100000000,0,1,2,1,0,0,0,0,0,0\n1200000000,0,2,2,1,0,0,0,0,0,0\n");
+  WriteText(log + "/objects0/data.csv",
+            "1000000000,crate,0.8,1,2,11,12\n1000000000,barrel,0.6,20,2,25,9\n1020000000,crate,0.7,2,2,12,12\n"
+            "1050000000,crate,0.7,2,2,12,12\n");
+  std::filesystem::create_directories(log + "/depth0/data");
+  cv::imwrite(log + "/depth0/data/d.png", cv::Mat(24, 32, CV_16UC1, cv::Scalar(4500)));
+  WriteText(log + "/depth0/data.csv", "1000000000,d.png\n1080000000,d.png\n1150000000,d.png\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_TRUE(source->info().has_poses && source->info().has_detections && source->info().has_depth);
+  Frame frame;
+  ASSERT_TRUE(source->Next(false, &frame).ok());  // 1.00 s
+  EXPECT_EQ(frame.poses.size(), 1u);
+  ASSERT_TRUE(frame.pose.has_value());
+  EXPECT_EQ(frame.detections.size(), 2u);
+  ASSERT_EQ(frame.depth.size(), 1u);
+  EXPECT_TRUE(frame.depth[0].pose.has_value());
+  EXPECT_FALSE(frame.image.empty());
+  ASSERT_TRUE(source->Next(false, &frame).ok());  // 1.05 s: the detection at 1.02 s belonged to no frame
+  EXPECT_TRUE(frame.poses.empty());
+  ASSERT_TRUE(frame.pose.has_value());
+  EXPECT_NEAR(frame.pose->position.y(), 0.5, 1e-12);
+  EXPECT_EQ(frame.detections.size(), 1u);
+  EXPECT_TRUE(frame.depth.empty());
+  EXPECT_FALSE(frame.image.empty());
+  ASSERT_TRUE(source->Next(false, &frame).ok());  // 1.10 s, the last: the pose and depth after it too
+  EXPECT_EQ(frame.poses.size(), 2u);
+  EXPECT_TRUE(frame.detections.empty());
+  ASSERT_EQ(frame.depth.size(), 2u);
+  EXPECT_EQ(frame.depth[1].timestamp_ns, 1150000000);
+  EXPECT_TRUE(frame.image.empty());
+  EXPECT_TRUE(source->Next(false, &frame).end_of_stream());
+}
+
 TEST(PatrolSensors, BadTablesNameFileAndLine) {
   TempDir dir;
   const std::string log = dir / "flight";

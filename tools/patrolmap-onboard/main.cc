@@ -73,10 +73,10 @@ void PrintSummary(const Arguments& arguments, const pipeline::FlightRun& run, co
 
 // Opens DIR/events.jsonl when there is a prior flight to compare with.
 Status OpenMonitor(const Arguments& arguments, const graph::TopoMap& prior, const pipeline::Config& config,
-                   const io::PatrolSensors& sensors, std::unique_ptr<pipeline::ChangeMonitor>* monitor) {
+                   std::unique_ptr<pipeline::ChangeMonitor>* monitor) {
   const std::vector<std::string> flights = prior.Flights();
   if (flights.empty()) return Status::Ok();
-  return pipeline::ChangeMonitor::Open(&prior, flights.back(), config, arguments.events, sensors.poses,
+  return pipeline::ChangeMonitor::Open(&prior, flights.back(), config, arguments.events,
                                        arguments.out + "/events.jsonl", monitor);
 }
 
@@ -127,11 +127,9 @@ Status Run(const Arguments& arguments) {
   PATROLMAP_RETURN_IF_ERROR(pipeline::CheckVocabulary(prior, arguments.prior_map, vocabulary, vocabulary_path));
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(arguments, config, &source));
-  io::PatrolSensors sensors;
-  PATROLMAP_RETURN_IF_ERROR(pipeline::ReadFlightSensors(source->info(), &sensors));
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(arguments.out));
   std::unique_ptr<pipeline::ChangeMonitor> monitor;
-  PATROLMAP_RETURN_IF_ERROR(OpenMonitor(arguments, prior, config, sensors, &monitor));
+  PATROLMAP_RETURN_IF_ERROR(OpenMonitor(arguments, prior, config, &monitor));
   place::PlaceRecognizer recognizer(&vocabulary, config.place);
   PATROLMAP_RETURN_IF_ERROR(pipeline::SeedRecognizer(prior, arguments.prior_map, vocabulary, &recognizer));
   pipeline::DriveOptions drive;
@@ -143,8 +141,8 @@ Status Run(const Arguments& arguments) {
   };
   pipeline::MapResult result;
   pipeline::FlightRun run;
-  PATROLMAP_RETURN_IF_ERROR(pipeline::RunFlight(source.get(), config, std::move(sensors), arguments.options, drive,
-                                                &recognizer, &result, monitor.get(), &run));
+  PATROLMAP_RETURN_IF_ERROR(
+      pipeline::RunFlight(source.get(), config, arguments.options, drive, &recognizer, &result, monitor.get(), &run));
   if (run.drive.interrupted) spdlog::info("stop requested: writing the map");
   for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
   PATROLMAP_RETURN_IF_ERROR(WriteOutputs(arguments, config, prior, result, recognizer,

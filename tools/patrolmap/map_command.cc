@@ -50,8 +50,6 @@ Status MapFlight(const MapArguments& arguments, const std::string& log, const pi
                  place::PlaceRecognizer* recognizer, pipeline::MapResult* result, PatrolRecord* record) {
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(io::OpenLog(log, config.input, &source));
-  io::PatrolSensors sensors;
-  PATROLMAP_RETURN_IF_ERROR(pipeline::ReadFlightSensors(source->info(), &sensors));
   if (arguments.every_frame && !source->info().timed) {
     spdlog::warn(
         "{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} before a "
@@ -66,7 +64,7 @@ Status MapFlight(const MapArguments& arguments, const std::string& log, const pi
   drive.progress = [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); };
   pipeline::FlightRun run;
   PATROLMAP_RETURN_IF_ERROR(
-      pipeline::RunFlight(source.get(), config, std::move(sensors), options, drive, recognizer, result, nullptr, &run));
+      pipeline::RunFlight(source.get(), config, options, drive, recognizer, result, nullptr, &run));
   for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
   LogRecord(run.result);
   *record = std::move(run.result.record);

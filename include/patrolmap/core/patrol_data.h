@@ -19,30 +19,10 @@
 
 namespace patrolmap {
 
-// Where the camera was: world_from_camera = (rotation, position).
-struct CameraPoseSample {
-  TimestampNs timestamp_ns = 0;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d ToWorld(const Eigen::Vector3d& in_camera) const { return rotation * in_camera + position; }
-  Eigen::Vector3d ToCamera(const Eigen::Vector3d& in_world) const {
-    return rotation.conjugate() * (in_world - position);
-  }
-};
-
 // The image box around `corners` seen from `pose` through `camera` (not clipped to the image); empty when
 // any of them lies less than 0.1 m in front of the camera.
 cv::Rect2d ProjectCorners(const CameraIntrinsics& camera, const CameraPoseSample& pose,
                           const std::array<Eigen::Vector3d, 8>& corners);
-
-// One object detection of one frame (objects0/data.csv).
-struct ObjectObservation {
-  TimestampNs timestamp_ns = 0;
-  std::string label;
-  double confidence = 0.0;
-  cv::Rect2d box;                                  // in the image [pixels]
-  std::optional<Eigen::Vector3d> centroid_camera;  // 3D centroid in the camera frame, when the detector gives one
-};
 
 // One object of a patrol's object map (paper 000): detections associated
 // across frames, with the label-confidence and label-count accumulators.

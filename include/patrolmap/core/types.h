@@ -6,10 +6,13 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
 
 namespace patrolmap {
 
@@ -41,8 +44,36 @@ struct CameraIntrinsics {
   CameraIntrinsics Scaled(double scale) const;
 };
 
+// Where the camera was: world_from_camera = (rotation, position).
+struct CameraPoseSample {
+  TimestampNs timestamp_ns = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d ToWorld(const Eigen::Vector3d& in_camera) const { return rotation * in_camera + position; }
+  Eigen::Vector3d ToCamera(const Eigen::Vector3d& in_world) const {
+    return rotation.conjugate() * (in_world - position);
+  }
+};
+
+// One object detection of one frame (objects0/data.csv).
+struct ObjectObservation {
+  TimestampNs timestamp_ns = 0;
+  std::string label;
+  double confidence = 0.0;
+  cv::Rect2d box;                                  // in the image [pixels]
+  std::optional<Eigen::Vector3d> centroid_camera;  // 3D centroid in the camera frame, when the detector gives one
+};
+
+// One depth image of the log (depth0/): its file, read when the evidence grid wants it.
+struct DepthSample {
+  TimestampNs timestamp_ns = 0;
+  std::string path;
+  std::optional<CameraPoseSample> pose;  // the camera pose at its time, when the log has poses
+};
+
 // One camera frame with the sensor data that arrived since the previous frame
-// the source returned (so skipping frames never loses IMU samples).
+// the source returned (so skipping frames never loses IMU samples, poses or depth images).
+// Samples after the log's last frame come with it.
 struct Frame {
   TimestampNs timestamp_ns = 0;
   std::int64_t index = 0;              // position in the log, counting unreadable frames too
@@ -50,6 +81,11 @@ struct Frame {
   std::vector<ImuSample> imu;          // samples with previous timestamp < t <= timestamp_ns
   std::optional<double> speed_mps;     // known platform speed, when the log carries it
   std::optional<Eigen::Vector3d> gps;  // latitude, longitude [deg], altitude [m], when the log carries it
+  // What change detection reads, when the log has it (EuRoC: state_groundtruth_estimate0/, objects0/, depth0/):
+  std::vector<CameraPoseSample> poses;        // state estimates with previous timestamp < t <= timestamp_ns
+  std::optional<CameraPoseSample> pose;       // the camera pose at timestamp_ns (interpolated)
+  std::vector<ObjectObservation> detections;  // at timestamp_ns exactly (a frame with some is always decoded)
+  std::vector<DepthSample> depth;             // depth images with previous timestamp < t <= timestamp_ns
 };
 
 // Kind of extremum of the smoothed scene-flow response (paper 002 §III-A).

@@ -42,6 +42,10 @@ struct LogInfo {
   std::string timing;  // where the times came from, for messages
   bool has_imu = false;
   bool has_speed = false;
+  // Change detection's tables (EuRoC): their samples come with the frames (Frame::poses, detections, depth).
+  bool has_poses = false;
+  bool has_detections = false;
+  bool has_depth = false;
 };
 
 // A frame that could not be read and was skipped.

@@ -41,6 +41,11 @@ struct PatrolSensors {
 // Malformed rows fail with the file and line.
 Status ReadPatrolSensors(const std::string& log, PatrolSensors* sensors);
 
+// The same tables under `root` (the folder holding cam0/), with the camera's rotation in the body frame
+// (EuRoC T_BS of cam0) turning body poses into camera poses. The EuRoC reader hands their samples out with
+// the frames.
+Status ReadSensorTables(const std::string& root, const Eigen::Matrix3d& body_from_camera, PatrolSensors* sensors);
+
 // The camera pose at `timestamp_ns`, interpolated between the two nearest
 // samples; nullopt when it lies outside the samples or in a gap longer than
 // `max_gap_ns`.

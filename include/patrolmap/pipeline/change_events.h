@@ -14,8 +14,10 @@
 // report that no event announced follow, marked "final": true (the report in changes.json is the reference).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -39,14 +41,15 @@ class ChangeMonitor {
  public:
   // Compares with flight `prior_flight` of `prior` (both outlive the monitor); appends to `path`.
   static Status Open(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
-                     const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, const std::string& path,
+                     const ChangeEventOptions& options, const std::string& path,
                      std::unique_ptr<ChangeMonitor>* monitor);
   ~ChangeMonitor();
   ChangeMonitor(const ChangeMonitor&) = delete;
   ChangeMonitor& operator=(const ChangeMonitor&) = delete;
 
-  // Place stage's thread: a new node of the flight and its loop closure (may be null).
-  void OnNode(const MapNode& node, const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer);
+  // Place stage's thread: a new node of the flight, the camera pose there and its loop closure (may be null).
+  void OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose, const MapLoopClosure* closure,
+              const place::PlaceRecognizer& recognizer);
   // Change stage's thread: after each step of the patrol record.
   void OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
   // After the flight: the final report's changes that no event announced. `map` holds both flights.
@@ -59,7 +62,7 @@ class ChangeMonitor {
 
  private:
   ChangeMonitor(const graph::TopoMap* prior, const std::string& prior_flight, const Config& config,
-                const ChangeEventOptions& options, std::vector<CameraPoseSample> poses, int fd);
+                const ChangeEventOptions& options, int fd);
   void Send(const Event& event, bool final_event);
   void CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
 
@@ -68,7 +71,8 @@ class ChangeMonitor {
   const PatrolRecord* prior_record_;
   Config config_;
   ChangeEventOptions options_;
-  std::vector<CameraPoseSample> poses_;
+  std::map<int, Eigen::Vector3d> node_positions_;  // place thread until Close()
+  TimestampNs last_ns_ = 0;                        // change thread until Close()
   int fd_;
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;

@@ -21,7 +21,6 @@
 #include "patrolmap/core/status.h"
 #include "patrolmap/flow/key_location_detector.h"
 #include "patrolmap/io/frame_source.h"
-#include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/pipeline/config.h"
 #include "patrolmap/pipeline/detect.h"
 #include "patrolmap/pipeline/map.h"
@@ -67,9 +66,8 @@ class FlightPass {
  public:
   // `recognizer` (may already hold earlier flights) and `places` are used by the place stage only, until
   // Finish(); `monitor` (may be null) is told of key frames and of the record as it grows.
-  FlightPass(const Config& config, const io::LogInfo& info, io::PatrolSensors sensors,
-             place::PlaceRecognizer* recognizer, MapResult* places, const FlightPassOptions& options,
-             ChangeMonitor* monitor = nullptr);
+  FlightPass(const Config& config, const io::LogInfo& info, place::PlaceRecognizer* recognizer, MapResult* places,
+             const FlightPassOptions& options, ChangeMonitor* monitor = nullptr);
   ~FlightPass();
   FlightPass(const FlightPass&) = delete;
   FlightPass& operator=(const FlightPass&) = delete;
@@ -92,6 +90,7 @@ class FlightPass {
     cv::Mat image;
     double heading = 0.0;
     std::optional<Eigen::Vector3d> gps;
+    std::optional<CameraPoseSample> pose;
   };
   void Remember(const Frame& frame, const cv::Mat& image);
   Status HandKeyLocation(const KeyLocation& key_location);
@@ -140,10 +139,6 @@ struct DriveResult {
 // when the source or a stage fails; an end of stream is success.
 Status Drive(io::FrameSource* source, FlightPass* pass, const DriveOptions& options, DriveResult* result);
 
-// The sensor tables of the log `info` describes (poses, detections, depth; none for a live camera or a log
-// without them).
-Status ReadFlightSensors(const io::LogInfo& info, io::PatrolSensors* sensors);
-
 struct FlightRun {
   FlightResult result;
   DriveResult drive;
@@ -152,8 +147,8 @@ struct FlightRun {
 
 // One flight through a FlightPass driven by `drive`: its nodes and loop closures go to `places` (after those
 // of earlier flights), the rest to `run`. Fails when no frame could be read.
-Status RunFlight(io::FrameSource* source, const Config& config, io::PatrolSensors sensors,
-                 const FlightPassOptions& options, const DriveOptions& drive, place::PlaceRecognizer* recognizer,
-                 MapResult* places, ChangeMonitor* monitor, FlightRun* run);
+Status RunFlight(io::FrameSource* source, const Config& config, const FlightPassOptions& options,
+                 const DriveOptions& drive, place::PlaceRecognizer* recognizer, MapResult* places,
+                 ChangeMonitor* monitor, FlightRun* run);
 
 }  // namespace patrolmap::pipeline

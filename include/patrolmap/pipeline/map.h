@@ -63,6 +63,7 @@ struct KeyFrameInput {
   place::KeyFrame key_frame;
   double heading = 0.0;
   std::optional<Eigen::Vector3d> gps;
+  std::optional<CameraPoseSample> pose;  // when the log has poses
 };
 
 // The place stage of a mapping run: recognises each key frame's place and records its node and loop

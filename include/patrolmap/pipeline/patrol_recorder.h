@@ -2,10 +2,10 @@
 // object map from the detections at each frame (with the frame's image and depth), the evidence grid from
 // the depth images at change.grid.rate_hz, and the views that say where the camera looked.
 //
-// The pass's frame thread calls Collect() for every frame: it picks the sensor samples that belong to the
-// frame (cheap; no image is read). The change thread calls Apply() for each piece of work in the order it
-// was collected: it reads depth images and updates the object map and the grid. One thread or two, the
-// record is the same.
+// The pass's frame thread calls Collect() for every frame: it turns the samples the frame brings (poses,
+// detections, depth images; io::FrameSource) into work (cheap; no depth image is read). The change thread calls Apply()
+// for each piece of work in the order it was collected: it reads depth images and updates the object map and the grid.
+// One thread or two, the record is the same.
 #pragma once
 
 #include <optional>
@@ -18,6 +18,7 @@
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/status.h"
+#include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/pipeline/config.h"
 
@@ -33,10 +34,12 @@ struct PatrolRecordStats {
   long long evicted_voxels = 0;  // the grid's least recently observed voxels, dropped at its memory budget
 };
 
-// One step of the change stage: the detections of a frame, or one depth image for the grid.
+// One step of the change stage: the detections of a frame, or one depth image for the grid; either carries
+// the views sampled since the previous step (kViews: those alone, at the end).
 struct ChangeWork {
-  enum class Kind { kObjects, kGrid };
+  enum class Kind { kObjects, kGrid, kViews };
   Kind kind = Kind::kGrid;
+  std::vector<CameraPoseSample> views;
   TimestampNs timestamp_ns = 0;
   std::optional<CameraPoseSample> pose;       // at timestamp_ns; none: the step is skipped
   std::vector<ObjectObservation> detections;  // kObjects
@@ -46,17 +49,15 @@ struct ChangeWork {
 
 class PatrolRecorder {
  public:
-  // `sensors` from io::ReadPatrolSensors. Without poses or a camera nothing but the camera is recorded.
-  PatrolRecorder(const Config& config, io::PatrolSensors sensors);
+  // For the log `info` describes. Without poses or a camera nothing but the camera is recorded.
+  PatrolRecorder(const Config& config, const io::LogInfo& info);
 
   // Whether the record has anything to build (poses, a camera, and detections or depth).
   bool active() const { return active_; }
-  // Whether the next frames may need their image (detections remain to be placed).
-  bool WantsImages() const { return active_ && next_detection_ < sensors_.detections.size(); }
 
-  // Frame thread: appends the work due at `frame` (its detections; depth images up to its time).
+  // Frame thread: appends the work `frame` brings (its detections; its depth images) and the views it adds.
   void Collect(const Frame& frame, std::vector<ChangeWork>* work);
-  // Frame thread, after the last frame: the depth images after it.
+  // Frame thread, after the last frame: the views not yet handed on.
   void CollectRest(std::vector<ChangeWork>* work);
 
   // Change thread: one step, in the order collected. An unreadable depth image is reported, counted and
@@ -70,14 +71,15 @@ class PatrolRecorder {
   void Finish(PatrolRecord* record, PatrolRecordStats* stats);
 
  private:
-  void CollectDepth(TimestampNs until_ns, std::vector<ChangeWork>* work);
   bool ReadDepth(const std::string& path, cv::Mat* depth);
 
   Config config_;
-  io::PatrolSensors sensors_;
   bool active_ = false;
-  PatrolRecord base_;  // flight, camera, views
-  std::size_t next_detection_ = 0, next_depth_ = 0;
+  bool has_depth_ = false;
+  PatrolRecord base_;  // flight, camera; views on the change thread
+  // Frame thread:
+  TimestampNs next_view_ns_;
+  std::vector<CameraPoseSample> pending_views_;
   // Change thread:
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;
