@@ -42,6 +42,11 @@ TEST(Routes, WaypointFileErrorsNameFileAndLine) {
   testing::WriteText(dir / "w.csv", "0,0\n20,0\n20,10\n");
   ASSERT_TRUE(ReadWaypoints(dir / "w.csv", &route).ok());
   EXPECT_EQ(route.waypoints.size(), 3u);
+  testing::WriteText(dir / "w.csv", "x,y\n0,0\n20,0\n");  // a header row
+  ASSERT_TRUE(ReadWaypoints(dir / "w.csv", &route).ok());
+  EXPECT_EQ(route.waypoints.size(), 2u);
+  testing::WriteText(dir / "w.csv", "0,0\nx,y\n");  // ... only as the first
+  EXPECT_NE(ReadWaypoints(dir / "w.csv", &route).message().find("w.csv:2:"), std::string::npos);
 }
 
 // Integrates the trajectory's own rates and compares them with its positions and headings.

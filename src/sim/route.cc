@@ -196,8 +196,12 @@ Status ReadWaypoints(const std::string& path, Route* route) {
   route->waypoints.clear();
   std::vector<std::string_view> fields;
   Status status;
+  bool first = true;
   while ((status = csv.NextRow(&fields)).ok()) {
     if (fields.size() < 2) return csv.Error("expected x,y");
+    const bool header = first && fields[0] == "x" && fields[1] == "y";  // a header row is allowed
+    first = false;
+    if (header) continue;
     Eigen::Vector2d point;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[0], "x [m]", &point.x()));
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[1], "y [m]", &point.y()));
