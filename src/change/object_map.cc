@@ -288,6 +288,7 @@ void ObjectMapper::Update(int index, const ObjectObservation& detection, Measure
     object.id = static_cast<int>(objects_.size());
     object.first_seen_ns = detection.timestamp_ns;
     object.descriptor.assign(measured.descriptor.size(), 0.0f);
+    if (static_cast<int>(objects_.size()) >= options_.max_objects) ForgetOne();
     objects_.push_back(std::move(object));
     sizes_.push_back(Eigen::Vector2d::Zero());
     index = static_cast<int>(objects_.size()) - 1;
@@ -313,6 +314,20 @@ void ObjectMapper::Update(int index, const ObjectObservation& detection, Measure
   evidence->confidence_sum += detection.confidence;
   ++evidence->count;
   AssignFinalLabel(&object);
+}
+
+// Forgets the unconfirmed object seen longest ago, or with none the object seen longest ago.
+void ObjectMapper::ForgetOne() {
+  const auto older = [this](const MapObject& a, const MapObject& b) {
+    const bool a_unconfirmed = a.detections < options_.min_detections;
+    const bool b_unconfirmed = b.detections < options_.min_detections;
+    if (a_unconfirmed != b_unconfirmed) return a_unconfirmed;
+    return a.last_seen_ns < b.last_seen_ns;
+  };
+  const auto victim = std::min_element(objects_.begin(), objects_.end(), older);
+  sizes_.erase(sizes_.begin() + (victim - objects_.begin()));
+  objects_.erase(victim);
+  ++forgotten_;
 }
 
 void ObjectMapper::AddFrame(const std::vector<ObjectObservation>& detections, const CameraPoseSample& pose,

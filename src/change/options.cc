@@ -33,6 +33,7 @@ void CheckObjectMap(const ObjectMapOptions& m, OptionCheck* check) {
       .InRange("change.object_map.min_category_prior", m.min_category_prior, 0.0, 1.0)
       .InRange("change.object_map.merge_distance_m", m.merge_distance_m, 0.0, 1000.0)
       .InRange("change.object_map.min_detections", m.min_detections, 1, 1000000)
+      .InRange("change.object_map.max_objects", m.max_objects, 1, 10000000)
       .AboveAtMost("change.object_map.max_range_m", m.max_range_m, 0.0, 10000.0);
 }
 

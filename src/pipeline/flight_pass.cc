@@ -223,6 +223,11 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
                        " key location(s) were confirmed after their frame left the ring of recent frames and are "
                        "not in the map; raise the ring (--ring-s)");
   }
+  if (result.record_stats.forgotten_objects > 0) {
+    warnings.push_back(info.path + ": the object map reached change.object_map.max_objects; " +
+                       std::to_string(result.record_stats.forgotten_objects) +
+                       " objects seen longest ago (unconfirmed ones first) were forgotten");
+  }
   const PatrolRecordStats& grid = result.record_stats;
   if (grid.evicted_voxels > 0 || grid.dropped_voxel_updates > 0) {
     warnings.push_back(info.path + ": the evidence grid reached change.grid.memory_mb; " +

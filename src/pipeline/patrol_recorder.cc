@@ -121,6 +121,7 @@ void PatrolRecorder::Finish(PatrolRecord* record, PatrolRecordStats* stats) {
   stats_.associations = mapper_.associations();
   stats_.association_seconds = mapper_.association_seconds();
   stats_.skipped_detections = mapper_.skipped();
+  stats_.forgotten_objects = mapper_.forgotten();
   stats_.dropped_voxel_updates = grid_.dropped_updates();
   stats_.evicted_voxels = grid_.evicted_voxels();
   *stats = stats_;

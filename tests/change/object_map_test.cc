@@ -106,6 +106,30 @@ TEST(ObjectMap, DetectionsBecomeObjectsWithAccumulatedLabels) {
   EXPECT_EQ(mapper.associations(), 25);
 }
 
+// At change.object_map.max_objects the map forgets an unconfirmed object before any confirmed one, the one
+// seen longest ago first.
+TEST(ObjectMap, AFullMapForgetsTheUnconfirmedObjectSeenLongestAgo) {
+  ObjectMapOptions options;
+  options.max_objects = 3;
+  ObjectMapper mapper(options, kCamera);
+  cv::RNG rng(7);
+  const Eigen::Vector3d crate(10, 0.5, 0.5), barrel(12, -1.0, 0.5), ghost(9, 2.0, 0.5), ghost2(11, 2.5, 0.5);
+  for (int frame = 0; frame < 8; ++frame) {
+    const CameraPoseSample pose = LookingAlongX(Eigen::Vector3d(0.2 * frame, 0, 1.5));
+    std::vector<ObjectObservation> detections = {Detection("crate", 0.8, pose, crate, 0.1, &rng)};
+    if (frame < 6) detections.push_back(Detection("barrel", 0.6, pose, barrel, 0.1, &rng));  // seen longest ago
+    if (frame == 4) detections.push_back(Detection("crate", 0.9, pose, ghost, 0.1, &rng));
+    if (frame == 7) detections.push_back(Detection("crate", 0.9, pose, ghost2, 0.1, &rng));
+    for (ObjectObservation& detection : detections) detection.timestamp_ns = frame;
+    mapper.AddFrame(detections, pose, cv::Mat(), cv::Mat());
+  }
+  EXPECT_EQ(mapper.forgotten(), 1);
+  const std::vector<MapObject> objects = mapper.Finish();
+  ASSERT_EQ(objects.size(), 3u);  // crate, barrel and the second ghost: the first ghost went, not the barrel
+  EXPECT_LT((objects[1].centroid - barrel).norm(), 0.2);
+  EXPECT_LT((objects[2].centroid - ghost2).norm(), 0.2);
+}
+
 TEST(ObjectMap, PointPairTestSeparatesNeighboursTheGateCannot) {
   ObjectMapOptions options;
   options.centroid_gate_m = 1.5;

@@ -48,6 +48,7 @@ class ObjectMapper {
   int associations() const { return associations_; }  // detections compared with the map
   double association_seconds() const { return association_seconds_; }
   int skipped() const { return skipped_; }
+  int forgotten() const { return forgotten_; }  // objects dropped at change.object_map.max_objects
 
  private:
   struct Candidate;
@@ -66,6 +67,7 @@ class ObjectMapper {
   double SurfaceAgreement(const MapObject& object, const cv::Rect2d& box, const CameraPoseSample& pose,
                           const cv::Mat& depth_m) const;
   void Update(int object, const ObjectObservation& detection, Measured&& measured);
+  void ForgetOne();
 
   ObjectMapOptions options_;
   CameraIntrinsics camera_;
@@ -75,6 +77,7 @@ class ObjectMapper {
   int associations_ = 0;
   double association_seconds_ = 0.0;
   int skipped_ = 0;
+  int forgotten_ = 0;
 };
 
 // Shares of nearest-neighbour pairs closer than `distance`: for each point of

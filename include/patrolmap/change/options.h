@@ -38,6 +38,9 @@ struct ObjectMapOptions {
   double merge_distance_m = 0.5;    // when the patrol ends, objects whose centroids are this close merge
   int min_detections = 3;           // objects seen fewer times stay unconfirmed: never reported themselves
   double max_range_m = 25.0;        // detections farther than this are ignored
+  // Objects kept at most (memory stays bounded over long flights: a few kB each with their points); beyond,
+  // the unconfirmed object seen longest ago is forgotten (with none, the object seen longest ago).
+  int max_objects = 5000;
 };
 
 // State of every object between two patrols (papers 000, 001, 003).

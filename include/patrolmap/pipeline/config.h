@@ -98,6 +98,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.object_map.merge_distance_m", &change.object_map.merge_distance_m);
   visitor->Field("change.object_map.min_detections", &change.object_map.min_detections);
   visitor->Field("change.object_map.max_range_m", &change.object_map.max_range_m);
+  visitor->Field("change.object_map.max_objects", &change.object_map.max_objects);
   visitor->Field("change.objects.match_distance_m", &change.objects.match_distance_m);
   visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
   visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);

@@ -26,6 +26,7 @@ namespace patrolmap::pipeline {
 
 struct PatrolRecordStats {
   int detections = 0, associations = 0, skipped_detections = 0;
+  int forgotten_objects = 0;  // dropped at change.object_map.max_objects
   double association_seconds = 0.0;
   int depth_frames = 0;
   int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
