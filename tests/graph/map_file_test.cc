@@ -196,6 +196,29 @@ void DowngradeEdges(std::string* bytes) {
   bytes->replace(tag, 20 + length, section + old);
 }
 
+// A version-3 map (before the grid counted the voxels its memory budget dropped) loads, with none dropped.
+TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
+  testing::TempDir dir;
+  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
+  std::string bytes = testing::ReadText(dir / "m.pmap");
+  const std::size_t tag = bytes.find("PTRL", 16);
+  ASSERT_NE(tag, std::string::npos);
+  std::uint64_t length = 0;
+  std::memcpy(&length, bytes.data() + tag + 4, 8);
+  const std::uint64_t old_length = length - 8;  // the one patrol's evicted-voxel count, its last field, goes
+  bytes.erase(tag + 20 + old_length, 8);
+  std::memcpy(bytes.data() + tag + 4, &old_length, 8);
+  const std::uint32_t version = 3;
+  std::memcpy(bytes.data() + 8, &version, sizeof(version));
+  testing::RecomputeMapChecksums(&bytes);
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << bytes;
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
+  ASSERT_NE(map.Patrol("b"), nullptr);
+  EXPECT_EQ(map.Patrol("b")->grid.voxels.size(), 3u);
+  EXPECT_EQ(map.Patrol("b")->grid.evicted_voxels, 0);
+}
+
 TEST(MapFile, VersionOneFilesStillLoad) {
   testing::TempDir dir;
   ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
