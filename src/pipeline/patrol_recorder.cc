@@ -14,10 +14,10 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
     : config_(config),
+      next_view_ns_(std::numeric_limits<TimestampNs>::min()),
       mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
-      next_grid_ns_(std::numeric_limits<TimestampNs>::min()),
-      next_view_ns_(std::numeric_limits<TimestampNs>::min()) {
+      next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
   base_.flight = info.flight_id;
   if (info.camera) base_.camera = *info.camera;
   if (!info.has_poses || !info.camera) return;
