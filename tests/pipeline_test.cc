@@ -356,6 +356,7 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/flight_pass.h"
 #include "patrolmap/pipeline/map.h"
+#include "patrolmap/pipeline/patrol_recorder.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -389,6 +390,35 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
   vocabulary_options.branching = 8;
   vocabulary_options.depth = 3;
   ASSERT_TRUE(vocab::Vocabulary::Train(training, vocabulary_options, vocabulary).ok());
+}
+
+// The patrol recorder turns a frame's samples into work: each depth image for the grid, and the detections
+// with the depth image of the frame's own time only (none when the depth camera missed that instant).
+TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
+  io::LogInfo info;
+  info.camera = CameraIntrinsics{40.0, 40.0, 31.5, 23.5, 64, 48};
+  info.has_poses = info.has_detections = info.has_depth = true;
+  PatrolRecorder recorder(Config{}, info);
+  ASSERT_TRUE(recorder.active());
+  Frame frame;
+  frame.timestamp_ns = 1000;
+  frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(0));
+  frame.pose = CameraPoseSample{1000, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
+  frame.detections.resize(2);
+  frame.depth = {{990, "early.png", frame.pose}, {1000, "own.png", frame.pose}};
+  std::vector<ChangeWork> work;
+  recorder.Collect(frame, &work);
+  ASSERT_EQ(work.size(), 3u);  // two depth images for the grid, then the detections
+  EXPECT_EQ(work[0].kind, ChangeWork::Kind::kGrid);
+  EXPECT_EQ(work[2].kind, ChangeWork::Kind::kObjects);
+  EXPECT_EQ(work[2].detections.size(), 2u);
+  EXPECT_EQ(work[2].depth_path, "own.png");
+  frame.timestamp_ns = 2000;
+  frame.depth = {{1990, "early.png", frame.pose}, {2010, "late.png", frame.pose}};
+  work.clear();
+  recorder.Collect(frame, &work);
+  ASSERT_EQ(work.size(), 3u);
+  EXPECT_EQ(work[2].depth_path, "");
 }
 
 // Maps `log` through the per-frame pass into `result` (after the nodes it holds).
