@@ -354,6 +354,7 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 
 #include "patrolmap/eval/loop_closure_score.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/pipeline/change_events.h"
 #include "patrolmap/pipeline/flight_pass.h"
 #include "patrolmap/pipeline/map.h"
 #include "patrolmap/pipeline/patrol_recorder.h"
@@ -419,6 +420,61 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   recorder.Collect(frame, &work);
   ASSERT_EQ(work.size(), 3u);
   EXPECT_EQ(work[2].depth_path, "");
+}
+
+// Onboard events: an object the prior patrol did not have is announced once two checks in a row find it, as
+// one whole JSON line.
+TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
+  testing::TempDir dir;
+  const CameraIntrinsics camera{40.0, 40.0, 31.5, 23.5, 64, 48};
+  graph::TopoMap prior;
+  PatrolRecord before;
+  before.flight = "before";
+  before.camera = camera;
+  before.has_objects = true;  // ... and none seen
+  prior.SetPatrol(before);
+  Config config;
+  ChangeEventOptions options;
+  options.interval_s = 1.0;
+  options.settle_s = 0.0;
+  std::unique_ptr<ChangeMonitor> monitor;
+  ASSERT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
+  io::LogInfo info;
+  info.camera = camera;
+  info.has_poses = info.has_detections = true;
+  PatrolRecorder recorder(config, info);
+  std::vector<ChangeWork> work;
+  int events_after_first_check = -1;
+  for (int i = 0; i <= 25; ++i) {  // frames every 0.1 s; checks at 1 s and 2 s
+    Frame frame;
+    frame.timestamp_ns = SecondsToNs(0.1 * i);
+    frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(100));
+    frame.pose = CameraPoseSample{frame.timestamp_ns, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
+    frame.poses = {*frame.pose};
+    if (i < 5) {  // a crate 5 m ahead
+      ObjectObservation crate{frame.timestamp_ns, "crate", 0.9, cv::Rect2d(22, 14, 20, 20), Eigen::Vector3d(0, 0, 5)};
+      frame.detections = {crate};
+    }
+    work.clear();
+    recorder.Collect(frame, &work);
+    if (work.empty()) {  // a frame without detections still advances the checks
+      ChangeWork step;
+      step.kind = ChangeWork::Kind::kViews;
+      step.timestamp_ns = frame.timestamp_ns;
+      work.push_back(step);
+    }
+    for (const ChangeWork& step : work) {
+      recorder.Apply(step);
+      monitor->OnChangeStep(step.timestamp_ns, recorder);
+    }
+    if (i == 15) events_after_first_check = monitor->events();
+  }
+  EXPECT_EQ(events_after_first_check, 0);
+  EXPECT_EQ(monitor->events(), 1);
+  const std::string text = testing::ReadText(dir / "events.jsonl");
+  EXPECT_NE(text.find("\"type\":\"object_new\""), std::string::npos) << text;
+  EXPECT_NE(text.find("\"id\":\"object-p-1-c0\""), std::string::npos) << text;
+  EXPECT_EQ(text.back(), '\n');
 }
 
 // Maps `log` through the per-frame pass into `result` (after the nodes it holds).
