@@ -84,7 +84,9 @@ sys.exit(0 if ok else 1)
 PY
 done
 
-# Killed (SIGKILL) at random moments while it writes events: every line present is whole JSON.
+# Killed (SIGKILL) at random moments while it writes events: every line present is whole JSON, and the kills
+# came while lines were being written (some runs left lines).
+lines_left=0
 for attempt in 1 2 3 4 5; do
   rm -rf "$work/killed"
   "$onboard" -q "$work/village1/flight_2" --map "$work/village1/m1/map.pmap" --fast --events-interval-s 0.5 \
@@ -98,7 +100,9 @@ import json, sys
 text = open('$work/killed/events.jsonl').read()
 [json.loads(line) for line in text.splitlines()]
 sys.exit(0 if not text or text.endswith('\n') else 1)"
+  lines_left=$((lines_left + $(wc -l <"$work/killed/events.jsonl" 2>/dev/null || echo 0)))
 done
+check "SIGKILL: the killed runs had written events" test "$lines_left" -gt 0
 
 output=$("$onboard" "$work/nothing" --vocabulary "$vocabulary" --out "$work/o" 2>&1)
 check "missing log exits 1" test $? -eq 1

@@ -13,7 +13,7 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 }  // namespace
 
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
-    : config_(config),
+    : grid_step_ns_(SecondsToNs(1.0 / config.change.grid.rate_hz)),
       next_view_ns_(std::numeric_limits<TimestampNs>::min()),
       mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
@@ -99,7 +99,7 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     return;
   }
   grid_.Integrate(depth_, base_.camera, *work.pose);
-  next_grid_ns_ = work.timestamp_ns + SecondsToNs(1.0 / config_.change.grid.rate_hz);
+  next_grid_ns_ = work.timestamp_ns + grid_step_ns_;
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

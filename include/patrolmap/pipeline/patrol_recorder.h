@@ -74,7 +74,7 @@ class PatrolRecorder {
  private:
   bool ReadDepth(const std::string& path, cv::Mat* depth);
 
-  Config config_;
+  TimestampNs grid_step_ns_;  // change.grid.rate_hz
   bool active_ = false;
   bool has_depth_ = false;
   PatrolRecord base_;  // flight, camera; views on the change thread
