@@ -16,9 +16,15 @@ class Progress {
     if (enabled_ && shown_) std::fprintf(stderr, "\n");
   }
 
-  // Shows "what: done/total (rate/s)"; total < 0 when unknown.
+  // Shows "what: done/total (rate/s)"; total < 0 when unknown. A count that goes down starts a new line (the
+  // next of several logs).
   void Update(std::int64_t done, std::int64_t total) {
     if (!enabled_) return;
+    if (done < last_done_) {
+      std::fprintf(stderr, "\n");
+      start_ = std::chrono::steady_clock::now();
+    }
+    last_done_ = done;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double rate = seconds > 0.0 ? done / seconds : 0.0;
     if (total > 0) {
@@ -34,6 +40,7 @@ class Progress {
   const char* what_;
   bool enabled_;
   bool shown_ = false;
+  std::int64_t last_done_ = 0;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 

@@ -1,0 +1,152 @@
+// Wiring of a mapping run (mapping.h).
+#include "patrolmap/pipeline/mapping.h"
+
+#include <algorithm>
+#include <memory>
+
+#include <spdlog/spdlog.h>
+
+#include "patrolmap/core/files.h"
+#include "patrolmap/graph/map_file.h"
+#include "patrolmap/io/readers.h"
+#include "patrolmap/pipeline/change.h"
+#include "patrolmap/pipeline/detect.h"
+
+namespace patrolmap::pipeline {
+namespace {
+
+const char kCameraPrefix[] = "camera:";
+
+bool IsCamera(const std::string& source) { return source.rfind(kCameraPrefix, 0) == 0; }
+
+Status OpenSource(const std::string& spec, const io::ImageFolderOptions& options,
+                  std::unique_ptr<io::FrameSource>* source) {
+  if (!IsCamera(spec)) return io::OpenLog(spec, options, source);
+  const std::string device = spec.substr(sizeof(kCameraPrefix) - 1);
+  if (device.empty() || device.size() > 6 || !std::all_of(device.begin(), device.end(), ::isdigit)) {
+    return Status::InvalidArgument(spec + ": expected camera:N with a device number N");
+  }
+  return io::OpenCamera(std::stoi(device), options, source);
+}
+
+// Everything the request names is checked before any work: a missing log first (the likeliest mistake), then
+// outputs that would overwrite inputs, the options, the configuration.
+Status CheckRequest(const MappingRequest& request, Config* config) {
+  if (request.sources.empty()) return Status::InvalidArgument("no flight log given");
+  for (const std::string& source : request.sources) {
+    if (IsCamera(source)) continue;
+    PATROLMAP_RETURN_IF_ERROR(io::CheckLogExists(source));
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out, source, "flight log"));
+  }
+  if (!request.prior_map.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out + "/map.pmap", request.prior_map, "prior map"));
+  }
+  std::string error;
+  if (!request.pass.IsValid(&error)) return Status::InvalidArgument(error);
+  if (request.events && !request.events->IsValid(&error)) return Status::InvalidArgument(error);
+  PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, config));
+  if (request.fps > 0.0) config->input.frame_rate_hz = request.fps;
+  return Status::Ok();
+}
+
+// What the patrol record of a flight holds, on the log.
+void LogRecord(const FlightResult& flight) {
+  const PatrolRecord& record = flight.record;
+  const PatrolRecordStats& stats = flight.record_stats;
+  if (record.has_objects) {
+    const auto confirmed =
+        std::count_if(record.objects.begin(), record.objects.end(), [](const MapObject& o) { return o.confirmed; });
+    spdlog::info("{}: {} objects ({} more seen too rarely) from {} detections ({:.3f} ms per association)",
+                 record.flight, confirmed, record.objects.size() - static_cast<std::size_t>(confirmed),
+                 stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
+  }
+  if (record.grid.voxel_size > 0) {
+    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s", record.flight,
+                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds);
+  }
+}
+
+Status WriteFlightOutputs(const MappingRequest& request, const io::LogInfo& info, const FlightResult& flight) {
+  switch (request.outputs) {
+    case FlightOutputs::kDetection:
+      return WriteDetectionOutputs(flight.detection,
+                                   request.sources.size() > 1 ? request.out + "/" + info.flight_id : request.out);
+    case FlightOutputs::kKeyLocations:
+      return WriteFileAtomically(request.out + "/key_locations.csv", KeyLocationsCsv(flight.detection.key_locations));
+    case FlightOutputs::kNone: return Status::Ok();
+  }
+  return Status::Ok();
+}
+
+// One source through the per-frame pass; its nodes and loop closures go to `outcome->places`.
+Status MapSource(const MappingRequest& request, const std::string& spec, const Config& config,
+                 place::PlaceRecognizer* recognizer, ChangeMonitor* monitor, MappingOutcome* outcome) {
+  std::unique_ptr<io::FrameSource> source;
+  PATROLMAP_RETURN_IF_ERROR(OpenSource(spec, config.input, &source));
+  const io::LogInfo& info = source->info();
+  if (request.pass.node_every > 0 && !info.timed) {
+    spdlog::warn(
+        "{}: no timestamps: every image is a node, and images at most place.exclude_recent_images = {} before a "
+        "query are not its candidates",
+        spec, config.place.exclude_recent_images);
+  }
+  DriveOptions drive = request.drive;
+  drive.paced = drive.paced && info.kind != "camera";
+  FlightRun& run = outcome->flights.emplace_back();
+  PATROLMAP_RETURN_IF_ERROR(
+      RunFlight(source.get(), config, request.pass, drive, recognizer, &outcome->places, monitor, &run));
+  if (run.drive.interrupted) spdlog::info("{}: stop requested: writing the map", spec);
+  for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
+  LogRecord(run.result);
+  return WriteFlightOutputs(request, info, run.result);
+}
+
+// The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes.
+graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecognizer& recognizer,
+                           const graph::TopoMap::VocabularyTag& tag, MappingOutcome* outcome) {
+  graph::TopoMap map = BuildTopoMap(outcome->places, recognizer, &prior);
+  map.set_vocabulary(tag);
+  for (FlightRun& run : outcome->flights) {
+    PatrolRecord& record = run.result.record;
+    const bool has_nodes = std::any_of(outcome->places.nodes.begin(), outcome->places.nodes.end(),
+                                       [&record](const MapNode& node) { return node.flight == record.flight; });
+    if (has_nodes) map.SetPatrol(std::move(record));
+  }
+  return map;
+}
+
+}  // namespace
+
+Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
+  Config config;
+  PATROLMAP_RETURN_IF_ERROR(CheckRequest(request, &config));
+  graph::TopoMap prior;
+  if (!request.prior_map.empty()) PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(request.prior_map, &prior));
+  vocab::Vocabulary vocabulary;
+  std::string vocabulary_path;
+  PATROLMAP_RETURN_IF_ERROR(LoadSiftVocabulary(request.vocabulary_path, &vocabulary, &vocabulary_path));
+  PATROLMAP_RETURN_IF_ERROR(CheckVocabulary(prior, request.prior_map, vocabulary, vocabulary_path));
+  place::PlaceRecognizer recognizer(&vocabulary, config.place);
+  PATROLMAP_RETURN_IF_ERROR(SeedRecognizer(prior, request.prior_map, vocabulary, &recognizer));
+  PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(request.out));
+  std::unique_ptr<ChangeMonitor> monitor;
+  const std::vector<std::string> prior_flights = prior.Flights();
+  if (request.events && !prior_flights.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(ChangeMonitor::Open(&prior, prior_flights.back(), config, *request.events,
+                                                  request.out + "/events.jsonl", &monitor));
+  }
+  outcome->flights.reserve(request.sources.size());
+  for (const std::string& source : request.sources) {
+    PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, &recognizer, monitor.get(), outcome));
+  }
+  graph::TopoMap map = AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), outcome);
+  if (!request.prior_map.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(
+        ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared));
+  }
+  if (monitor != nullptr && outcome->compared) PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map));
+  if (monitor != nullptr) outcome->events = monitor->events();
+  return SaveMapRun(&map, request.out);
+}
+
+}  // namespace patrolmap::pipeline
