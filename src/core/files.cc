@@ -12,21 +12,6 @@
 namespace patrolmap {
 namespace {
 
-Status WriteAll(int fd, const std::string& content, const std::string& path) {
-  const char* data = content.data();
-  std::size_t left = content.size();
-  while (left > 0) {
-    const ssize_t written = ::write(fd, data, left);
-    if (written < 0) {
-      if (errno == EINTR) continue;
-      return Status::IoError(path + ": write failed: " + std::strerror(errno));
-    }
-    data += written;
-    left -= static_cast<std::size_t>(written);
-  }
-  return Status::Ok();
-}
-
 // Removes path.tmp.<pid> files whose process is gone.
 void RemoveStaleTemporaries(const std::string& path) {
   namespace fs = std::filesystem;
@@ -61,23 +46,60 @@ Status RefuseOverwritingInput(const std::string& output, const std::string& inpu
   return Status::InvalidArgument(output + " would replace " + input + " (the " + what + "); choose another output");
 }
 
-Status WriteFileAtomically(const std::string& path, const std::string& content) {
+Status AtomicFile::Open(const std::string& path, AtomicFile* file) {
+  file->Abandon();
   RemoveStaleTemporaries(path);
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return Status::IoError(temporary + ": cannot create: " + std::strerror(errno));
-  Status status = WriteAll(fd, content, temporary);
-  if (status.ok() && ::fsync(fd) != 0) {
-    status = Status::IoError(temporary + ": fsync failed: " + std::strerror(errno));
+  file->path_ = path;
+  file->temporary_ = path + ".tmp." + std::to_string(::getpid());
+  file->fd_ = ::open(file->temporary_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (file->fd_ < 0) return Status::IoError(file->temporary_ + ": cannot create: " + std::strerror(errno));
+  return Status::Ok();
+}
+
+AtomicFile::~AtomicFile() { Abandon(); }
+
+void AtomicFile::Abandon() {
+  if (fd_ < 0) return;
+  ::close(fd_);
+  std::remove(temporary_.c_str());
+  fd_ = -1;
+}
+
+Status AtomicFile::Write(const char* data, std::size_t size) {
+  if (fd_ < 0) return Status::IoError(path_ + ": write to a file that is not open");
+  while (size > 0) {
+    const ssize_t written = ::write(fd_, data, size);
+    if (written < 0) {
+      if (errno == EINTR) continue;
+      const Status status = Status::IoError(temporary_ + ": write failed: " + std::strerror(errno));
+      Abandon();
+      return status;
+    }
+    data += written;
+    size -= static_cast<std::size_t>(written);
   }
-  if (::close(fd) != 0 && status.ok()) {
-    status = Status::IoError(temporary + ": close failed: " + std::strerror(errno));
+  return Status::Ok();
+}
+
+Status AtomicFile::Commit() {
+  if (fd_ < 0) return Status::IoError(path_ + ": commit of a file that is not open");
+  Status status;
+  if (::fsync(fd_) != 0) status = Status::IoError(temporary_ + ": fsync failed: " + std::strerror(errno));
+  if (::close(fd_) != 0 && status.ok())
+    status = Status::IoError(temporary_ + ": close failed: " + std::strerror(errno));
+  fd_ = -1;
+  if (status.ok() && std::rename(temporary_.c_str(), path_.c_str()) != 0) {
+    status = Status::IoError(path_ + ": rename failed: " + std::strerror(errno));
   }
-  if (status.ok() && std::rename(temporary.c_str(), path.c_str()) != 0) {
-    status = Status::IoError(path + ": rename failed: " + std::strerror(errno));
-  }
-  if (!status.ok()) std::remove(temporary.c_str());
+  if (!status.ok()) std::remove(temporary_.c_str());
   return status;
+}
+
+Status WriteFileAtomically(const std::string& path, const std::string& content) {
+  AtomicFile file;
+  PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
+  PATROLMAP_RETURN_IF_ERROR(file.Write(content));
+  return file.Commit();
 }
 
 Status EnsureDirectory(const std::string& path) {

@@ -214,12 +214,15 @@ std::string VocabularySection(const TopoMap& map) {
   return std::move(w.bytes());
 }
 
-void AppendSection(const char (&tag)[5], const std::string& payload, std::string* file) {
-  file->append(tag, 4);
+// Writes one section (tag, length, checksum, payload): the file is written a section at a time, so saving holds
+// one section in memory besides the map, not the whole file.
+Status WriteSection(const char (&tag)[5], const std::string& payload, AtomicFile* file) {
+  std::string header(tag, 4);
   const std::uint64_t length = payload.size(), checksum = Checksum(payload.data(), payload.size());
-  file->append(reinterpret_cast<const char*>(&length), 8);
-  file->append(reinterpret_cast<const char*>(&checksum), 8);
-  file->append(payload);
+  header.append(reinterpret_cast<const char*>(&length), 8);
+  header.append(reinterpret_cast<const char*>(&checksum), 8);
+  PATROLMAP_RETURN_IF_ERROR(file->Write(header));
+  return file->Write(payload);
 }
 
 Status Corrupt(const std::string& path, const std::string& what) {
@@ -441,15 +444,18 @@ Status ParseSection(const std::string& path, std::uint32_t version, const std::s
 }  // namespace
 
 Status SaveMap(const TopoMap& map, const std::string& path) {
-  std::string file(kMagic, 8);
+  AtomicFile file;
+  PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
+  std::string start(kMagic, 8);
   const std::uint32_t header[2] = {kVersion, 5};
-  file.append(reinterpret_cast<const char*>(header), sizeof(header));
-  AppendSection("NODE", NodeSection(map), &file);
-  AppendSection("EDGE", EdgeSection(map), &file);
-  AppendSection("FEAT", FeatureSection(map), &file);
-  AppendSection("PTRL", PatrolSection(map), &file);
-  AppendSection("VOCB", VocabularySection(map), &file);
-  return WriteFileAtomically(path, file);
+  start.append(reinterpret_cast<const char*>(header), sizeof(header));
+  PATROLMAP_RETURN_IF_ERROR(file.Write(start));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("NODE", NodeSection(map), &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("EDGE", EdgeSection(map), &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("FEAT", FeatureSection(map), &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("PTRL", PatrolSection(map), &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("VOCB", VocabularySection(map), &file));
+  return file.Commit();
 }
 
 Status LoadMap(const std::string& path, TopoMap* map) {

@@ -1,19 +1,38 @@
 // File helpers shared by every stage that writes results.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "patrolmap/core/status.h"
 
 namespace patrolmap {
 
-// Writes `content` to `path` atomically: a temporary file beside it is written,
-// flushed to disk and renamed over `path`, so readers see either the old file
-// or the complete new one, never a half-written file.
-Status WriteFileAtomically(const std::string& path, const std::string& content);
+// A file written atomically in pieces: a temporary file beside `path` (path.tmp.<pid>) takes the pieces and
+// Commit() flushes it to disk and renames it over `path`, so readers see either the old file or the complete
+// new one, never a half-written file. Without a successful Commit() the temporary is removed. Temporaries of
+// `path` left by a process that no longer runs (a killed run) are removed when it opens.
+class AtomicFile {
+ public:
+  static Status Open(const std::string& path, AtomicFile* file);
+  AtomicFile() = default;
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
 
-// Writes `content` to `path` atomically: ... (above). Temporaries of `path` left by a process that no longer
-// runs (path.tmp.<pid>, a killed run) are removed first.
+  Status Write(const char* data, std::size_t size);
+  Status Write(const std::string& bytes) { return Write(bytes.data(), bytes.size()); }
+  Status Commit();
+
+ private:
+  void Abandon();
+
+  std::string path_, temporary_;
+  int fd_ = -1;
+};
+
+// Writes `content` to `path` atomically (AtomicFile).
+Status WriteFileAtomically(const std::string& path, const std::string& content);
 
 // Creates `path` and its parents when missing.
 Status EnsureDirectory(const std::string& path);
