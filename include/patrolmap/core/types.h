@@ -64,11 +64,24 @@ struct ObjectObservation {
   std::optional<Eigen::Vector3d> centroid_camera;  // 3D centroid in the camera frame, when the detector gives one
 };
 
-// One depth image of the log (depth0/): its file, read when the evidence grid wants it.
+// A calibrated stereo pair (EuRoC cam0 and cam1 with their sensor.yaml): the intrinsics and the
+// radial-tangential distortion (k1, k2, p1, p2) of each camera, and where the right camera sits in the left
+// one's frame: x_right = right_from_left_rotation * x_left + right_from_left_translation [m].
+struct StereoCalibration {
+  CameraIntrinsics left, right;
+  std::array<double, 4> left_distortion{}, right_distortion{};
+  Eigen::Matrix3d right_from_left_rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d right_from_left_translation = Eigen::Vector3d::Zero();
+};
+
+// Depth of the log at one time, read when the change stage wants it: a depth image (depth0/), or the two
+// images of a stereo pair (cam0/ and cam1/) that the depth stage matches.
 struct DepthSample {
   TimestampNs timestamp_ns = 0;
-  std::string path;
+  std::string path;                      // the depth image; for a stereo pair the left (cam0) image
+  std::string right_path;                // the right (cam1) image of a stereo pair; empty for a depth image
   std::optional<CameraPoseSample> pose;  // the camera pose at its time, when the log has poses
+  bool stereo() const { return !right_path.empty(); }
 };
 
 // One camera frame with the sensor data that arrived since the previous frame

@@ -1,0 +1,194 @@
+#include "patrolmap/depth/stereo.h"
+
+#include <cmath>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/core/option_check.h"
+
+namespace patrolmap::depth {
+
+// Buffers of one matching, reused from frame to frame.
+struct MatchBuffers {
+  cv::Mat padded_left, padded_right, padded_disparity, flipped_left, flipped_right, right_view;
+};
+
+namespace {
+
+cv::Mat CameraMatrix(const CameraIntrinsics& camera) {
+  return (cv::Mat_<double>(3, 3) << camera.fx, 0, camera.cx, 0, camera.fy, camera.cy, 0, 0, 1);
+}
+
+cv::Mat Distortion(const std::array<double, 4>& coefficients) {
+  return (cv::Mat_<double>(1, 4) << coefficients[0], coefficients[1], coefficients[2], coefficients[3]);
+}
+
+cv::Ptr<cv::StereoSGBM> CreateMatcher(const StereoOptions& options) {
+  const int area = options.block_size * options.block_size;
+  return cv::StereoSGBM::create(0, options.num_disparities, options.block_size, 8 * area, 32 * area, -1, 0,
+                                options.uniqueness_ratio, options.speckle_window, options.speckle_range,
+                                options.full_paths ? cv::StereoSGBM::MODE_HH : cv::StereoSGBM::MODE_SGBM_3WAY);
+}
+
+// SGBM leaves the first num_disparities columns of the left view unmatched (their search would leave the
+// image). Both images are padded on the left by that many replicated columns, so every real column gets a
+// disparity; those pointing into the padding fail the left-right check.
+void MatchPadded(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, int pad, MatchBuffers* buffers,
+                 cv::Mat* disparity) {
+  cv::copyMakeBorder(left, buffers->padded_left, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+  cv::copyMakeBorder(right, buffers->padded_right, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+  matcher->compute(buffers->padded_left, buffers->padded_right, buffers->padded_disparity);
+  buffers->padded_disparity.colRange(pad, buffers->padded_disparity.cols).copyTo(*disparity);
+}
+
+// Disparity of the left view in SGBM's fixed point (CV_16S, 1/16 px; 0 or below: none). With the left-right
+// check the right view's disparity is matched too (the pair mirrored), and a left disparity is kept only where
+// the right view's, at the pixel it points to, agrees within max_lr_difference.
+void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
+               MatchBuffers* buffers, cv::Mat* disparity) {
+  MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
+  if (!options.lr_check) return;
+  cv::flip(left, buffers->flipped_left, 1);
+  cv::flip(right, buffers->flipped_right, 1);
+  // Mirrored: column w-1-x of the result is column x of the right view.
+  MatchPadded(matcher, buffers->flipped_right, buffers->flipped_left, options.num_disparities, buffers,
+              &buffers->right_view);
+  const int scale = cv::StereoMatcher::DISP_SCALE;
+  const int tolerance = options.max_lr_difference * scale;
+  const int width = disparity->cols;
+  for (int y = 0; y < disparity->rows; ++y) {
+    std::int16_t* d = disparity->ptr<std::int16_t>(y);
+    const std::int16_t* mirrored = buffers->right_view.ptr<std::int16_t>(y);
+    for (int x = 0; x < width; ++x) {
+      if (d[x] <= 0) continue;
+      const int xr = x - (d[x] + scale / 2) / scale;
+      const std::int16_t back = xr >= 0 ? mirrored[width - 1 - xr] : -1;
+      if (back <= 0 || std::abs(back - d[x]) > tolerance) d[x] = -1;
+    }
+  }
+}
+
+// Left pinhole grid -> rectified left pixel, and the factor turning a rectified depth into a left one.
+void BackMaps(const CameraIntrinsics& left, const cv::Mat& rotation, const cv::Mat& projection, cv::Mat* map_x,
+              cv::Mat* map_y, cv::Mat* scale) {
+  map_x->create(left.height, left.width, CV_32F);
+  map_y->create(left.height, left.width, CV_32F);
+  scale->create(left.height, left.width, CV_32F);
+  const cv::Matx33d r(rotation);
+  const double fx = projection.at<double>(0, 0), fy = projection.at<double>(1, 1);
+  const double cx = projection.at<double>(0, 2), cy = projection.at<double>(1, 2);
+  for (int v = 0; v < left.height; ++v) {
+    for (int u = 0; u < left.width; ++u) {
+      const cv::Vec3d ray = r * cv::Vec3d((u - left.cx) / left.fx, (v - left.cy) / left.fy, 1.0);
+      const bool ahead = ray[2] > 1e-6;
+      map_x->at<float>(v, u) = ahead ? static_cast<float>(fx * ray[0] / ray[2] + cx) : -1.0f;
+      map_y->at<float>(v, u) = ahead ? static_cast<float>(fy * ray[1] / ray[2] + cy) : -1.0f;
+      scale->at<float>(v, u) = ahead ? static_cast<float>(1.0 / ray[2]) : 0.0f;
+    }
+  }
+}
+
+}  // namespace
+
+bool StereoOptions::IsValid(std::string* error) const {
+  OptionCheck check(error);
+  check.InRange("depth.stereo.num_disparities", num_disparities, 16, 512)
+      .Holds("depth.stereo.num_disparities", num_disparities, num_disparities % 16 == 0, "must be a multiple of 16")
+      .InRange("depth.stereo.block_size", block_size, 1, 21)
+      .Holds("depth.stereo.block_size", block_size, block_size % 2 == 1, "must be odd")
+      .InRange("depth.stereo.uniqueness_ratio", uniqueness_ratio, 0, 100)
+      .InRange("depth.stereo.max_lr_difference", max_lr_difference, 0, 64)
+      .InRange("depth.stereo.speckle_window", speckle_window, 0, 10000)
+      .InRange("depth.stereo.speckle_range", speckle_range, 1, 64)
+      .AboveAtMost("depth.stereo.min_range_m", min_range_m, 0.0, 1000.0)
+      .AboveAtMost("depth.stereo.max_range_m", max_range_m, 0.0, 1000.0)
+      .Holds("depth.stereo.max_range_m", max_range_m, max_range_m > min_range_m,
+             "must be above depth.stereo.min_range_m")
+      .InRange("depth.stereo.disparity_sigma_px", disparity_sigma_px, 0.0, 16.0);
+  return check.ok();
+}
+
+void ComputeDisparity(const cv::Mat& left, const cv::Mat& right, const StereoOptions& options, cv::Mat* disparity) {
+  cv::Mat fixed_point;
+  MatchBuffers buffers;
+  MatchPair(CreateMatcher(options).get(), left, right, options, &buffers, &fixed_point);
+  fixed_point.convertTo(*disparity, CV_32F, 1.0 / cv::StereoMatcher::DISP_SCALE);
+}
+
+Status StereoDepth::Create(const StereoCalibration& calibration, const StereoOptions& options,
+                           std::unique_ptr<StereoDepth>* stereo) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::InvalidArgument(error);
+  if (!calibration.left.valid() || !calibration.right.valid()) {
+    return Status::InvalidArgument("stereo pair: a camera has no valid intrinsics or resolution");
+  }
+  const double baseline = calibration.right_from_left_translation.norm();
+  if (!(baseline > 1e-4))
+    return Status::InvalidArgument("stereo pair: the cameras are at the same place (no baseline)");
+  std::unique_ptr<StereoDepth> result(new StereoDepth());
+  result->options_ = options;
+  result->left_size_ = cv::Size(calibration.left.width, calibration.left.height);
+  result->right_size_ = cv::Size(calibration.right.width, calibration.right.height);
+  result->rectified_size_ = result->left_size_;
+  cv::Mat rotation, translation;
+  cv::eigen2cv(calibration.right_from_left_rotation, rotation);
+  cv::eigen2cv(calibration.right_from_left_translation, translation);
+  const cv::Mat k_left = CameraMatrix(calibration.left), k_right = CameraMatrix(calibration.right);
+  const cv::Mat d_left = Distortion(calibration.left_distortion), d_right = Distortion(calibration.right_distortion);
+  cv::Mat r_left, r_right, p_left, p_right, q;
+  cv::stereoRectify(k_left, d_left, k_right, d_right, result->left_size_, rotation, translation, r_left, r_right,
+                    p_left, p_right, q, cv::CALIB_ZERO_DISPARITY, 0.0, result->rectified_size_);
+  // Side by side: the right camera's projection shifts x only (a vertical pair would shift y).
+  if (std::abs(p_right.at<double>(1, 3)) > 1e-6 * std::abs(p_right.at<double>(0, 3))) {
+    return Status::InvalidArgument(
+        "stereo pair: the cameras are one above the other; only side-by-side pairs are matched");
+  }
+  result->focal_px_ = p_left.at<double>(0, 0);
+  result->baseline_m_ = std::abs(p_right.at<double>(0, 3) / p_right.at<double>(0, 0));
+  result->range_sigma_per_m2_ = options.disparity_sigma_px / (result->focal_px_ * result->baseline_m_);
+  cv::initUndistortRectifyMap(k_left, d_left, r_left, p_left, result->rectified_size_, CV_16SC2, result->left_map_x_,
+                              result->left_map_y_);
+  cv::initUndistortRectifyMap(k_right, d_right, r_right, p_right, result->rectified_size_, CV_16SC2,
+                              result->right_map_x_, result->right_map_y_);
+  BackMaps(calibration.left, r_left, p_left, &result->back_x_, &result->back_y_, &result->back_scale_);
+  result->matcher_ = CreateMatcher(options);
+  result->buffers_ = std::make_unique<MatchBuffers>();
+  *stereo = std::move(result);
+  return Status::Ok();
+}
+
+StereoDepth::~StereoDepth() = default;
+
+Status StereoDepth::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* depth_m) {
+  if (left.type() != CV_8UC1 || right.type() != CV_8UC1) {
+    return Status::InvalidArgument("stereo pair: images must be 8-bit grey");
+  }
+  if (left.size() != left_size_ || right.size() != right_size_) {
+    return Status::InvalidArgument(
+        "stereo pair: images are " + std::to_string(left.cols) + "x" + std::to_string(left.rows) + " and " +
+        std::to_string(right.cols) + "x" + std::to_string(right.rows) + ", the calibration says " +
+        std::to_string(left_size_.width) + "x" + std::to_string(left_size_.height) + " and " +
+        std::to_string(right_size_.width) + "x" + std::to_string(right_size_.height));
+  }
+  cv::remap(left, left_rectified_, left_map_x_, left_map_y_, cv::INTER_LINEAR);
+  cv::remap(right, right_rectified_, right_map_x_, right_map_y_, cv::INTER_LINEAR);
+  MatchPair(matcher_.get(), left_rectified_, right_rectified_, options_, buffers_.get(), &disparity_);
+  // Rectified depth f * b / d, unknown outside the range (and where no disparity was found).
+  rectified_depth_.create(disparity_.size(), CV_32F);
+  const double focal_baseline = focal_px_ * baseline_m_ * cv::StereoMatcher::DISP_SCALE;
+  for (int y = 0; y < disparity_.rows; ++y) {
+    const std::int16_t* d = disparity_.ptr<std::int16_t>(y);
+    float* z = rectified_depth_.ptr<float>(y);
+    for (int x = 0; x < disparity_.cols; ++x) {
+      const double range = d[x] > 0 ? focal_baseline / d[x] : 0.0;
+      z[x] = range >= options_.min_range_m && range <= options_.max_range_m ? static_cast<float>(range) : 0.0f;
+    }
+  }
+  cv::remap(rectified_depth_, *depth_m, back_x_, back_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::multiply(*depth_m, back_scale_, *depth_m);
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::depth
