@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/eval/key_location_score.h"
@@ -60,7 +61,7 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   KeyKinds kinds;
   Config defaults;
   VisitConfig(&defaults, &kinds);
-  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 84u);  // every numeric key (the rest are switches)
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 95u);  // every numeric key (the rest are switches)
   const auto refused = [&](const std::string& key, const std::string& value) {
     testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
     Config config;
@@ -406,7 +407,7 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(0));
   frame.pose = CameraPoseSample{1000, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
   frame.detections.resize(2);
-  frame.depth = {{990, "early.png", frame.pose}, {1000, "own.png", frame.pose}};
+  frame.depth = {{990, "early.png", "", frame.pose}, {1000, "own.png", "", frame.pose}};
   std::vector<ChangeWork> work;
   recorder.Collect(frame, &work);
   ASSERT_EQ(work.size(), 3u);  // two depth images for the grid, then the detections
@@ -415,7 +416,7 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   EXPECT_EQ(work[2].detections.size(), 2u);
   EXPECT_EQ(work[2].depth_path, "own.png");
   frame.timestamp_ns = 2000;
-  frame.depth = {{1990, "early.png", frame.pose}, {2010, "late.png", frame.pose}};
+  frame.depth = {{1990, "early.png", "", frame.pose}, {2010, "late.png", "", frame.pose}};
   work.clear();
   recorder.Collect(frame, &work);
   ASSERT_EQ(work.size(), 3u);
@@ -424,6 +425,85 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
 
 // Onboard events: an object the prior patrol did not have is announced once two checks in a row find it, as
 // one whole JSON line.
+// A simulated street flown with a depth camera and a stereo pair 0.5 m wide (logged as EuRoC cam0 + cam1
+// with their sensor.yaml): the reader pairs the images, and the depth stage, from the calibration it read,
+// gives the depth of depth0/ (the renderer's exact depth) wherever it finds one.
+class StereoStreet : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::TempDir();
+    sim::StreetOptions street;
+    street.walls = 2;
+    street.speed_mps = 5.0;
+    sim::LogOptions options;
+    options.depth = true;
+    options.stereo_baseline_m = 0.5;
+    ASSERT_TRUE(sim::WriteEurocLog(sim::MakeStreetFlight(street), *dir_ / "log", options).ok());
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static testing::TempDir* dir_;
+};
+testing::TempDir* StereoStreet::dir_ = nullptr;
+
+TEST_F(StereoStreet, StereoDepthAgreesWithTheDepthCamera) {
+  std::unique_ptr<io::FrameSource> source;
+  ASSERT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
+  const io::LogInfo& info = source->info();
+  ASSERT_TRUE(info.has_stereo && info.has_depth);
+  EXPECT_NEAR(info.stereo->right_from_left_translation.norm(), 0.5, 1e-9);
+  std::unique_ptr<depth::StereoDepth> stereo;
+  ASSERT_TRUE(depth::StereoDepth::Create(*info.stereo, depth::StereoOptions(), &stereo).ok());
+  Frame frame;
+  int truth = 0, found = 0, close = 0;
+  std::vector<double> errors;
+  while (source->Next(false, &frame).ok()) {
+    if (frame.index % 40 != 0) continue;
+    const DepthSample* images = nullptr;
+    const DepthSample* pair = nullptr;
+    for (const DepthSample& sample : frame.depth) (sample.stereo() ? pair : images) = &sample;
+    ASSERT_TRUE(images != nullptr && pair != nullptr);
+    EXPECT_EQ(pair->timestamp_ns, images->timestamp_ns);
+    cv::Mat exact, matched;
+    ASSERT_TRUE(io::ReadDepthImage(images->path, &exact).ok());
+    ASSERT_TRUE(stereo
+                    ->Compute(cv::imread(pair->path, cv::IMREAD_GRAYSCALE),
+                              cv::imread(pair->right_path, cv::IMREAD_GRAYSCALE), &matched)
+                    .ok());
+    for (int y = 0; y < exact.rows; y += 4) {
+      for (int x = 0; x < exact.cols; x += 4) {
+        const float z = exact.at<float>(y, x), m = matched.at<float>(y, x);
+        if (z <= 0 || z > 15) continue;
+        ++truth;
+        if (m <= 0) continue;
+        ++found;
+        close += std::abs(m - z) <= stereo->RangeSigma(z) * 4 + 0.05;
+      }
+    }
+  }
+  ASSERT_GT(truth, 1000);
+  std::printf("stereo street: %d of %d depth pixels matched, %d of them within 4 range errors\n", found, truth, close);
+  EXPECT_GT(found, 0.7 * truth);
+  EXPECT_GT(close, 0.95 * found);
+}
+
+TEST_F(StereoStreet, TheRecordTakesTheDepthTheConfigurationChooses) {
+  const auto source_of = [](depth::DepthSource choice) {
+    std::unique_ptr<io::FrameSource> source;
+    EXPECT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
+    Config config;
+    config.depth.source = choice;
+    PatrolRecorder recorder(config, source->info());
+    PatrolRecord record;
+    PatrolRecordStats stats;
+    recorder.Finish(&record, &stats);
+    return record.depth_source;
+  };
+  EXPECT_EQ(source_of(depth::DepthSource::kAuto), "images");
+  EXPECT_EQ(source_of(depth::DepthSource::kImages), "images");
+  EXPECT_EQ(source_of(depth::DepthSource::kStereo), "stereo");
+  EXPECT_EQ(source_of(depth::DepthSource::kNone), "");
+}
+
 TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
   testing::TempDir dir;
   const CameraIntrinsics camera{40.0, 40.0, 31.5, 23.5, 64, 48};

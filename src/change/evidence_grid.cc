@@ -194,7 +194,7 @@ bool EvidenceGrid::Evict() {
   return true;
 }
 
-void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit) {
+void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit, double hold_back_m) {
   const Eigen::Vector3d a = origin / options_.voxel_size_m + Eigen::Vector3d::Constant(0.5);
   const Eigen::Vector3d b = end / options_.voxel_size_m + Eigen::Vector3d::Constant(0.5);
   Eigen::Vector3i voxel = a.array().floor().cast<int>();
@@ -214,6 +214,10 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
     t_delta[axis] = std::abs(1.0 / d[axis]);
   }
   int remaining = (last - voxel).cwiseAbs().sum();
+  // Voxels entered after t_free (of the way from origin to end) lie within the return's uncertainty: not free.
+  const double length = (end - origin).norm();
+  const double t_free = length > 0.0 ? 1.0 - hold_back_m / length : 1.0;
+  double t_entry = 0.0;
   const auto count = [this](const Eigen::Vector3i& v, bool is_hit) {
     Slot* slot = Find(PackKey(v));
     if (slot == nullptr) return void(++dropped_);
@@ -222,15 +226,17 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
     slot->stamp = stamp_;
   };
   while (remaining-- > 0) {
-    count(voxel, false);
+    if (t_entry < t_free) count(voxel, false);
     const int axis = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
     voxel[axis] += step[axis];
+    t_entry = t_max[axis];
     t_max[axis] += t_delta[axis];
   }
   count(last, hit);
 }
 
-void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose) {
+void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose,
+                             double range_sigma_per_m2) {
   constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
   ++stamp_;
   const int step =
@@ -244,7 +250,11 @@ void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& cam
       const double length = depth * ray.norm();
       const bool hit = depth < kNoReturnBeyond && length <= options_.max_range_m;
       const double traced = hit ? depth : options_.max_range_m / ray.norm();
-      TraceRay(pose.position, pose.ToWorld(traced * ray), hit);
+      // Free space ends free_space_sigmas range errors before a return (the error grows with depth squared).
+      const double sigma = range_sigma_per_m2 * length * length;
+      // A return too uncertain to place in a voxel still says the space before it is free.
+      const double hold_back = hit ? options_.free_space_sigmas * sigma : 0.0;
+      TraceRay(pose.position, pose.ToWorld(traced * ray), hit && sigma <= options_.max_hit_sigma_m, hold_back);
     }
   }
 }

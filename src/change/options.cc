@@ -57,6 +57,8 @@ void CheckGrid(const EvidenceGridOptions& g, OptionCheck* check) {
              "must be under 10000 voxels (change.grid.voxel_size_m)")
       .InRange("change.grid.rays_per_row", g.rays_per_row, 1, 10000)
       .AboveAtMost("change.grid.rate_hz", g.rate_hz, 0.0, 1000.0)
+      .InRange("change.grid.free_space_sigmas", g.free_space_sigmas, 0.0, 10.0)
+      .AboveAtMost("change.grid.max_hit_sigma_m", g.max_hit_sigma_m, 0.0, 1000.0)
       .InRange("change.grid.memory_mb", g.memory_mb, 1.0, 65536.0);
 }
 

@@ -77,8 +77,15 @@ json GeometryJson(const GeometryChange& g) {
   return {{"voxel_size", g.voxel_size},
           {"compared_voxels", g.compared_voxels},
           {"evicted_voxels", {{"prior", g.evicted_prior}, {"current", g.evicted_current}}},
+          {"depth_source", {{"prior", g.depth_prior}, {"current", g.depth_current}}},
           {"changed_voxels", g.changed_voxels.size()},
           {"regions", regions}};
+}
+
+const char* DepthWords(const std::string& source) {
+  if (source == "images") return "depth images";
+  if (source == "stereo") return "stereo matching";
+  return "unrecorded";
 }
 
 // The key frame with regions outlined, twice its size.
@@ -214,7 +221,11 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
          << report.ObjectsIn(ObjectState::kPersistent) << " persistent, " << report.ObjectsIn(ObjectState::kUnobserved)
          << " unobserved.";
   }
-  if (report.geometry_compared) html << " Geometry: " << report.geometry.regions.size() << " changed regions.";
+  if (report.geometry_compared) {
+    html << " Geometry: " << report.geometry.regions.size() << " changed regions (depth: "
+         << DepthWords(report.geometry.depth_prior) << " in the prior patrol, "
+         << DepthWords(report.geometry.depth_current) << " in this one).";
+  }
   if (report.geometry_compared && (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0)) {
     html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped their least "
             "recently observed voxels: "

@@ -6,8 +6,6 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "patrolmap/core/option_check.h"
-
 namespace patrolmap::depth {
 
 // Buffers of one matching, reused from frame to frame.
@@ -91,24 +89,6 @@ void BackMaps(const CameraIntrinsics& left, const cv::Mat& rotation, const cv::M
 }
 
 }  // namespace
-
-bool StereoOptions::IsValid(std::string* error) const {
-  OptionCheck check(error);
-  check.InRange("depth.stereo.num_disparities", num_disparities, 16, 512)
-      .Holds("depth.stereo.num_disparities", num_disparities, num_disparities % 16 == 0, "must be a multiple of 16")
-      .InRange("depth.stereo.block_size", block_size, 1, 21)
-      .Holds("depth.stereo.block_size", block_size, block_size % 2 == 1, "must be odd")
-      .InRange("depth.stereo.uniqueness_ratio", uniqueness_ratio, 0, 100)
-      .InRange("depth.stereo.max_lr_difference", max_lr_difference, 0, 64)
-      .InRange("depth.stereo.speckle_window", speckle_window, 0, 10000)
-      .InRange("depth.stereo.speckle_range", speckle_range, 1, 64)
-      .AboveAtMost("depth.stereo.min_range_m", min_range_m, 0.0, 1000.0)
-      .AboveAtMost("depth.stereo.max_range_m", max_range_m, 0.0, 1000.0)
-      .Holds("depth.stereo.max_range_m", max_range_m, max_range_m > min_range_m,
-             "must be above depth.stereo.min_range_m")
-      .InRange("depth.stereo.disparity_sigma_px", disparity_sigma_px, 0.0, 16.0);
-  return check.ok();
-}
 
 void ComputeDisparity(const cv::Mat& left, const cv::Mat& right, const StereoOptions& options, cv::Mat* disparity) {
   cv::Mat fixed_point;

@@ -16,7 +16,7 @@ namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped
-constexpr std::uint32_t kVersion = 4;
+constexpr std::uint32_t kVersion = 5;
 constexpr std::uint32_t kOldestVersion = 1;
 constexpr int kDescriptorWidth = 128;  // SIFT
 
@@ -203,6 +203,7 @@ std::string PatrolSection(const TopoMap& map) {
     w.Value(p.grid.voxel_size);
     w.Vector(p.grid.voxels);
     w.Value<std::int64_t>(p.grid.evicted_voxels);
+    w.String(p.depth_source);
   }
   return std::move(w.bytes());
 }
@@ -397,13 +398,15 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     p.grid.voxel_size = r->Value<double>();
     p.grid.voxels = r->Vector<VoxelEvidence>();
     if (version >= 4) p.grid.evicted_voxels = r->Value<std::int64_t>();
+    if (version >= 5) p.depth_source = r->String();
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
     for (const MapObject& object : p.objects) {
       if (!ValidObject(object)) return Corrupt(path, "object " + std::to_string(object.id) + " of patrol " + p.flight);
     }
-    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid) || p.grid.evicted_voxels < 0) {
+    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid) || p.grid.evicted_voxels < 0 ||
+        (p.depth_source != "" && p.depth_source != "images" && p.depth_source != "stereo")) {
       return Corrupt(path, "evidence grid of " + p.flight);
     }
     map->SetPatrol(std::move(p));

@@ -1,7 +1,9 @@
 // EuRoC/ASL flight-log reader (DESIGN.md "Flight logs").
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include <spdlog/spdlog.h>
 #include <Eigen/Geometry>
@@ -19,12 +21,13 @@ namespace fs = std::filesystem;
 namespace patrolmap::io {
 namespace {
 
-Status ReadCameraTable(const std::string& log, std::vector<ImageEntry>* entries) {
-  const std::string path = log + "/cam0/data.csv";
-  const auto parse = [&log](const CsvReader& csv, const std::vector<std::string_view>& fields, ImageEntry* entry) {
+// CAMERA/data.csv: timestamp, file name under CAMERA/data/.
+Status ReadCameraTable(const std::string& log, const std::string& camera, std::vector<ImageEntry>* entries) {
+  const std::string path = log + "/" + camera + "/data.csv";
+  const auto parse = [&](const CsvReader& csv, const std::vector<std::string_view>& fields, ImageEntry* entry) {
     std::string name;
     PATROLMAP_RETURN_IF_ERROR(ParseFileName(csv, fields[1], &name));
-    entry->path = log + "/cam0/data/" + name;
+    entry->path = log + "/" + camera + "/data/" + name;
     return Status::Ok();
   };
   PATROLMAP_RETURN_IF_ERROR(ReadTimedTable(path, 2, parse, entries));
@@ -82,9 +85,12 @@ Status ReadRate(const std::string& path, const YAML::Node& root, const char* key
   return Status::Ok();
 }
 
-// Reads T_BS (body from sensor) of a sensor.yaml; identity when absent.
-Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen::Matrix3d* rotation) {
+// Reads T_BS (body from sensor) of a sensor.yaml: its rotation, and its translation when `translation` is
+// not null; identity when absent.
+Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen::Matrix3d* rotation,
+                          Eigen::Vector3d* translation = nullptr) {
   rotation->setIdentity();
+  if (translation != nullptr) translation->setZero();
   if (!root["T_BS"]) return Status::Ok();
   if (!root["T_BS"].IsMap()) return Status::DataLoss(path + ": 'T_BS' must be a map with 'data'");
   std::vector<double> data;
@@ -94,7 +100,86 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
   }
   for (int row = 0; row < 3; ++row) {
     for (int col = 0; col < 3; ++col) (*rotation)(row, col) = data[row * 4 + col];
+    if (translation != nullptr) (*translation)[row] = data[row * 4 + 3];
   }
+  return Status::Ok();
+}
+
+// A camera of a stereo pair: its intrinsics, distortion and pose in the body frame.
+struct StereoCamera {
+  CameraIntrinsics intrinsics;
+  std::array<double, 4> distortion{};
+  Eigen::Matrix3d body_rotation;
+  Eigen::Vector3d body_translation;
+};
+
+// CAMERA/sensor.yaml for stereo matching: pinhole with radial-tangential distortion (k1, k2, p1, p2; none
+// when absent).
+Status ReadStereoCamera(const std::string& path, StereoCamera* camera) {
+  YAML::Node root;
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
+  std::vector<double> intrinsics, resolution, distortion(4, 0.0);
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
+  camera->intrinsics = {intrinsics[0],
+                        intrinsics[1],
+                        intrinsics[2],
+                        intrinsics[3],
+                        static_cast<int>(resolution[0]),
+                        static_cast<int>(resolution[1])};
+  if (!camera->intrinsics.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
+  if (root["distortion_model"]) {
+    const std::string model = root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "";
+    if (model != "radial-tangential" && model != "radtan") {
+      return Status::DataLoss(path + ": distortion_model '" + model +
+                              "' is not radial-tangential, the only one stereo matching undoes");
+    }
+  }
+  if (root["distortion_coefficients"]) {
+    PATROLMAP_RETURN_IF_ERROR(
+        ReadNumbers(path, root["distortion_coefficients"], "distortion_coefficients", 4, &distortion));
+  }
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(distortion[i])) return Status::DataLoss(path + ": distortion_coefficients must be finite");
+    camera->distortion[i] = distortion[i];
+  }
+  return ReadBodyFromSensor(path, root, &camera->body_rotation, &camera->body_translation);
+}
+
+// The stereo pair of a log with cam1/ (both sensor.yaml and data.csv): its calibration, and one entry per cam0
+// frame that cam1 saw at the same time (left and right image). Nothing when the log has no cam1/.
+Status ReadStereoPairs(const std::string& log, const std::vector<ImageEntry>& left_entries,
+                       std::optional<StereoCalibration>* calibration, std::vector<DepthEntry>* pairs) {
+  if (!fs::exists(log + "/cam1/data.csv") || !fs::exists(log + "/cam1/sensor.yaml")) return Status::Ok();
+  if (!fs::exists(log + "/cam0/sensor.yaml")) {
+    spdlog::warn("{}: cam1/ present but cam0/sensor.yaml missing: the stereo pair's calibration is unknown", log);
+    return Status::Ok();
+  }
+  StereoCamera left, right;
+  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam0/sensor.yaml", &left));
+  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam1/sensor.yaml", &right));
+  StereoCalibration pair;
+  pair.left = left.intrinsics;
+  pair.right = right.intrinsics;
+  pair.left_distortion = left.distortion;
+  pair.right_distortion = right.distortion;
+  // x_right = R_BC1^T (R_BC0 x_left + t_BC0 - t_BC1)
+  pair.right_from_left_rotation = right.body_rotation.transpose() * left.body_rotation;
+  pair.right_from_left_translation = right.body_rotation.transpose() * (left.body_translation - right.body_translation);
+  std::vector<ImageEntry> right_entries;
+  PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, "cam1", &right_entries));
+  auto right_entry = right_entries.begin();
+  for (const ImageEntry& entry : left_entries) {
+    while (right_entry != right_entries.end() && right_entry->timestamp_ns < entry.timestamp_ns) ++right_entry;
+    if (right_entry == right_entries.end()) break;
+    if (right_entry->timestamp_ns == entry.timestamp_ns)
+      pairs->push_back({entry.timestamp_ns, entry.path, right_entry->path});
+  }
+  if (pairs->empty()) {
+    spdlog::warn("{}: cam1/data.csv shares no timestamp with cam0/data.csv: no stereo pairs", log);
+    return Status::Ok();
+  }
+  *calibration = pair;
   return Status::Ok();
 }
 
@@ -175,7 +260,7 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   std::vector<ImuSample> imu;
   std::vector<SpeedSample> speeds;
   std::vector<GpsSample> gps;
-  PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, &entries));
+  PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, "cam0", &entries));
   PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &speeds));
   if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
   if (!(info.frame_rate_hz > 0.0 && std::isfinite(info.frame_rate_hz))) {
@@ -190,6 +275,7 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   PatrolSensors sensors;
   PATROLMAP_RETURN_IF_ERROR(
       ReadSensorTables(log, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), &sensors));
+  PATROLMAP_RETURN_IF_ERROR(ReadStereoPairs(log, entries, &info.stereo, &sensors.stereo));
   *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu), std::move(speeds),
                                               std::move(gps), std::move(sensors));
   return Status::Ok();

@@ -20,6 +20,7 @@ ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries, 
   info_.has_poses = !sensors_.poses.empty();
   info_.has_detections = !sensors_.detections.empty();
   info_.has_depth = !sensors_.depth.empty();
+  info_.has_stereo = info_.stereo.has_value() && !sensors_.stereo.empty();
   info_.has_speed = !speeds_.empty();
 }
 
@@ -61,16 +62,22 @@ bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Ma
   return true;
 }
 
+void ImageListSource::AttachDepth(const std::vector<DepthEntry>& entries, TimestampNs timestamp_ns, std::size_t* next,
+                                  Frame* frame) const {
+  for (; *next < entries.size() && entries[*next].timestamp_ns <= timestamp_ns; ++*next) {
+    const DepthEntry& entry = entries[*next];
+    frame->depth.push_back(
+        {entry.timestamp_ns, entry.path, entry.right_path, PoseAt(sensors_.poses, entry.timestamp_ns)});
+  }
+}
+
 void ImageListSource::AttachSensors(TimestampNs timestamp_ns, Frame* frame) {
   const std::vector<CameraPoseSample>& poses = sensors_.poses;
   for (; next_pose_ < poses.size() && poses[next_pose_].timestamp_ns <= timestamp_ns; ++next_pose_) {
     frame->poses.push_back(poses[next_pose_]);
   }
-  const std::vector<DepthEntry>& depth = sensors_.depth;
-  for (; next_depth_ < depth.size() && depth[next_depth_].timestamp_ns <= timestamp_ns; ++next_depth_) {
-    frame->depth.push_back(
-        {depth[next_depth_].timestamp_ns, depth[next_depth_].path, PoseAt(poses, depth[next_depth_].timestamp_ns)});
-  }
+  AttachDepth(sensors_.depth, timestamp_ns, &next_depth_, frame);
+  AttachDepth(sensors_.stereo, timestamp_ns, &next_stereo_, frame);
   // Detections between frames belong to none and are dropped; those of a skipped frame go with it.
   const std::vector<ObjectObservation>& detections = sensors_.detections;
   frame->detections.clear();

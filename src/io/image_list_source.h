@@ -38,6 +38,9 @@ class ImageListSource : public FrameSource {
   void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);
   // Poses and depth images up to `timestamp_ns` into `frame`, and the detections at exactly that time.
   void AttachSensors(TimestampNs timestamp_ns, Frame* frame);
+  // Appends the entries up to `timestamp_ns` from *next on, with the pose at their time.
+  void AttachDepth(const std::vector<DepthEntry>& entries, TimestampNs timestamp_ns, std::size_t* next,
+                   Frame* frame) const;
   std::optional<double> SpeedAt(TimestampNs timestamp_ns) const;
   std::optional<Eigen::Vector3d> GpsAt(TimestampNs timestamp_ns) const;
   bool Decode(std::int64_t index, const std::string& path, cv::Mat* image);
@@ -48,7 +51,7 @@ class ImageListSource : public FrameSource {
   std::vector<SpeedSample> speeds_;
   std::vector<GpsSample> gps_;
   PatrolSensors sensors_;
-  std::size_t next_pose_ = 0, next_detection_ = 0, next_depth_ = 0;
+  std::size_t next_pose_ = 0, next_detection_ = 0, next_depth_ = 0, next_stereo_ = 0;
   std::size_t next_entry_ = 0;
   std::size_t next_imu_ = 0;
   cv::Size first_size_;

@@ -58,6 +58,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   start = std::chrono::steady_clock::now();
   report->geometry_compared =
       change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
+  report->geometry.depth_prior = prior_record->depth_source;
+  report->geometry.depth_current = current_record->depth_source;
   report->seconds_geometry = SecondsSince(start);
   return Status::Ok();
 }

@@ -94,6 +94,12 @@ class YamlReader {
     }
   }
 
+  void Parse(const std::string& path, const YAML::Node& node, depth::DepthSource* value) {
+    if (!depth::ParseDepthSource(Scalar(node), value)) {
+      Fail(path, node, "expected auto, images, stereo or none, got '" + Scalar(node) + "'");
+    }
+  }
+
   void Parse(const std::string& path, const YAML::Node& node, place::FundamentalMethod* value) {
     if (!place::ParseFundamentalMethod(Scalar(node), value)) {
       Fail(path, node, "expected ransac, usac or magsac, got '" + Scalar(node) + "'");
@@ -121,6 +127,7 @@ class YamlWriter {
   void Field(const std::string& path, flow::ResponseQuantity* value) { Slot(path) = flow::ToString(*value); }
   void Field(const std::string& path, flow::SmoothingMode* value) { Slot(path) = flow::ToString(*value); }
   void Field(const std::string& path, place::FundamentalMethod* value) { Slot(path) = place::ToString(*value); }
+  void Field(const std::string& path, depth::DepthSource* value) { Slot(path) = depth::ToString(*value); }
 
   YAML::Node root = YAML::Node(YAML::NodeType::Map);
 
@@ -141,7 +148,7 @@ class YamlWriter {
 
 bool Config::IsValid(std::string* error) const {
   if (!OptionCheck(error).InRange("input.frame_rate_hz", input.frame_rate_hz, 0.0, 10000.0).ok()) return false;
-  return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error);
+  return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error) && depth.IsValid(error);
 }
 
 Status LoadConfig(const std::string& path, Config* config) {

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include <spdlog/spdlog.h>
+#include <opencv2/imgcodecs.hpp>
 
 namespace patrolmap::pipeline {
 namespace {
@@ -18,12 +19,34 @@ PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
       mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
       next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
+  next_stereo_ns_ = next_grid_ns_;
   base_.flight = info.flight_id;
   if (info.camera) base_.camera = *info.camera;
   if (!info.has_poses || !info.camera) return;
   base_.has_objects = info.has_detections;
-  has_depth_ = info.has_depth;
+  ChooseDepth(config, info);
   active_ = base_.has_objects || has_depth_;
+}
+
+void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) {
+  using depth::DepthSource;
+  const DepthSource source = config.depth.source;
+  const bool images = info.has_depth && (source == DepthSource::kAuto || source == DepthSource::kImages);
+  const bool stereo = !images && info.has_stereo && (source == DepthSource::kAuto || source == DepthSource::kStereo);
+  if (source == DepthSource::kImages && !info.has_depth && info.has_stereo) {
+    spdlog::warn("{}: depth.source is images but the log has no depth0/ (it has a stereo pair): no depth", info.path);
+  }
+  if (source == DepthSource::kStereo && !info.has_stereo) {
+    spdlog::warn("{}: depth.source is stereo but the log has no stereo pair (cam1/ with its sensor.yaml): no depth",
+                 info.path);
+  }
+  if (stereo) {
+    const Status status = depth::StereoDepth::Create(*info.stereo, config.depth.stereo, &stereo_);
+    if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
+  }
+  use_stereo_ = stereo_ != nullptr;
+  has_depth_ = images || use_stereo_;
+  base_.depth_source = images ? "images" : (use_stereo_ ? "stereo" : "");
 }
 
 void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) {
@@ -37,11 +60,15 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
   const std::size_t first = work->size();
   if (has_depth_) {
     for (const DepthSample& depth : frame.depth) {
+      if (depth.stereo() != use_stereo_) continue;
+      if (use_stereo_ && depth.timestamp_ns < next_stereo_ns_) continue;
+      if (use_stereo_) next_stereo_ns_ = depth.timestamp_ns + grid_step_ns_;
       ChangeWork step_work;
       step_work.kind = ChangeWork::Kind::kGrid;
       step_work.timestamp_ns = depth.timestamp_ns;
       step_work.pose = depth.pose;
       step_work.depth_path = depth.path;
+      step_work.right_path = depth.right_path;
       work->push_back(std::move(step_work));
     }
   }
@@ -52,7 +79,9 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
     objects.detections = frame.detections;
     objects.pose = frame.pose;
     for (const DepthSample& depth : frame.depth) {
-      if (depth.timestamp_ns == frame.timestamp_ns) objects.depth_path = depth.path;
+      if (!has_depth_ || depth.stereo() != use_stereo_ || depth.timestamp_ns != frame.timestamp_ns) continue;
+      objects.depth_path = depth.path;
+      objects.right_path = depth.right_path;
     }
     objects.image = frame.image.clone();  // the source reuses its buffer
     work->push_back(std::move(objects));
@@ -70,8 +99,22 @@ void PatrolRecorder::CollectRest(std::vector<ChangeWork>* work) {
   work->push_back(std::move(views));
 }
 
-bool PatrolRecorder::ReadDepth(const std::string& path, cv::Mat* depth) {
-  const Status status = io::ReadDepthImage(path, depth);
+bool PatrolRecorder::ReadStereoDepth(const ChangeWork& work, cv::Mat* depth) {
+  left_ = cv::imread(work.depth_path, cv::IMREAD_GRAYSCALE);
+  right_ = cv::imread(work.right_path, cv::IMREAD_GRAYSCALE);
+  const std::string& unreadable = left_.empty() ? work.depth_path : work.right_path;
+  Status status = left_.empty() || right_.empty() ? Status::DataLoss(unreadable + ": missing or unreadable image")
+                                                  : stereo_->Compute(left_, right_, depth);
+  if (status.ok()) return true;
+  spdlog::warn("{} and {}: {}; skipped", work.depth_path, work.right_path, status.message());
+  ++stats_.skipped_depth_frames;
+  depth->release();
+  return false;
+}
+
+bool PatrolRecorder::ReadDepth(const ChangeWork& work, cv::Mat* depth) {
+  if (!work.right_path.empty()) return ReadStereoDepth(work, depth);
+  const Status status = io::ReadDepthImage(work.depth_path, depth);
   if (status.ok()) return true;
   spdlog::warn("{}; skipped", status.message());
   ++stats_.skipped_depth_frames;
@@ -85,20 +128,20 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
   if (work.kind == ChangeWork::Kind::kObjects) {
     stats_.detections += static_cast<int>(work.detections.size());
     depth_.release();
-    if (!work.depth_path.empty()) ReadDepth(work.depth_path, &depth_);
+    if (!work.depth_path.empty()) ReadDepth(work, &depth_);
     mapper_.AddFrame(work.detections, *work.pose, depth_, work.image);
     return;
   }
   if (work.timestamp_ns < next_grid_ns_) return;  // change.grid.rate_hz
   const auto start = std::chrono::steady_clock::now();
-  if (!ReadDepth(work.depth_path, &depth_)) return;
+  if (!ReadDepth(work, &depth_)) return;
   if (depth_.cols != base_.camera.width || depth_.rows != base_.camera.height) {
     spdlog::warn("{}: depth image is {}x{}, the camera {}x{}; skipped", work.depth_path, depth_.cols, depth_.rows,
                  base_.camera.width, base_.camera.height);
     ++stats_.skipped_depth_frames;
     return;
   }
-  grid_.Integrate(depth_, base_.camera, *work.pose);
+  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0);
   next_grid_ns_ = work.timestamp_ns + grid_step_ns_;
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

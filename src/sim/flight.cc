@@ -30,28 +30,31 @@ Eigen::Matrix3d WorldFromBody(double heading) {
   return Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 }
 
-std::string MatrixYaml(const Eigen::Matrix3d& rotation) {
+std::string MatrixYaml(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation = Eigen::Vector3d::Zero()) {
   std::ostringstream out;
   out.precision(12);
   out << "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 4; ++col) {
-      const double value = row < 3 && col < 3 ? rotation(row, col) : (row == col ? 1.0 : 0.0);
+      double value = row < 3 && col < 3 ? rotation(row, col) : (row == col ? 1.0 : 0.0);
+      if (row < 3 && col == 3) value = translation[row];
       out << value << (row == 3 && col == 3 ? "]\n" : ", ");
     }
   }
   return out.str();
 }
 
-std::string CameraYaml(const SimulatedFlight& flight) {
+// cam0 (baseline 0) or, `baseline_m` to its right, cam1 of the stereo pair.
+std::string CameraYaml(const SimulatedFlight& flight, double baseline_m = 0.0) {
   const CameraIntrinsics& camera = flight.camera;
+  const Eigen::Matrix3d body_from_camera = BodyFromCamera(flight.mount_angle);
   std::ostringstream out;
   out.precision(12);
   out << "sensor_type: camera\ncomment: patrolmap simulated camera\n"
-      << MatrixYaml(BodyFromCamera(flight.mount_angle)) << "rate_hz: " << flight.frame_rate_hz << "\nresolution: ["
-      << camera.width << ", " << camera.height << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", "
-      << camera.fy << ", " << camera.cx << ", " << camera.cy
-      << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
+      << MatrixYaml(body_from_camera, body_from_camera * Eigen::Vector3d(baseline_m, 0.0, 0.0))
+      << "rate_hz: " << flight.frame_rate_hz << "\nresolution: [" << camera.width << ", " << camera.height
+      << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", " << camera.fy << ", " << camera.cx << ", "
+      << camera.cy << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
   return out.str();
 }
 
@@ -181,13 +184,23 @@ Status WriteImage(const std::string& path, const cv::Mat& image) {
   return cv::imwrite(path, image) ? Status::Ok() : Status::IoError(path + ": cannot write image");
 }
 
-// Renders frame `frame`; with an exposure time, the mean of kBlurSamples renders spread over it.
-void RenderFrame(const SimulatedFlight& flight, double exposure_s, int frame, Renderer* renderer, cv::Mat* image,
-                 cv::Mat* sum, cv::Mat* sample) {
+// The pose of a camera `baseline_m` to the right of the flight's camera (0: that camera) at `t`.
+CameraPose ShiftedPose(const SimulatedFlight& flight, double t, double baseline_m) {
+  CameraPose pose = CameraPoseAt(flight, flight.trajectory(t));
+  pose.position += baseline_m * WorldFromCameraRotation(pose.yaw).col(0);
+  return pose;
+}
+
+// Renders frame `frame` of the camera `baseline_m` to the right of the flight's (0: the flight's camera; its
+// sensor noise is drawn apart); with an exposure time, the mean of kBlurSamples renders spread over it.
+void RenderFrame(const SimulatedFlight& flight, double exposure_s, int frame, double baseline_m, Renderer* renderer,
+                 cv::Mat* image, cv::Mat* sum, cv::Mat* sample) {
   constexpr int kBlurSamples = 5;
+  constexpr int kRightNoiseOffset = 1 << 24;  // sensor noise of the right camera differs from the left one's
   const double t = frame / flight.frame_rate_hz;
+  const int noise = baseline_m > 0.0 ? frame + kRightNoiseOffset : frame;
   if (exposure_s <= 0.0) {
-    renderer->Render(CameraPoseAt(flight, flight.trajectory(t)), image, frame);
+    renderer->Render(ShiftedPose(flight, t, baseline_m), image, noise);
     return;
   }
   sum->create(flight.camera.height, flight.camera.width, CV_32FC1);
@@ -195,7 +208,7 @@ void RenderFrame(const SimulatedFlight& flight, double exposure_s, int frame, Re
   for (int i = 0; i < kBlurSamples; ++i) {
     const double offset = exposure_s * ((i + 0.5) / kBlurSamples - 0.5);
     const double when = std::clamp(t + offset, 0.0, flight.duration_s);
-    renderer->Render(CameraPoseAt(flight, flight.trajectory(when)), sample, frame);
+    renderer->Render(ShiftedPose(flight, when, baseline_m), sample, noise);
     cv::accumulate(*sample, *sum);
   }
   sum->convertTo(*image, CV_8UC1, 1.0 / kBlurSamples);
@@ -211,9 +224,13 @@ Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, con
     const TimestampNs timestamp = FrameTimestamp(flight, frame);
     const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
     const std::string name = std::to_string(timestamp) + ".png";
-    RenderFrame(flight, options.exposure_s, frame, &renderer, &image, &sum, &sample);
+    RenderFrame(flight, options.exposure_s, frame, 0.0, &renderer, &image, &sum, &sample);
     PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/cam0/data/" + name, image));
     tables->images << timestamp << "," << name << "\n";
+    if (options.stereo_baseline_m > 0.0) {
+      RenderFrame(flight, options.exposure_s, frame, options.stereo_baseline_m, &renderer, &image, &sum, &sample);
+      PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/cam1/data/" + name, image));
+    }
     if (options.depth) {
       renderer.RenderDepth(pose, &depth);
       PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/depth0/data/" + name, depth));
@@ -323,6 +340,7 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
     PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + sub));
   }
   if (options.depth) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/depth0/data"));
+  if (options.stereo_baseline_m > 0.0) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/cam1/data"));
   if (options.detections) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/objects0"));
   if (options.gps) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/gps0"));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight)));
@@ -330,6 +348,11 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, options, progress, &tables));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/data.csv", tables.images.str()));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight)));
+  if (options.stereo_baseline_m > 0.0) {
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam1/data.csv", tables.images.str()));
+    PATROLMAP_RETURN_IF_ERROR(
+        WriteFileAtomically(folder + "/cam1/sensor.yaml", CameraYaml(flight, options.stereo_baseline_m)));
+  }
   PATROLMAP_RETURN_IF_ERROR(
       WriteFileAtomically(folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +
                                                             "rate_hz: " + std::to_string(flight.imu_rate_hz) + "\n"));

@@ -135,6 +135,46 @@ TEST(EvidenceGrid, DepthImageRaysEndOnTheWall) {
   EXPECT_GE(halfway_passes, 16 * 12);
 }
 
+TEST(EvidenceGrid, UncertainReturnsLeaveTheSpaceJustBeforeThemUnknown) {
+  EvidenceGrid grid(EvidenceGridOptions{});
+  // Voxels 0..10 along x; those entered in the last 0.55 m (8 at 1.5 m, 9 at 1.7 m) are neither free nor hit.
+  grid.TraceRay(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(2.0, 0.0, 0.0), true, 0.55);
+  const EvidenceGridData data = grid.ToData();
+  for (int x = 0; x <= 7; ++x) EXPECT_EQ(At(data, x, 0, 0)->passes, 1) << x;
+  EXPECT_EQ(At(data, 8, 0, 0), nullptr);
+  EXPECT_EQ(At(data, 9, 0, 0), nullptr);
+  EXPECT_EQ(At(data, 10, 0, 0)->hits, 1);
+}
+
+TEST(EvidenceGrid, StereoDepthCarvesLessAndHitsOnlyWhereItIsSure) {
+  EvidenceGridOptions options;
+  options.rays_per_row = 16;
+  EvidenceGrid exact(options), near_stereo(options), far_stereo(options);
+  const cv::Mat wall = WallDepth(kCamera, 10.0);
+  const CameraPoseSample pose = LookingAlongX(Eigen::Vector3d(0, 0, 2));
+  exact.Integrate(wall, kCamera, pose);
+  // Range error 0.2 m at 10 m: hits, and 0.4 m (2 voxels) before the wall not carved.
+  near_stereo.Integrate(wall, kCamera, pose, 0.2 / 100.0);
+  // Range error 1 m at 10 m, above change.grid.max_hit_sigma_m (0.5 m): free space up to 8 m and no hit.
+  far_stereo.Integrate(wall, kCamera, pose, 1.0 / 100.0);
+  const auto count = [](const EvidenceGridData& data, int from_x, int to_x, bool hits) {
+    long long total = 0;
+    for (const VoxelEvidence& v : data.voxels) {
+      if (v.x >= from_x && v.x <= to_x) total += hits ? v.hits : v.passes;
+    }
+    return total;
+  };
+  const EvidenceGridData a = exact.ToData(), b = near_stereo.ToData(), c = far_stereo.ToData();
+  EXPECT_EQ(count(a, 50, 50, true), 16 * 12);
+  EXPECT_EQ(count(b, 50, 50, true), 16 * 12);
+  EXPECT_EQ(count(c, 0, 1000, true), 0);
+  EXPECT_GT(count(a, 48, 49, false), 0);
+  EXPECT_EQ(count(b, 49, 49, false), 0);
+  EXPECT_GT(count(b, 45, 46, false), 0);
+  EXPECT_EQ(count(c, 41, 49, false), 0);
+  EXPECT_GT(count(c, 30, 39, false), 0);
+}
+
 EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& cells) {
   EvidenceGridData grid;
   grid.voxel_size = 0.2;

@@ -142,6 +142,10 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
   app->add_flag("--detections", arguments->log.detections, "write objects0/ from a simulated object detector");
   app->add_flag("--depth", arguments->log.depth, "write depth0/ (16-bit PNG depth along the optical axis, mm)");
   app->add_flag("--gps", arguments->log.gps, "write gps0/ (10 Hz, 1.5 m noise)");
+  app->add_option("--stereo", arguments->log.stereo_baseline_m,
+                  "write cam1/, a second camera BASELINE_M to the right of cam0 (a stereo pair, with its sensor.yaml)")
+      ->type_name("BASELINE_M")
+      ->check(FiniteRange(0.01, 10.0));
   app->add_flag("--truth-only", arguments->log.truth_only,
                 "write only groundtruth/key_locations.csv into an existing log of the same options");
   app->add_option("--motion-blur", arguments->log.exposure_s,

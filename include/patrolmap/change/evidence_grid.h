@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -23,10 +24,13 @@ class EvidenceGrid {
   explicit EvidenceGrid(const EvidenceGridOptions& options);
 
   // Traces the rays of one depth image (metres along the optical axis, 0 = no
-  // return) seen from `pose`.
-  void Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose);
-  // Traces one ray from `origin` towards `end`; `hit` when it ends on a surface.
-  void TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit);
+  // return) seen from `pose`. Depth whose range error grows as sigma(r) = range_sigma_per_m2 * r^2 (stereo;
+  // 0 for exact depth) carves free space only up to free_space_sigmas * sigma(r) before each return.
+  void Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose,
+                 double range_sigma_per_m2 = 0.0);
+  // Traces one ray from `origin` towards `end`; `hit` when it ends on a surface. The voxels of the last
+  // `hold_back_m` before the end are neither free nor hit.
+  void TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, bool hit, double hold_back_m = 0.0);
 
   std::size_t voxel_count() const { return size_; }
   // The most voxels options.memory_mb holds: the table is a power of two of 16-byte slots, at most half of
@@ -83,6 +87,7 @@ struct GeometryChange {
   long long compared_voxels = 0;  // observed enough in both patrols
   // Voxels each patrol's grid dropped at its memory budget (change.grid.memory_mb): nothing is compared there.
   long long evicted_prior = 0, evicted_current = 0;
+  std::string depth_prior, depth_current;  // where each grid's depth came from (PatrolRecord::depth_source)
   std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions
   std::vector<GeometryRegion> regions;          // largest first
 };

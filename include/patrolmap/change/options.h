@@ -69,6 +69,10 @@ struct EvidenceGridOptions {
   int rays_per_row = 94;      // depth pixels traced per image row (every width/94-th pixel, and
                               // every as many rows): 94 is every 8th pixel at 752 px
   double rate_hz = 5.0;       // depth frames integrated per second of flight
+  // Uncertain depth (stereo) carves free space only up to this many range errors before a return.
+  double free_space_sigmas = 2.0;
+  // ... and marks a voxel hit only where its range error is at most this [m] (farther returns carve only).
+  double max_hit_sigma_m = 0.5;
   // Memory of the grid's table at most, the copy made while it grows or sheds voxels included [MB]: 256 MB
   // hold 4.2 million voxels (16 bytes a slot, at most half the slots used). When full, the least recently
   // observed quarter of the voxels is dropped (EvidenceGrid); the patrol record counts them.

@@ -93,7 +93,8 @@ struct PatrolRecord {
   std::vector<CameraPoseSample> views;  // camera poses sampled along the flight
   bool has_objects = false;             // the log had detections
   std::vector<MapObject> objects;
-  EvidenceGridData grid;  // voxel_size 0 when the log had no depth
+  EvidenceGridData grid;     // voxel_size 0 when the log had no depth
+  std::string depth_source;  // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
 };
 
 }  // namespace patrolmap

@@ -17,6 +17,7 @@
 
 #include "patrolmap/core/status.h"
 #include "patrolmap/core/types.h"
+#include "patrolmap/depth/options.h"
 
 namespace cv {
 class StereoSGBM;
@@ -25,22 +26,6 @@ class StereoSGBM;
 namespace patrolmap::depth {
 
 struct MatchBuffers;
-
-struct StereoOptions {
-  int num_disparities = 64;   // disparity search range [px], a multiple of 16: the nearest depth is
-                              // f * b / num_disparities
-  int block_size = 5;         // matched block side [px], odd
-  int uniqueness_ratio = 10;  // the best cost must beat the second best by this percentage
-  bool lr_check = true;       // left-right consistency check (matches the pair a second time, mirrored)
-  int max_lr_difference = 1;  // ... the disparities of the two views may differ this much [px]
-  int speckle_window = 100;   // disparity blobs smaller than this are removed [px]; 0: no speckle filter
-  int speckle_range = 2;      // ... a blob's disparities vary at most this much [px]
-  bool full_paths = false;    // 8 path directions (slower) instead of OpenCV's 3-way approximation
-  double min_range_m = 0.3;   // depths outside [min_range_m, max_range_m] are left unknown
-  double max_range_m = 30.0;
-  double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]
-  bool IsValid(std::string* error) const;
-};
 
 // Disparity of the left view [px] from rectified grey images (CV_32F; unmatched pixels below 0).
 void ComputeDisparity(const cv::Mat& left, const cv::Mat& right, const StereoOptions& options, cv::Mat* disparity);

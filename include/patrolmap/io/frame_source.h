@@ -45,7 +45,9 @@ struct LogInfo {
   // Change detection's tables (EuRoC): their samples come with the frames (Frame::poses, detections, depth).
   bool has_poses = false;
   bool has_detections = false;
-  bool has_depth = false;
+  bool has_depth = false;   // depth0/ images
+  bool has_stereo = false;  // stereo pairs (cam0 + cam1 with their calibration)
+  std::optional<StereoCalibration> stereo;
 };
 
 // A frame that could not be read and was skipped.

@@ -10,6 +10,9 @@
 //                                         may share a timestamp
 //   depth0/data.csv + depth0/data/        timestamp, file name: 16-bit PNGs, depth along
 //                                         the optical axis [mm], 0 = no return
+//   cam1/data.csv + cam1/sensor.yaml      the right camera of a stereo pair (intrinsics,
+//                                         radial-tangential distortion, T_BS): its images of
+//                                         cam0's times make stereo pairs for the depth stage
 // Every part is optional; a log without poses gets appearance changes only.
 #pragma once
 
@@ -26,7 +29,8 @@ namespace patrolmap::io {
 
 struct DepthEntry {
   TimestampNs timestamp_ns = 0;
-  std::string path;
+  std::string path;        // depth image; stereo: the left (cam0) image
+  std::string right_path;  // stereo: the right (cam1) image
 };
 
 struct PatrolSensors {
@@ -35,6 +39,7 @@ struct PatrolSensors {
   std::vector<CameraPoseSample> poses;        // world_from_camera, ascending time
   std::vector<ObjectObservation> detections;  // ascending time
   std::vector<DepthEntry> depth;              // ascending time
+  std::vector<DepthEntry> stereo;             // cam0 and cam1 images of the same time (EuRoC reader), ascending
 };
 
 // Reads the optional tables of a log (EuRoC layout; other logs have none).

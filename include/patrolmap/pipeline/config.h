@@ -7,6 +7,7 @@
 
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/status.h"
+#include "patrolmap/depth/options.h"
 #include "patrolmap/flow/options.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/place/place_recognizer.h"
@@ -18,6 +19,7 @@ struct Config {
   flow::KeyLocationOptions flow;
   place::PlaceOptions place;
   ::patrolmap::change::ChangeOptions change;
+  depth::DepthOptions depth;
 
   bool IsValid(std::string* error) const;
 };
@@ -113,6 +115,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
   visitor->Field("change.grid.rays_per_row", &change.grid.rays_per_row);
   visitor->Field("change.grid.rate_hz", &change.grid.rate_hz);
+  visitor->Field("change.grid.free_space_sigmas", &change.grid.free_space_sigmas);
+  visitor->Field("change.grid.max_hit_sigma_m", &change.grid.max_hit_sigma_m);
   visitor->Field("change.grid.memory_mb", &change.grid.memory_mb);
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
   visitor->Field("change.geometry.max_free_occupancy", &change.geometry.max_free_occupancy);
@@ -122,6 +126,19 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
   visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
+  depth::DepthOptions& depth = config->depth;
+  visitor->Field("depth.source", &depth.source);
+  visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);
+  visitor->Field("depth.stereo.block_size", &depth.stereo.block_size);
+  visitor->Field("depth.stereo.uniqueness_ratio", &depth.stereo.uniqueness_ratio);
+  visitor->Field("depth.stereo.lr_check", &depth.stereo.lr_check);
+  visitor->Field("depth.stereo.max_lr_difference", &depth.stereo.max_lr_difference);
+  visitor->Field("depth.stereo.speckle_window", &depth.stereo.speckle_window);
+  visitor->Field("depth.stereo.speckle_range", &depth.stereo.speckle_range);
+  visitor->Field("depth.stereo.full_paths", &depth.stereo.full_paths);
+  visitor->Field("depth.stereo.min_range_m", &depth.stereo.min_range_m);
+  visitor->Field("depth.stereo.max_range_m", &depth.stereo.max_range_m);
+  visitor->Field("depth.stereo.disparity_sigma_px", &depth.stereo.disparity_sigma_px);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

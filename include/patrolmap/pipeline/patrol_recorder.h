@@ -8,6 +8,7 @@
 // One thread or two, the record is the same.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/status.h"
+#include "patrolmap/depth/stereo.h"
 #include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/pipeline/config.h"
@@ -44,7 +46,8 @@ struct ChangeWork {
   TimestampNs timestamp_ns = 0;
   std::optional<CameraPoseSample> pose;       // at timestamp_ns; none: the step is skipped
   std::vector<ObjectObservation> detections;  // kObjects
-  std::string depth_path;                     // kGrid; kObjects: the frame's depth image, if any
+  std::string depth_path;                     // kGrid; kObjects: the frame's depth image, if any; stereo: left
+  std::string right_path;                     // stereo: the right image of the pair
   cv::Mat image;                              // kObjects: the frame at the camera's size
 };
 
@@ -72,16 +75,23 @@ class PatrolRecorder {
   void Finish(PatrolRecord* record, PatrolRecordStats* stats);
 
  private:
-  bool ReadDepth(const std::string& path, cv::Mat* depth);
+  // Which depth the log gives the record (config.depth.source), and the stereo matcher it needs.
+  void ChooseDepth(const Config& config, const io::LogInfo& info);
+  bool ReadDepth(const ChangeWork& work, cv::Mat* depth);
+  bool ReadStereoDepth(const ChangeWork& work, cv::Mat* depth);
 
   TimestampNs grid_step_ns_;  // change.grid.rate_hz
   bool active_ = false;
   bool has_depth_ = false;
-  PatrolRecord base_;  // flight, camera; views on the change thread
+  bool use_stereo_ = false;  // depth from the stereo pair, not depth0/
+  PatrolRecord base_;        // flight, camera; views on the change thread
   // Frame thread:
   TimestampNs next_view_ns_;
   std::vector<CameraPoseSample> pending_views_;
+  TimestampNs next_stereo_ns_;  // stereo pairs come with every frame: only those at the grid's rate are work
   // Change thread:
+  std::unique_ptr<depth::StereoDepth> stereo_;
+  cv::Mat left_, right_;
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;
   TimestampNs next_grid_ns_;
