@@ -51,13 +51,15 @@ TEST(StereoMatching, MiddleburyAloeAgreesWithTheTrueDisparity) {
   const DisparityScore score = Score(disparity, truth);
   std::printf("aloe: %.3f within 1 px, %.3f within 3 px, %.3f matched\n", score.within_1px, score.within_3px,
               score.density);
-  // Measured: 0.792 within 1 px, 0.822 within 3 px, 0.833 matched (0.950 of the matched within 1 px).
-  EXPECT_GE(score.within_1px, 0.75);
-  EXPECT_GE(score.within_3px, 0.80);
-  EXPECT_GE(score.within_1px / score.density, 0.93);
+  // Measured with the defaults: 0.756 within 1 px, 0.775 within 3 px, 0.779 matched (0.970 of the matched
+  // within 1 px).
+  EXPECT_GE(score.within_1px, 0.72);
+  EXPECT_GE(score.within_3px, 0.74);
+  EXPECT_GE(score.within_1px / score.density, 0.95);
 }
 
-// Without the left-right check more pixels get a disparity, and more of them are wrong.
+// Without the left-right check more pixels get a disparity, and more of them are wrong (with permissive
+// uniqueness and speckle settings, where the check has most to remove).
 TEST(StereoMatching, TheLeftRightCheckKeepsTheRightDisparities) {
   const cv::Mat left = cv::imread(kOpencvData + "/aloeL.jpg", cv::IMREAD_GRAYSCALE);
   const cv::Mat right = cv::imread(kOpencvData + "/aloeR.jpg", cv::IMREAD_GRAYSCALE);
@@ -65,6 +67,8 @@ TEST(StereoMatching, TheLeftRightCheckKeepsTheRightDisparities) {
   if (left.empty() || right.empty() || truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
   StereoOptions options;
   options.num_disparities = 256;
+  options.uniqueness_ratio = 10;
+  options.speckle_window = 100;
   cv::Mat checked, unchecked;
   ComputeDisparity(left, right, options, &checked);
   options.lr_check = false;

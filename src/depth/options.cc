@@ -28,7 +28,7 @@ bool StereoOptions::IsValid(std::string* error) const {
       .InRange("depth.stereo.block_size", block_size, 1, 21)
       .Holds("depth.stereo.block_size", block_size, block_size % 2 == 1, "must be odd")
       .InRange("depth.stereo.uniqueness_ratio", uniqueness_ratio, 0, 100)
-      .InRange("depth.stereo.max_lr_difference", max_lr_difference, 0, 64)
+      .InRange("depth.stereo.max_lr_difference", max_lr_difference, 0.0, 64.0)
       .InRange("depth.stereo.speckle_window", speckle_window, 0, 10000)
       .InRange("depth.stereo.speckle_range", speckle_range, 1, 64)
       .AboveAtMost("depth.stereo.min_range_m", min_range_m, 0.0, 1000.0)

@@ -54,7 +54,7 @@ void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& righ
   MatchPadded(matcher, buffers->flipped_right, buffers->flipped_left, options.num_disparities, buffers,
               &buffers->right_view);
   const int scale = cv::StereoMatcher::DISP_SCALE;
-  const int tolerance = options.max_lr_difference * scale;
+  const double tolerance = options.max_lr_difference * scale;
   const int width = disparity->cols;
   for (int y = 0; y < disparity->rows; ++y) {
     std::int16_t* d = disparity->ptr<std::int16_t>(y);

@@ -18,16 +18,16 @@ const char* ToString(DepthSource source);
 bool ParseDepthSource(const std::string& text, DepthSource* source);
 
 struct StereoOptions {
-  int num_disparities = 64;   // disparity search range [px], a multiple of 16: the nearest depth is
-                              // f * b / num_disparities
-  int block_size = 5;         // matched block side [px], odd
-  int uniqueness_ratio = 10;  // the best cost must beat the second best by this percentage
-  bool lr_check = true;       // left-right consistency check (matches the pair a second time, mirrored)
-  int max_lr_difference = 1;  // ... the disparities of the two views may differ this much [px]
-  int speckle_window = 100;   // disparity blobs smaller than this are removed [px]; 0: no speckle filter
-  int speckle_range = 2;      // ... a blob's disparities vary at most this much [px]
-  bool full_paths = false;    // 8 path directions (slower) instead of OpenCV's 3-way approximation
-  double min_range_m = 0.3;   // depths outside [min_range_m, max_range_m] are left unknown
+  int num_disparities = 64;        // disparity search range [px], a multiple of 16: the nearest depth is
+                                   // f * b / num_disparities
+  int block_size = 5;              // matched block side [px], odd
+  int uniqueness_ratio = 30;       // the best cost must beat the second best by this percentage
+  bool lr_check = true;            // left-right consistency check (matches the pair a second time, mirrored)
+  double max_lr_difference = 0.5;  // ... the disparities of the two views may differ this much [px]
+  int speckle_window = 400;        // disparity blobs smaller than this are removed [px]; 0: no speckle filter
+  int speckle_range = 2;           // ... a blob's disparities vary at most this much [px]
+  bool full_paths = false;         // 8 path directions (slower) instead of OpenCV's 3-way approximation
+  double min_range_m = 0.3;        // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]
   bool IsValid(std::string* error) const;
