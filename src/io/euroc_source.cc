@@ -114,8 +114,8 @@ struct StereoCamera {
 };
 
 // CAMERA/sensor.yaml for stereo matching: pinhole with radial-tangential distortion (k1, k2, p1, p2; none
-// when absent).
-Status ReadStereoCamera(const std::string& path, StereoCamera* camera) {
+// when absent). Another distortion model is valid but not matched: `unsupported` receives why.
+Status ReadStereoCamera(const std::string& path, StereoCamera* camera, std::string* unsupported) {
   YAML::Node root;
   PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
   std::vector<double> intrinsics, resolution, distortion(4, 0.0);
@@ -131,8 +131,8 @@ Status ReadStereoCamera(const std::string& path, StereoCamera* camera) {
   if (root["distortion_model"]) {
     const std::string model = root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "";
     if (model != "radial-tangential" && model != "radtan") {
-      return Status::DataLoss(path + ": distortion_model '" + model +
-                              "' is not radial-tangential, the only one stereo matching undoes");
+      *unsupported =
+          path + ": distortion_model '" + model + "' is not radial-tangential, the only one stereo matching undoes";
     }
   }
   if (root["distortion_coefficients"]) {
@@ -156,8 +156,13 @@ Status ReadStereoPairs(const std::string& log, const std::vector<ImageEntry>& le
     return Status::Ok();
   }
   StereoCamera left, right;
-  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam0/sensor.yaml", &left));
-  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam1/sensor.yaml", &right));
+  std::string unsupported;  // a camera model stereo matching does not undo
+  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam0/sensor.yaml", &left, &unsupported));
+  PATROLMAP_RETURN_IF_ERROR(ReadStereoCamera(log + "/cam1/sensor.yaml", &right, &unsupported));
+  if (!unsupported.empty()) {
+    spdlog::warn("{}; the log's stereo pair is not used", unsupported);
+    return Status::Ok();
+  }
   StereoCalibration pair;
   pair.left = left.intrinsics;
   pair.right = right.intrinsics;

@@ -274,6 +274,56 @@ TEST(Euroc, GpsIsInterpolatedAtFrameTimes) {
             std::string::npos);
 }
 
+// cam0 and cam1 0.11 m apart (EuRoC's layout): cam1's images at cam0's times make stereo pairs.
+void AddStereoCamera(const std::string& log, const std::string& cam1_model) {
+  const std::string intrinsics = "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\n";
+  WriteText(log + "/cam0/sensor.yaml",
+            "T_BS:\n  data: [1, 0, 0, 0.01, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n" + intrinsics +
+                "distortion_model: radial-tangential\ndistortion_coefficients: [0.01, -0.002, 0.0001, 0.0002]\n");
+  WriteText(log + "/cam1/sensor.yaml", "T_BS:\n  data: [1, 0, 0, 0.12, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n" +
+                                           intrinsics + "distortion_model: " + cam1_model + "\n");
+  std::filesystem::create_directories(log + "/cam1/data");
+  // cam1 misses cam0's second frame.
+  WriteText(log + "/cam1/data.csv", "#timestamp [ns],filename\n1000000000,a.png\n1100000000,c.png\n");
+}
+
+TEST(Euroc, Cam1MakesStereoPairsAtCam0sTimes) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  AddStereoCamera(log, "radial-tangential");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  const LogInfo& info = source->info();
+  ASSERT_TRUE(info.has_stereo);
+  EXPECT_NEAR(info.stereo->right_from_left_translation.x(), -0.11, 1e-12);
+  EXPECT_DOUBLE_EQ(info.stereo->left_distortion[0], 0.01);
+  EXPECT_DOUBLE_EQ(info.stereo->left_distortion[3], 0.0002);
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_EQ(frames.size(), 3u);
+  ASSERT_EQ(frames[0].depth.size(), 1u);
+  EXPECT_TRUE(frames[0].depth[0].stereo());
+  EXPECT_EQ(frames[0].depth[0].right_path, log + "/cam1/data/a.png");
+  EXPECT_EQ(frames[0].depth[0].path, log + "/cam0/data/1000000000.png");
+  EXPECT_TRUE(frames[1].depth.empty());
+  ASSERT_EQ(frames[2].depth.size(), 1u);
+  EXPECT_EQ(frames[2].depth[0].right_path, log + "/cam1/data/c.png");
+}
+
+TEST(Euroc, AStereoCameraOfAnotherModelIsLeftOutNamingItsFile) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);
+  AddStereoCamera(log, "equidistant");
+  testing::LogCapture capture;
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_FALSE(source->info().has_stereo);
+  EXPECT_NE(capture.text().find("cam1/sensor.yaml: distortion_model 'equidistant'"), std::string::npos)
+      << capture.text();
+}
+
 TEST(Euroc, RealSensorYamlFromSharedData) {
   const std::string path = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/sensorLeft.yaml";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data not present";
