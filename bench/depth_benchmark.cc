@@ -3,6 +3,7 @@
 #include <memory>
 
 #include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
 
 #include "patrolmap/depth/stereo.h"
 #include "patrolmap/sim/renderer.h"
