@@ -504,6 +504,23 @@ TEST_F(StereoStreet, TheRecordTakesTheDepthTheConfigurationChooses) {
   EXPECT_EQ(source_of(depth::DepthSource::kNone), "");
 }
 
+TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
+  for (const depth::DepthSource choice : {depth::DepthSource::kImages, depth::DepthSource::kStereo}) {
+    std::unique_ptr<io::FrameSource> source;
+    ASSERT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
+    Config config;
+    config.depth.source = choice;
+    PatrolRecorder recorder(config, source->info());
+    Frame frame;
+    std::vector<ChangeWork> work;
+    for (int i = 0; i < 30 && source->Next(false, &frame).ok(); ++i) recorder.Collect(frame, &work);
+    ASSERT_FALSE(work.empty());
+    for (const ChangeWork& step : work) {
+      EXPECT_EQ(step.right_path.empty(), choice == depth::DepthSource::kImages) << step.depth_path;
+    }
+  }
+}
+
 TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
   testing::TempDir dir;
   const CameraIntrinsics camera{40.0, 40.0, 31.5, 23.5, 64, 48};
