@@ -15,6 +15,13 @@ std::string CleanFlightId(const std::string& raw) {
   return id;
 }
 
+Status FrameSource::UsePoseFile(const std::string& path) {
+  return Status::InvalidArgument(path +
+                                 ": poses from a file need a log whose frame times are known before it is "
+                                 "read (an image folder or a EuRoC log), not a " +
+                                 info().kind);
+}
+
 void FrameSource::RecordSkipped(std::int64_t index, std::string reason) {
   spdlog::warn("skipping frame {}: {}", index, reason);
   skipped_.push_back({index, std::move(reason)});

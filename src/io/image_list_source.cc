@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <limits>
 
+#include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
+
+#include "patrolmap/io/pose_file.h"
 
 namespace patrolmap::io {
 
@@ -22,6 +25,17 @@ ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries, 
   info_.has_depth = !sensors_.depth.empty();
   info_.has_stereo = info_.stereo.has_value() && !sensors_.stereo.empty();
   info_.has_speed = !speeds_.empty();
+}
+
+Status ImageListSource::UsePoseFile(const std::string& path) {
+  std::vector<TimestampNs> times(entries_.size());
+  std::transform(entries_.begin(), entries_.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
+  std::vector<CameraPoseSample> poses;
+  PATROLMAP_RETURN_IF_ERROR(ReadPoseFile(path, times, &poses));
+  if (info_.has_poses) spdlog::info("{}: camera poses from {}, not the log's state estimate", info_.path, path);
+  sensors_.poses = std::move(poses);
+  info_.has_poses = true;
+  return Status::Ok();
 }
 
 Status ImageListSource::Next(bool decode_image, Frame* frame) {

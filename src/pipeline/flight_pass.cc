@@ -218,6 +218,16 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
   std::vector<std::string> warnings;
   if (options.node_every == 0 && options.keep_samples)
     warnings = DetectionWarnings(info, result.detection, config.flow);
+  const bool change_data = info.has_detections || info.has_depth || info.has_stereo;
+  if (change_data && !info.has_poses) {
+    warnings.push_back(info.path +
+                       ": no camera poses (state_groundtruth_estimate0/data.csv, or --poses FILE: a TUM or KITTI "
+                       "pose file), so its detections and depth are not used: appearance change only");
+  } else if (change_data && !info.camera) {
+    warnings.push_back(info.path +
+                       ": no camera intrinsics (cam0/sensor.yaml), so its detections and depth are not used: "
+                       "appearance change only");
+  }
   if (result.stats.lost_key_frames > 0) {
     warnings.push_back(info.path + ": " + std::to_string(result.stats.lost_key_frames) +
                        " key location(s) were confirmed after their frame left the ring of recent frames and are "

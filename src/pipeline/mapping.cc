@@ -41,6 +41,11 @@ Status CheckRequest(const MappingRequest& request, Config* config) {
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out + "/map.pmap", request.prior_map, "prior map"));
   }
+  if (!request.poses.empty() && request.sources.size() > 1) {
+    return Status::InvalidArgument("--poses " + request.poses +
+                                   ": a pose file belongs to one log; map the logs "
+                                   "one at a time (patrol adds each to the map)");
+  }
   std::string error;
   if (!request.pass.IsValid(&error)) return Status::InvalidArgument(error);
   if (request.events && !request.events->IsValid(&error)) return Status::InvalidArgument(error);
@@ -83,6 +88,7 @@ Status MapSource(const MappingRequest& request, const std::string& spec, const C
                  place::PlaceRecognizer* recognizer, ChangeMonitor* monitor, MappingOutcome* outcome) {
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(spec, config.input, &source));
+  if (!request.poses.empty()) PATROLMAP_RETURN_IF_ERROR(source->UsePoseFile(request.poses));
   const io::LogInfo& info = source->info();
   if (request.pass.node_every > 0 && !info.timed) {
     spdlog::warn(

@@ -90,6 +90,10 @@ int main(int argc, char** argv) {
   app.add_option("--vocabulary", arguments.request.vocabulary_path, "vocabulary file (default: the shipped one)");
   app.add_option("--fps", arguments.request.fps, "frame rate of a log without timestamps [Hz] (default: its own times)")
       ->check(patrolmap::tools::FiniteRange(0.001, 10000.0));
+  app.add_option("--poses", arguments.request.poses,
+                 "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "
+                 "matrix per image); replaces the log's state estimate")
+      ->check(CLI::ExistingFile);
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
   app.add_option("--max-seconds", arguments.request.drive.max_seconds,
                  "stop after this much of the flight [s]; 0: at its end")

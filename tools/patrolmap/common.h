@@ -26,6 +26,9 @@ using tools::FiniteRange;
 // --fps: the frame rate of image folders, patterns and videos, overriding their own times [Hz].
 void AddFpsOption(CLI::App* app, double* fps);
 
+// --poses: the camera poses of the log from a TUM or KITTI pose file (change detection needs them).
+void AddPosesOption(CLI::App* app, std::string* poses);
+
 // Prints one line on what changed between the report's flights (diff and patrol).
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out);
 

@@ -52,6 +52,13 @@ void AddFpsOption(CLI::App* app, double* fps) {
       ->check(FiniteRange(0.001, 10000.0));
 }
 
+void AddPosesOption(CLI::App* app, std::string* poses) {
+  app->add_option("--poses", *poses,
+                  "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "
+                  "matrix per image); replaces the log's state estimate")
+      ->check(CLI::ExistingFile);
+}
+
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out) {
   std::printf("changes %s -> %s: %zu places compared, %d with appearance changes", report.prior_flight.c_str(),
               report.current_flight.c_str(), report.places.size(), report.ChangedPlaces());

@@ -54,6 +54,7 @@ Command AddPatrolCommand(CLI::App* app) {
   app->add_option("-c,--config", arguments->request.config_path, "YAML configuration (see config/default.yaml)");
   app->add_option("--vocabulary", arguments->request.vocabulary_path, "vocabulary file (default: the shipped one)");
   AddFpsOption(app, &arguments->request.fps);
+  AddPosesOption(app, &arguments->request.poses);
   app->footer(
       "Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
       "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
@@ -74,6 +75,7 @@ Command AddMapCommand(CLI::App* app) {
                   "vocabulary file (patrolmap vocab build; default: the shipped one, found beside the program, in "
                   "the install prefix or at $PATROLMAP_VOCABULARY)");
   AddFpsOption(app, &arguments->request.fps);
+  AddPosesOption(app, &arguments->request.poses);
   app->add_flag("--every-frame", arguments->every_frame,
                 "make every image a node, without key-location detection (image collections, place recognition "
                 "alone); without timestamps 'recent' is counted in images (place.exclude_recent_images)");

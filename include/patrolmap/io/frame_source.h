@@ -69,6 +69,10 @@ class FrameSource {
 
   virtual const LogInfo& info() const = 0;
 
+  // Takes the camera poses from a pose file (io/pose_file.h) instead of the log's own, before the first
+  // Next(). Sources whose frame times are not known in advance (videos, cameras) refuse it.
+  virtual Status UsePoseFile(const std::string& path);
+
   const std::vector<SkippedFrame>& skipped() const { return skipped_; }
 
  protected:

@@ -31,6 +31,7 @@ struct MappingRequest {
   std::string config_path;           // YAML configuration (empty: the defaults)
   std::string vocabulary_path;       // empty: the default one (FindDefaultVocabulary)
   double fps = 0.0;                  // rate of logs without timestamps [Hz] (0: their own)
+  std::string poses;                 // camera poses of the (one) log from a TUM or KITTI file (io/pose_file.h)
   FlightPassOptions pass;
   DriveOptions drive;  // a live camera is never paced (it paces itself)
   // With a prior map that has a flight: append each change found while flying to OUT/events.jsonl.
