@@ -58,6 +58,7 @@ inline graph::TopoMap TwoFlights() {
   record.grid.voxel_size = 0.2;
   record.grid.voxels = {{-3, 0, 1, 2, 7}, {-3, 1, 0, 0, 4}, {5, -2, 2, 9, 1}};
   record.grid.evicted_voxels = 11;
+  record.depth_source = "stereo";
   map.SetPatrol(record);
   return map;
 }

@@ -273,6 +273,13 @@ EvidenceGridData EvidenceGrid::ToData() const {
   return data;
 }
 
+EvidenceGridData EvidenceGrid::TakeData() {
+  EvidenceGridData data = ToData();
+  std::vector<Slot>(std::min<std::size_t>(1 << 16, 2 * max_voxels_)).swap(slots_);  // as a new grid's
+  size_ = 0;
+  return data;
+}
+
 // True when a voxel next to `index` is occupied in `grid`, the patrol where `index` is free: the same
 // surface seen a voxel off (an edge or a corner from a slightly different view) explains the change.
 // With `vertical` false only the horizontal neighbours count.

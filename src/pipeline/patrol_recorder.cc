@@ -160,7 +160,7 @@ PatrolRecord PatrolRecorder::Snapshot(TimestampNs until_ns, bool with_grid) cons
 void PatrolRecorder::Finish(PatrolRecord* record, PatrolRecordStats* stats) {
   *record = base_;
   if (active_ && record->has_objects) record->objects = mapper_.Finish();
-  if (active_ && has_depth_) record->grid = grid_.ToData();
+  if (active_ && has_depth_) record->grid = grid_.TakeData();
   stats_.associations = mapper_.associations();
   stats_.association_seconds = mapper_.association_seconds();
   stats_.skipped_detections = mapper_.skipped();

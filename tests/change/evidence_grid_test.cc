@@ -135,6 +135,18 @@ TEST(EvidenceGrid, DepthImageRaysEndOnTheWall) {
   EXPECT_GE(halfway_passes, 16 * 12);
 }
 
+TEST(EvidenceGrid, TakingTheDataEmptiesTheGrid) {
+  EvidenceGrid grid(EvidenceGridOptions{});
+  grid.TraceRay(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 0.0), true);
+  const EvidenceGridData copy = grid.ToData();
+  const EvidenceGridData taken = grid.TakeData();
+  ASSERT_EQ(taken.voxels.size(), copy.voxels.size());
+  EXPECT_EQ(taken.voxels.back().hits, 1);
+  EXPECT_TRUE(grid.ToData().voxels.empty());
+  grid.TraceRay(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.3, 0.0, 0.0), true);  // still usable
+  EXPECT_EQ(grid.ToData().voxels.size(), 2u);
+}
+
 TEST(EvidenceGrid, UncertainReturnsLeaveTheSpaceJustBeforeThemUnknown) {
   EvidenceGrid grid(EvidenceGridOptions{});
   // Voxels 0..10 along x; those entered in the last 0.55 m (8 at 1.5 m, 9 at 1.7 m) are neither free nor hit.

@@ -85,6 +85,7 @@ TEST(MapFile, RoundTripKeepsEverything) {
   EXPECT_EQ(p.grid.voxels[2].hits, 9);
   EXPECT_EQ(p.grid.voxels[0].passes, 7);
   EXPECT_EQ(p.grid.evicted_voxels, 11);
+  EXPECT_EQ(p.depth_source, "stereo");
   // Saving again gives the same bytes.
   ASSERT_TRUE(SaveMap(loaded, dir / "again.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "m.pmap"), testing::ReadText(dir / "again.pmap"));
@@ -196,27 +197,46 @@ void DowngradeEdges(std::string* bytes) {
   bytes->replace(tag, 20 + length, section + old);
 }
 
-// A version-3 map (before the grid counted the voxels its memory budget dropped) loads, with none dropped.
-TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
-  testing::TempDir dir;
-  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
-  std::string bytes = testing::ReadText(dir / "m.pmap");
+// The map file of `map` as an older version wrote it: the last `dropped` bytes of the one patrol record (its
+// newest fields) cut off.
+std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std::uint32_t version,
+                               std::uint64_t dropped) {
+  EXPECT_TRUE(SaveMap(map, path).ok());
+  std::string bytes = testing::ReadText(path);
   const std::size_t tag = bytes.find("PTRL", 16);
-  ASSERT_NE(tag, std::string::npos);
+  EXPECT_NE(tag, std::string::npos);
   std::uint64_t length = 0;
   std::memcpy(&length, bytes.data() + tag + 4, 8);
-  const std::uint64_t old_length = length - 8;  // the one patrol's evicted-voxel count, its last field, goes
-  bytes.erase(tag + 20 + old_length, 8);
+  const std::uint64_t old_length = length - dropped;
+  bytes.erase(tag + 20 + old_length, dropped);
   std::memcpy(bytes.data() + tag + 4, &old_length, 8);
-  const std::uint32_t version = 3;
   std::memcpy(bytes.data() + 8, &version, sizeof(version));
   testing::RecomputeMapChecksums(&bytes);
-  std::ofstream(dir / "v3.pmap", std::ios::binary) << bytes;
+  return bytes;
+}
+
+// A version-3 map (before the grid counted the voxels its memory budget dropped, and before the record kept
+// its depth source) loads, with none dropped and no source.
+TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
+  testing::TempDir dir;
+  // The evicted-voxel count (8 bytes) and the depth source ("stereo": a 4-byte length and 6 characters).
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 18);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
   EXPECT_EQ(map.Patrol("b")->grid.voxels.size(), 3u);
   EXPECT_EQ(map.Patrol("b")->grid.evicted_voxels, 0);
+  EXPECT_EQ(map.Patrol("b")->depth_source, "");
+}
+
+TEST(MapFile, VersionFourPatrolRecordsStillLoad) {
+  testing::TempDir dir;
+  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 10);
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v4.pmap", &map).ok()) << LoadMap(dir / "v4.pmap", &map).message();
+  ASSERT_NE(map.Patrol("b"), nullptr);
+  EXPECT_EQ(map.Patrol("b")->grid.evicted_voxels, 11);
+  EXPECT_EQ(map.Patrol("b")->depth_source, "");
 }
 
 TEST(MapFile, VersionOneFilesStillLoad) {

@@ -42,6 +42,9 @@ class EvidenceGrid {
   // Updates lost because the current depth image alone filled the grid.
   long long dropped_updates() const { return dropped_; }
   EvidenceGridData ToData() const;
+  // ToData(), and the table's memory given back (the grid is as a new one afterwards, its eviction count
+  // kept): the end of a patrol.
+  EvidenceGridData TakeData();
 
  private:
   struct Slot {
@@ -87,7 +90,7 @@ struct GeometryChange {
   long long compared_voxels = 0;  // observed enough in both patrols
   // Voxels each patrol's grid dropped at its memory budget (change.grid.memory_mb): nothing is compared there.
   long long evicted_prior = 0, evicted_current = 0;
-  std::string depth_prior, depth_current;  // where each grid's depth came from (PatrolRecord::depth_source)
+  std::string depth_prior, depth_current;       // where each grid's depth came from (PatrolRecord::depth_source)
   std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions
   std::vector<GeometryRegion> regions;          // largest first
 };
