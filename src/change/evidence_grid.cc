@@ -136,7 +136,10 @@ EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
     if (slot.key == key) return &slot;
     if (slot.key == 0) {
       if (size_ >= max_voxels_) return Evict() ? Find(key) : nullptr;
-      if (2 * (size_ + 1) > slots_.size()) {
+      // Grow at three quarters full: each growth holds the old table and the new, twice its size, at once
+      // (a memory peak), so it comes late. The largest table (2 * max_voxels_ slots) is never more than half
+      // full.
+      if (4 * (size_ + 1) > 3 * slots_.size()) {
         Grow();
         return Find(key);
       }

@@ -74,8 +74,9 @@ struct EvidenceGridOptions {
   // ... and marks a voxel hit only where its range error is at most this [m] (farther returns carve only).
   double max_hit_sigma_m = 0.5;
   // Memory of the grid's table at most, the copy made while it grows or sheds voxels included [MB]: 256 MB
-  // hold 4.2 million voxels (16 bytes a slot, at most half the slots used). When full, the least recently
-  // observed quarter of the voxels is dropped (EvidenceGrid); the patrol record counts them.
+  // hold 4.2 million voxels (16 bytes a slot; the largest table at most half used, smaller ones grow at three
+  // quarters). When full, the least recently observed quarter of the voxels is dropped (EvidenceGrid); the
+  // patrol record counts them.
   double memory_mb = 256.0;
 };
 
