@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <set>
 
 #include <spdlog/spdlog.h>
 #include <opencv2/imgproc.hpp>
@@ -14,6 +15,7 @@
 
 #include "image_list_source.h"
 #include "image_times.h"
+#include "patrolmap/io/bag.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/readers.h"
 
@@ -262,9 +264,34 @@ Status CheckLogExists(const std::string& path) {
   return Status::NotFound(path + ": no such file or folder");
 }
 
+Status ParseTopicChoice(const std::vector<std::string>& assignments, TopicChoice* choice) {
+  std::set<std::string> given;
+  for (const std::string& assignment : assignments) {
+    const std::size_t equals = assignment.find('=');
+    const std::string role = assignment.substr(0, equals);
+    std::string* slot = role == "camera"        ? &choice->camera
+                        : role == "camera_info" ? &choice->camera_info
+                        : role == "imu"         ? &choice->imu
+                        : role == "gps"         ? &choice->gps
+                        : role == "pose"        ? &choice->pose
+                                                : nullptr;
+    if (equals == std::string::npos || equals + 1 == assignment.size()) {
+      return Status::InvalidArgument("--topic " + assignment + ": expected ROLE=TOPIC, e.g. camera=/cam0/image_raw");
+    }
+    if (slot == nullptr) {
+      return Status::InvalidArgument("--topic " + assignment + ": unknown role '" + role +
+                                     "' (camera, camera_info, imu, gps, pose)");
+    }
+    if (!given.insert(role).second) return Status::InvalidArgument("--topic: role '" + role + "' given twice");
+    *slot = assignment.substr(equals + 1);
+  }
+  return Status::Ok();
+}
+
 Status OpenLog(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
   if (path.find('%') != std::string::npos) return OpenImagePattern(path, options, source);
   if (!fs::exists(path)) return Status::NotFound(path + ": no such file or folder");
+  if (IsBag(path)) return OpenBag(path, options, source);
   if (fs::is_directory(path)) {
     if (fs::exists(path + "/cam0/data.csv") || fs::exists(path + "/mav0/cam0/data.csv")) {
       return OpenEuroc(path, source);

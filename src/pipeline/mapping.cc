@@ -51,6 +51,7 @@ Status CheckRequest(const MappingRequest& request, Config* config) {
   if (request.events && !request.events->IsValid(&error)) return Status::InvalidArgument(error);
   PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, config));
   if (request.fps > 0.0) config->input.frame_rate_hz = request.fps;
+  PATROLMAP_RETURN_IF_ERROR(io::ParseTopicChoice(request.topics, &config->input.topics));
   return Status::Ok();
 }
 

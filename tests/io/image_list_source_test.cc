@@ -27,7 +27,7 @@ TEST(ImageFolder, ReadsInNaturalOrderWithTimestampsFromRate) {
   for (int i : {10, 2, 1}) cv::imwrite(dir / (std::to_string(i) + ".png"), TestImage(i));
   WriteText(dir / "notes.txt", "not an image");
   std::unique_ptr<FrameSource> source;
-  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0}, &source).ok());
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0, {}}, &source).ok());
   Status end;
   const std::vector<Frame> frames = ReadAll(source.get(), &end);
   EXPECT_TRUE(end.end_of_stream());
@@ -46,7 +46,7 @@ TEST(ImageFolder, WithoutTimesTheRateIsAssumedAndMarked) {
   ASSERT_TRUE(OpenImageFolder(dir.path(), {}, &source).ok());
   EXPECT_FALSE(source->info().timed);
   EXPECT_DOUBLE_EQ(source->info().frame_rate_hz, kAssumedFrameRateHz);
-  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0}, &source).ok());
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0, {}}, &source).ok());
   EXPECT_TRUE(source->info().timed);
   EXPECT_DOUBLE_EQ(source->info().frame_rate_hz, 10.0);
 }

@@ -94,6 +94,10 @@ int main(int argc, char** argv) {
                  "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "
                  "matrix per image); replaces the log's state estimate")
       ->check(CLI::ExistingFile);
+  app.add_option("--topic", arguments.request.topics,
+                 "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose); repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
   app.add_option("--max-seconds", arguments.request.drive.max_seconds,
                  "stop after this much of the flight [s]; 0: at its end")

@@ -26,6 +26,9 @@ using tools::FiniteRange;
 // --fps: the frame rate of image folders, patterns and videos, overriding their own times [Hz].
 void AddFpsOption(CLI::App* app, double* fps);
 
+// --topic ROLE=NAME (repeatable): the topics of a ROS bag the flight is read from.
+void AddTopicOption(CLI::App* app, std::vector<std::string>* topics);
+
 // --poses: the camera poses of the log from a TUM or KITTI pose file (change detection needs them).
 void AddPosesOption(CLI::App* app, std::string* poses);
 

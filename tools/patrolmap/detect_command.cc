@@ -23,6 +23,7 @@ struct DetectArguments {
   std::string quantity;
   std::string smoothing;
   double fps = 0.0;
+  std::vector<std::string> topics;
 };
 
 Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config) {
@@ -62,6 +63,7 @@ int RunDetect(const DetectArguments& arguments) {
   if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
   if (status.ok()) status = ApplyOverrides(arguments, &config);  // command-line flags win over the file
   if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
+  if (status.ok()) status = io::ParseTopicChoice(arguments.topics, &config.input.topics);
   if (!status.ok()) return Fail(status);
   std::unique_ptr<io::FrameSource> source;
   status = io::OpenLog(arguments.log, config.input, &source);
@@ -98,6 +100,7 @@ Command AddDetectCommand(CLI::App* app) {
   app->add_option("--response", arguments->quantity, "override flow.response.quantity: length or line_parameter");
   app->add_option("--smoothing", arguments->smoothing, "override flow.smoothing.mode: centered or causal");
   AddFpsOption(app, &arguments->fps);
+  AddTopicOption(app, &arguments->topics);
   app->footer("Writes OUT/key_locations.csv, OUT/response.csv and OUT/response.svg.");
   return [arguments] { return RunDetect(*arguments); };
 }

@@ -52,6 +52,15 @@ void AddFpsOption(CLI::App* app, double* fps) {
       ->check(FiniteRange(0.001, 10000.0));
 }
 
+void AddTopicOption(CLI::App* app, std::vector<std::string>* topics) {
+  app->add_option("--topic", *topics,
+                  "a ROS bag's topic for a role, as ROLE=TOPIC (roles: camera, camera_info, imu, gps, pose); "
+                  "repeat for several; default: the first topic of each role's message type (patrolmap info BAG "
+                  "lists them)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
 void AddPosesOption(CLI::App* app, std::string* poses) {
   app->add_option("--poses", *poses,
                   "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "

@@ -1,4 +1,4 @@
-// patrolmap info MAP
+// patrolmap info MAP|BAG
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -8,11 +8,28 @@
 #include "commands.h"
 #include "common.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/io/bag.h"
 
 namespace patrolmap::tools {
 namespace {
 
+// A bag's topics: name, type, messages and rate, as `rosbag info` and `ros2 bag info` list them.
+int RunBagInfo(const std::string& path) {
+  std::vector<io::BagTopic> topics;
+  const Status status = io::ListBagTopics(path, &topics);
+  if (!status.ok()) return Fail(status);
+  std::printf("%s: %zu %s\n", path.c_str(), topics.size(), topics.size() == 1 ? "topic" : "topics");
+  for (const io::BagTopic& topic : topics) {
+    std::printf("  %-36s %-36s %8lld msgs", topic.name.c_str(), topic.type.c_str(),
+                static_cast<long long>(topic.count));
+    if (topic.rate_hz > 0.0) std::printf(" %8.2f Hz", topic.rate_hz);
+    std::printf("\n");
+  }
+  return 0;
+}
+
 int RunInfo(const std::string& path, bool verbose) {
+  if (io::IsBag(path)) return RunBagInfo(path);
   graph::TopoMap map;
   const Status status = graph::LoadMap(path, &map);
   if (!status.ok()) return Fail(status);
@@ -64,7 +81,8 @@ int RunInfo(const std::string& path, bool verbose) {
 Command AddInfoCommand(CLI::App* app) {
   auto path = std::make_shared<std::string>();
   auto verbose = std::make_shared<bool>(false);
-  app->add_option("map", *path, "map file (map.pmap)")->required();
+  app->add_option("file", *path, "a map file (map.pmap), or a ROS bag (.bag, or a ROS 2 bag folder) to list its topics")
+      ->required();
   app->add_flag("-v,--verbose", *verbose, "list every flight's objects");
   return [path, verbose] { return RunInfo(*path, *verbose); };
 }

@@ -54,6 +54,7 @@ Command AddPatrolCommand(CLI::App* app) {
   app->add_option("-c,--config", arguments->request.config_path, "YAML configuration (see config/default.yaml)");
   app->add_option("--vocabulary", arguments->request.vocabulary_path, "vocabulary file (default: the shipped one)");
   AddFpsOption(app, &arguments->request.fps);
+  AddTopicOption(app, &arguments->request.topics);
   AddPosesOption(app, &arguments->request.poses);
   app->footer(
       "Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
@@ -75,6 +76,7 @@ Command AddMapCommand(CLI::App* app) {
                   "vocabulary file (patrolmap vocab build; default: the shipped one, found beside the program, in "
                   "the install prefix or at $PATROLMAP_VOCABULARY)");
   AddFpsOption(app, &arguments->request.fps);
+  AddTopicOption(app, &arguments->request.topics);
   AddPosesOption(app, &arguments->request.poses);
   app->add_flag("--every-frame", arguments->every_frame,
                 "make every image a node, without key-location detection (image collections, place recognition "

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "patrolmap/io/frame_source.h"
 
@@ -11,11 +12,23 @@ namespace patrolmap::io {
 // Rate taken for a log without timestamps when none is given (with a warning) [Hz].
 constexpr double kAssumedFrameRateHz = 30.0;
 
+// The topics of a ROS bag a flight is read from (--topic ROLE=NAME); an empty name takes the first topic
+// of the role's type (bag.h).
+struct TopicChoice {
+  std::string camera, camera_info, imu, gps, pose;
+};
+
+// Sets the roles of "ROLE=NAME" assignments (roles: camera, camera_info, imu, gps, pose); fails naming an
+// assignment without '=', an unknown role or a role given twice.
+Status ParseTopicChoice(const std::vector<std::string>& assignments, TopicChoice* choice);
+
 struct ImageFolderOptions {
   // Frame rate of image folders, printf patterns and videos [Hz] (--fps). 0: from the log's own times
   // (a times file, the file names, the video's metadata); a log without any is read at
   // kAssumedFrameRateHz with a warning. A positive rate overrides the log's times.
   double frame_rate_hz = 0.0;
+  // Topics of a ROS bag.
+  TopicChoice topics;
 };
 
 // Image folder: every .png/.jpg/.jpeg/.bmp/.pgm/.ppm/.tif/.tiff file of a
@@ -44,11 +57,14 @@ Status OpenCamera(int device, const ImageFolderOptions& options, std::unique_ptr
 // the log is opened: malformed lines and non-monotonic timestamps fail here.
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source);
 
+// ROS 1 bag (.bag) or ROS 2 bag (a folder with metadata.yaml, or one of its .db3 files): bag.h.
+Status OpenBag(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source);
+
 // Fails with "PATH: no such file or folder" unless `path` exists (a printf pattern: its folder), so a
 // front end can name a missing log before it loads anything else.
 Status CheckLogExists(const std::string& path);
 
-// Picks the reader for `path`: EuRoC when it holds cam0/data.csv (or
+// Picks the reader for `path`: a ROS bag (IsBag in bag.h), EuRoC when it holds cam0/data.csv (or
 // mav0/cam0/data.csv), a printf pattern when it contains '%', an image folder
 // for other folders, and a video for other files.
 Status OpenLog(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source);

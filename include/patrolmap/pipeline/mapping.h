@@ -31,6 +31,7 @@ struct MappingRequest {
   std::string config_path;           // YAML configuration (empty: the defaults)
   std::string vocabulary_path;       // empty: the default one (FindDefaultVocabulary)
   double fps = 0.0;                  // rate of logs without timestamps [Hz] (0: their own)
+  std::vector<std::string> topics;   // a bag's topics as ROLE=NAME (io::ParseTopicChoice)
   std::string poses;                 // camera poses of the (one) log from a TUM or KITTI file (io/pose_file.h)
   FlightPassOptions pass;
   DriveOptions drive;  // a live camera is never paced (it paces itself)

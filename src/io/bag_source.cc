@@ -1,0 +1,589 @@
+// A FrameSource over a ROS bag (bag.h): the chosen topics streamed in record-time order, camera messages
+// held in a short queue until the samples that belong to them have been read (the IMU up to the next
+// frame, a pose after the frame's time), then decoded one at a time.
+#include <algorithm>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include <spdlog/spdlog.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "bag_file.h"
+#include "image_times.h"
+#include "patrolmap/io/patrol_sensors.h"
+#include "patrolmap/io/pose_file.h"
+#include "patrolmap/io/readers.h"
+
+namespace fs = std::filesystem;
+
+namespace patrolmap::io {
+namespace {
+
+using rosmsg::MessageKind;
+
+// Camera messages held while waiting for a pose after their time; beyond, a frame goes without one.
+constexpr std::size_t kMaxPendingFrames = 64;
+
+bool IsImageKind(MessageKind kind) { return kind == MessageKind::kImage || kind == MessageKind::kCompressedImage; }
+bool IsPoseKind(MessageKind kind) {
+  return kind == MessageKind::kPoseStamped || kind == MessageKind::kPoseWithCovarianceStamped ||
+         kind == MessageKind::kOdometry;
+}
+
+// The topic chosen for one role: the named one (which must exist and have a fitting type) or the first of
+// a fitting type. -1 when the bag has none and none was named.
+Status ChooseTopic(const std::string& path, const std::vector<BagTopic>& topics, const char* role,
+                   const std::string& wanted, bool (*fits)(MessageKind), int* chosen) {
+  *chosen = -1;
+  for (std::size_t i = 0; i < topics.size(); ++i) {
+    if (!wanted.empty() && topics[i].name != wanted) continue;
+    const bool fitting = fits(rosmsg::KindOfType(topics[i].type));
+    if (wanted.empty() && !fitting) continue;
+    if (!fitting) {
+      return Status::InvalidArgument(path + ", topic " + topics[i].name + ": type " + topics[i].type +
+                                     " cannot be the " + role + " topic");
+    }
+    *chosen = static_cast<int>(i);
+    return Status::Ok();
+  }
+  if (!wanted.empty()) {
+    std::string names;
+    for (const BagTopic& topic : topics) names += (names.empty() ? "" : ", ") + topic.name;
+    return Status::NotFound(path + ": no topic " + wanted + " (--topic " + role + "=); the bag has " +
+                            (names.empty() ? "no topics" : names));
+  }
+  return Status::Ok();
+}
+
+// The topics a flight is read from.
+struct BagRoles {
+  int camera = -1, camera_info = -1, imu = -1, gps = -1, pose = -1, transforms = -1;
+};
+
+Status ChooseRoles(const std::string& path, const std::vector<BagTopic>& topics, const TopicChoice& choice,
+                   BagRoles* roles) {
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "camera", choice.camera, IsImageKind, &roles->camera));
+  if (roles->camera < 0) {
+    return Status::DataLoss(path + ": no sensor_msgs/Image or CompressedImage topic (patrolmap info " + path +
+                            " lists its topics)");
+  }
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(
+      path, topics, "camera_info", choice.camera_info, [](MessageKind k) { return k == MessageKind::kCameraInfo; },
+      &roles->camera_info));
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(
+      path, topics, "imu", choice.imu, [](MessageKind k) { return k == MessageKind::kImu; }, &roles->imu));
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(
+      path, topics, "gps", choice.gps, [](MessageKind k) { return k == MessageKind::kNavSatFix; }, &roles->gps));
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "pose", choice.pose, IsPoseKind, &roles->pose));
+  for (std::size_t i = 0; i < topics.size(); ++i) {
+    if (topics[i].name == "/tf_static" && rosmsg::KindOfType(topics[i].type) == MessageKind::kTransforms) {
+      roles->transforms = static_cast<int>(i);
+    }
+  }
+  return Status::Ok();
+}
+
+// The static transforms of a bag as a forest of frames: each frame's rotation in its tree's root.
+class FrameTree {
+ public:
+  void Add(const rosmsg::TransformMessage& transform) {
+    parent_[transform.child_frame] = {transform.header.frame_id, transform.rotation};
+  }
+
+  // The rotation taking vectors of `source` into `target`, when both frames are known and linked.
+  std::optional<Eigen::Matrix3d> Rotation(const std::string& target, const std::string& source) const {
+    if (target == source) return Eigen::Matrix3d::Identity();
+    std::string target_root, source_root;
+    const Eigen::Quaterniond root_from_target = FromRoot(target, &target_root);
+    const Eigen::Quaterniond root_from_source = FromRoot(source, &source_root);
+    if (target_root != source_root || (target_root == target && source_root == source)) return std::nullopt;
+    return (root_from_target.conjugate() * root_from_source).toRotationMatrix();
+  }
+
+ private:
+  Eigen::Quaterniond FromRoot(const std::string& frame, std::string* root) const {
+    Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+    std::string at = frame;
+    for (std::size_t depth = 0; depth < parent_.size(); ++depth) {  // a cycle ends here
+      const auto parent = parent_.find(at);
+      if (parent == parent_.end()) break;
+      rotation = parent->second.second * rotation;
+      at = parent->second.first;
+    }
+    *root = at;
+    return rotation;
+  }
+
+  std::map<std::string, std::pair<std::string, Eigen::Quaterniond>> parent_;
+};
+
+// Reads at most `limit` messages of one topic (0: all), each handed to `use`.
+template <typename Use>
+Status ForEachMessage(BagFile* bag, int topic, std::size_t limit, Use use) {
+  std::unique_ptr<BagStream> stream;
+  PATROLMAP_RETURN_IF_ERROR(bag->Stream({topic}, limit, &stream));
+  BagMessage message;
+  while (true) {
+    const Status status = stream->Next(&message);
+    if (status.code() == StatusCode::kEndOfStream) return Status::Ok();
+    PATROLMAP_RETURN_IF_ERROR(status);
+    PATROLMAP_RETURN_IF_ERROR(use(message));
+  }
+}
+
+Status TopicError(const std::string& path, const BagTopic& topic, const Status& status) {
+  return Status::DataLoss(path + ", topic " + topic.name + " (" + topic.type + "): " + status.message());
+}
+
+// A sample of a slowly varying quantity (GPS position, speed) interpolated at frame times.
+template <typename Value>
+struct TimedValue {
+  TimestampNs timestamp_ns = 0;
+  Value value{};
+};
+
+// The value at `t` from `samples` (ascending): interpolated between the two around it, the first before
+// them and the last after them; samples before the one at or before `t` are dropped.
+template <typename Value>
+std::optional<Value> ValueAt(std::deque<TimedValue<Value>>* samples, TimestampNs t) {
+  while (samples->size() >= 2 && (*samples)[1].timestamp_ns <= t) samples->pop_front();
+  if (samples->empty()) return std::nullopt;
+  const TimedValue<Value>& before = samples->front();
+  if (samples->size() == 1 || before.timestamp_ns >= t) return before.value;
+  const TimedValue<Value>& after = (*samples)[1];
+  const double weight =
+      static_cast<double>(t - before.timestamp_ns) / static_cast<double>(after.timestamp_ns - before.timestamp_ns);
+  return Value(before.value + weight * (after.value - before.value));
+}
+
+// Converts a decoded image message to the frame's 8-bit grey image; fails naming the problem.
+Status ToGrey(const rosmsg::ImageMessage& image, cv::Mat* grey) {
+  if (image.compressed) {
+    const cv::Mat bytes(1, static_cast<int>(image.size), CV_8UC1, const_cast<std::uint8_t*>(image.data));
+    *grey = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    if (grey->empty()) return Status::DataLoss("compressed image (" + image.encoding + ") does not decode");
+    return Status::Ok();
+  }
+  static const std::map<std::string, std::pair<int, int>> kEncodings = {
+      // encoding -> (OpenCV type, conversion to grey; -1: none)
+      {"mono8", {CV_8UC1, -1}},
+      {"8UC1", {CV_8UC1, -1}},
+      {"mono16", {CV_16UC1, -1}},
+      {"16UC1", {CV_16UC1, -1}},
+      {"bgr8", {CV_8UC3, cv::COLOR_BGR2GRAY}},
+      {"rgb8", {CV_8UC3, cv::COLOR_RGB2GRAY}},
+      {"bgra8", {CV_8UC4, cv::COLOR_BGRA2GRAY}},
+      {"rgba8", {CV_8UC4, cv::COLOR_RGBA2GRAY}},
+  };
+  const auto encoding = kEncodings.find(image.encoding);
+  if (encoding == kEncodings.end()) {
+    return Status::DataLoss("encoding '" + image.encoding + "' is not one of mono8, mono16, bgr8, rgb8, bgra8, rgba8");
+  }
+  const int type = encoding->second.first;
+  const std::size_t row_bytes = static_cast<std::size_t>(image.width) * CV_ELEM_SIZE(type);
+  if (image.width == 0 || image.height == 0 || image.width > 1 << 15 || image.height > 1 << 15 ||
+      image.step < row_bytes || static_cast<std::size_t>(image.step) * image.height > image.size) {
+    return Status::DataLoss("image of " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", step " +
+                            std::to_string(image.step) + " does not fit its " + std::to_string(image.size) + " bytes");
+  }
+  const cv::Mat view(static_cast<int>(image.height), static_cast<int>(image.width), type,
+                     const_cast<std::uint8_t*>(image.data), image.step);
+  if (type == CV_16UC1) {
+    cv::Mat wide = view;
+    if (image.big_endian) {
+      wide = view.clone();
+      wide.forEach<std::uint16_t>(
+          [](std::uint16_t& v, const int*) { v = static_cast<std::uint16_t>(v << 8 | v >> 8); });
+    }
+    wide.convertTo(*grey, CV_8UC1, 1.0 / 256.0);
+  } else if (encoding->second.second < 0) {
+    view.copyTo(*grey);
+  } else {
+    cv::cvtColor(view, *grey, encoding->second.second);
+  }
+  return Status::Ok();
+}
+
+// A camera message waiting for its samples: its bytes and its time.
+struct PendingFrame {
+  BagMessage message;
+  TimestampNs timestamp_ns = 0;
+  std::int64_t index = 0;
+};
+
+class BagSource : public FrameSource {
+ public:
+  BagSource(LogInfo info, std::unique_ptr<BagFile> bag, BagRoles roles, std::unique_ptr<BagStream> stream,
+            std::optional<Eigen::Matrix3d> body_from_camera)
+      : info_(std::move(info)),
+        bag_(std::move(bag)),
+        roles_(roles),
+        stream_(std::move(stream)),
+        body_from_camera_(body_from_camera.value_or(Eigen::Matrix3d::Identity())) {}
+
+  const LogInfo& info() const override { return info_; }
+
+  Status UsePoseFile(const std::string& path) override {
+    std::vector<TimestampNs> times;
+    PATROLMAP_RETURN_IF_ERROR(bag_->Times(roles_.camera, &times));
+    std::vector<CameraPoseSample> poses;
+    PATROLMAP_RETURN_IF_ERROR(ReadPoseFile(path, times, &poses));
+    if (info_.has_poses) spdlog::info("{}: camera poses from {}, not the bag's pose topic", info_.path, path);
+    file_poses_ = std::move(poses);
+    roles_.pose = -1;
+    info_.has_poses = true;
+    return Status::Ok();
+  }
+
+  Status Next(bool decode_image, Frame* frame) override {
+    frame->imu.clear();
+    frame->poses.clear();
+    frame->depth.clear();
+    frame->detections.clear();
+    while (true) {
+      PATROLMAP_RETURN_IF_ERROR(Fill());
+      if (pending_.empty()) return Status::EndOfStream();
+      PendingFrame& next = pending_.front();
+      const bool ok = Emit(decode_image, next, frame);
+      spare_.push_back(std::move(next.message));
+      pending_.pop_front();
+      if (ok) return Status::Ok();
+    }
+  }
+
+ private:
+  // Reads until two frames wait (so the first has the IMU up to the second) and the first has a pose after
+  // its time, or the bag ends.
+  Status Fill() {
+    while (!ended_ && pending_.size() < kMaxPendingFrames && (pending_.size() < 2 || WantsPose())) {
+      BagMessage message;
+      if (!spare_.empty()) {
+        message = std::move(spare_.back());
+        spare_.pop_back();
+      }
+      const Status status = stream_->Next(&message);
+      if (status.code() == StatusCode::kEndOfStream) {
+        ended_ = true;
+        break;
+      }
+      PATROLMAP_RETURN_IF_ERROR(status);
+      if (message.topic == roles_.camera) {
+        PATROLMAP_RETURN_IF_ERROR(Enqueue(std::move(message)));
+      } else {
+        PATROLMAP_RETURN_IF_ERROR(Consume(message));
+        spare_.push_back(std::move(message));
+      }
+    }
+    return Status::Ok();
+  }
+
+  bool WantsPose() const {
+    return roles_.pose >= 0 && (poses_.empty() || poses_.back().timestamp_ns < pending_.front().timestamp_ns);
+  }
+
+  Status Enqueue(BagMessage message) {
+    rosmsg::ImageMessage image;
+    const bool compressed = rosmsg::KindOfType(Topic(roles_.camera).type) == MessageKind::kCompressedImage;
+    const Status status = rosmsg::DecodeImage(message.bytes, bag_->wire(), compressed, &image);
+    if (!status.ok()) return TopicError(info_.path, Topic(roles_.camera), status);
+    const TimestampNs t = StampOrRecord(image.header, message.record_ns);
+    pending_.push_back({std::move(message), t, next_index_++});
+    return Status::Ok();
+  }
+
+  static TimestampNs StampOrRecord(const rosmsg::Header& header, TimestampNs record_ns) {
+    return header.stamp_ns > 0 ? header.stamp_ns : record_ns;
+  }
+
+  const BagTopic& Topic(int index) const { return bag_->topics()[index]; }
+
+  // A sensor message: into the samples waiting for frames.
+  Status Consume(const BagMessage& message) {
+    const BagTopic& topic = Topic(message.topic);
+    Status status;
+    if (message.topic == roles_.imu) {
+      rosmsg::ImuMessage imu;
+      status = rosmsg::DecodeImu(message.bytes, bag_->wire(), &imu);
+      const TimestampNs t = StampOrRecord(imu.header, message.record_ns);
+      if (status.ok() && (imu_.empty() || t > imu_.back().timestamp_ns) && t > last_imu_ns_) {
+        imu_.push_back({t, imu.gyro, imu.accel});
+      }
+    } else if (message.topic == roles_.gps) {
+      rosmsg::NavSatFixMessage fix;
+      status = rosmsg::DecodeNavSatFix(message.bytes, bag_->wire(), &fix);
+      if (status.ok() && fix.status >= 0)
+        AppendTimed(&gps_, StampOrRecord(fix.header, message.record_ns), fix.position);
+    } else if (message.topic == roles_.pose) {
+      rosmsg::PoseMessage pose;
+      status = rosmsg::DecodePose(message.bytes, bag_->wire(), rosmsg::KindOfType(topic.type), &pose);
+      if (status.ok()) AddPose(pose, StampOrRecord(pose.header, message.record_ns));
+    }
+    if (!status.ok()) return TopicError(info_.path, topic, status);
+    return Status::Ok();
+  }
+
+  template <typename Value>
+  static void AppendTimed(std::deque<TimedValue<Value>>* samples, TimestampNs t, const Value& value) {
+    if (samples->empty() || t > samples->back().timestamp_ns) samples->push_back({t, value});
+  }
+
+  void AddPose(const rosmsg::PoseMessage& pose, TimestampNs t) {
+    if (!poses_.empty() && t <= poses_.back().timestamp_ns) return;
+    CameraPoseSample sample;
+    sample.timestamp_ns = t;
+    sample.position = pose.position;
+    sample.rotation = (pose.rotation * Eigen::Quaterniond(body_from_camera_)).normalized();
+    poses_.push_back(sample);
+    if (pose.has_velocity) AppendTimed(&speeds_, t, pose.velocity.norm());
+  }
+
+  // Hands `pending` out as `frame` with its samples; false when its image is skipped.
+  bool Emit(bool decode_image, const PendingFrame& pending, Frame* frame) {
+    const TimestampNs t = pending.timestamp_ns;
+    if (t <= last_frame_ns_) {
+      RecordSkipped(pending.index, info_.path + ", topic " + Topic(roles_.camera).name + ": frame at " +
+                                       std::to_string(t) + " ns is not after the previous one");
+      return false;
+    }
+    while (!imu_.empty() && imu_.front().timestamp_ns <= t) {
+      frame->imu.push_back(imu_.front());
+      last_imu_ns_ = imu_.front().timestamp_ns;
+      imu_.pop_front();
+    }
+    AttachPoses(t, frame);
+    frame->image.release();
+    if (decode_image) {
+      rosmsg::ImageMessage image;
+      const bool compressed = rosmsg::KindOfType(Topic(roles_.camera).type) == MessageKind::kCompressedImage;
+      Status status = rosmsg::DecodeImage(pending.message.bytes, bag_->wire(), compressed, &image);
+      if (status.ok()) status = ToGrey(image, &frame->image);
+      if (status.ok() && first_size_.empty()) first_size_ = frame->image.size();
+      if (status.ok() && frame->image.size() != first_size_) {
+        status = Status::DataLoss("image is " + std::to_string(frame->image.cols) + "x" +
+                                  std::to_string(frame->image.rows) + ", the bag's first is " +
+                                  std::to_string(first_size_.width) + "x" + std::to_string(first_size_.height));
+      }
+      if (!status.ok()) {
+        RecordSkipped(pending.index, info_.path + ", topic " + Topic(roles_.camera).name + ", message " +
+                                         std::to_string(pending.index) + ": " + status.message());
+        return false;
+      }
+    }
+    last_frame_ns_ = t;
+    frame->timestamp_ns = t;
+    frame->index = pending.index;
+    frame->speed_mps = ValueAt(&speeds_, t);
+    frame->gps = ValueAt(&gps_, t);
+    return true;
+  }
+
+  void AttachPoses(TimestampNs t, Frame* frame) {
+    if (!file_poses_.empty()) {
+      for (; next_file_pose_ < file_poses_.size() && file_poses_[next_file_pose_].timestamp_ns <= t;
+           ++next_file_pose_) {
+        frame->poses.push_back(file_poses_[next_file_pose_]);
+      }
+      frame->pose = PoseAt(file_poses_, t);
+      return;
+    }
+    // Keeps the last pose at or before the frame for the next frame's interpolation.
+    for (const CameraPoseSample& pose : poses_) {
+      if (pose.timestamp_ns > t) break;
+      if (pose.timestamp_ns > last_pose_handed_ns_) frame->poses.push_back(pose);
+    }
+    if (!frame->poses.empty()) last_pose_handed_ns_ = frame->poses.back().timestamp_ns;
+    frame->pose = PoseAt(poses_, t);
+    std::size_t passed = 0;
+    while (passed + 1 < poses_.size() && poses_[passed + 1].timestamp_ns <= t) ++passed;
+    poses_.erase(poses_.begin(), poses_.begin() + static_cast<std::ptrdiff_t>(passed));
+  }
+
+  LogInfo info_;
+  std::unique_ptr<BagFile> bag_;
+  BagRoles roles_;
+  std::unique_ptr<BagStream> stream_;
+  Eigen::Matrix3d body_from_camera_;
+  std::deque<PendingFrame> pending_;
+  std::vector<BagMessage> spare_;  // buffers of read messages, reused
+  bool ended_ = false;
+  std::int64_t next_index_ = 0;
+  TimestampNs last_frame_ns_ = -1, last_imu_ns_ = -1, last_pose_handed_ns_ = -1;
+  std::deque<ImuSample> imu_;
+  std::vector<CameraPoseSample> poses_;  // from the last one at or before the last frame on
+  std::deque<TimedValue<Eigen::Vector3d>> gps_;
+  std::deque<TimedValue<double>> speeds_;
+  std::vector<CameraPoseSample> file_poses_;
+  std::size_t next_file_pose_ = 0;
+  cv::Size first_size_;
+};
+
+Status OpenBagFile(const std::string& path, std::unique_ptr<BagFile>* bag) {
+  if (!fs::exists(path)) return Status::NotFound(path + ": no such file or folder");
+  const fs::path location(path);
+  if (fs::is_directory(location)) return OpenRos2Bag(path, bag);
+  if (location.extension() == ".db3") return OpenRos2Bag(location.parent_path().string(), bag);
+  return OpenRos1Bag(path, bag);
+}
+
+// The first message of `topic` decoded by `decode`; false when the topic has none.
+template <typename Message, typename Decode>
+Status FirstMessage(BagFile* bag, const std::string& path, int topic, Decode decode, Message* message, bool* found) {
+  *found = false;
+  if (topic < 0) return Status::Ok();
+  return ForEachMessage(bag, topic, 1, [&](const BagMessage& m) {
+    const Status status = decode(m.bytes, message);
+    if (!status.ok()) return TopicError(path, bag->topics()[topic], status);
+    *found = true;
+    return Status::Ok();
+  });
+}
+
+// What the bag says before its frames: intrinsics, the frame rate and count, the sensors' frames and the
+// rotations between them.
+struct BagFrames {
+  std::string camera, imu, body;
+};
+
+Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles, LogInfo* info,
+                   std::optional<Eigen::Matrix3d>* body_from_camera) {
+  const rosmsg::Wire wire = bag->wire();
+  const bool compressed = rosmsg::KindOfType(bag->topics()[roles.camera].type) == MessageKind::kCompressedImage;
+  BagFrames frames;
+  bool found = false;
+  rosmsg::ImageMessage image;
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+      bag, path, roles.camera,
+      [&](const std::vector<std::uint8_t>& b, rosmsg::ImageMessage* m) {
+        return rosmsg::DecodeImage(b, wire, compressed, m);
+      },
+      &image, &found));
+  frames.camera = image.header.frame_id;
+  rosmsg::CameraInfoMessage camera_info;
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+      bag, path, roles.camera_info,
+      [&](const std::vector<std::uint8_t>& b, rosmsg::CameraInfoMessage* m) {
+        return rosmsg::DecodeCameraInfo(b, wire, m);
+      },
+      &camera_info, &found));
+  if (found) {
+    const CameraIntrinsics camera{camera_info.k[0],
+                                  camera_info.k[4],
+                                  camera_info.k[2],
+                                  camera_info.k[5],
+                                  static_cast<int>(camera_info.width),
+                                  static_cast<int>(camera_info.height)};
+    if (camera.valid()) info->camera = camera;
+    if (!camera.valid())
+      spdlog::warn("{}, topic {}: camera info without intrinsics", path, bag->topics()[roles.camera_info].name);
+  }
+  rosmsg::ImuMessage imu;
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+      bag, path, roles.imu,
+      [&](const std::vector<std::uint8_t>& b, rosmsg::ImuMessage* m) { return rosmsg::DecodeImu(b, wire, m); }, &imu,
+      &found));
+  frames.imu = imu.header.frame_id;
+  rosmsg::PoseMessage pose;
+  const MessageKind pose_kind =
+      roles.pose >= 0 ? rosmsg::KindOfType(bag->topics()[roles.pose].type) : MessageKind::kOther;
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+      bag, path, roles.pose,
+      [&](const std::vector<std::uint8_t>& b, rosmsg::PoseMessage* m) {
+        return rosmsg::DecodePose(b, wire, pose_kind, m);
+      },
+      &pose, &found));
+  FrameTree tree;
+  if (roles.transforms >= 0) {
+    PATROLMAP_RETURN_IF_ERROR(ForEachMessage(bag, roles.transforms, 0, [&](const BagMessage& m) {
+      std::vector<rosmsg::TransformMessage> transforms;
+      const Status status = rosmsg::DecodeTransforms(m.bytes, wire, &transforms);
+      if (!status.ok()) return TopicError(path, bag->topics()[roles.transforms], status);
+      for (const rosmsg::TransformMessage& transform : transforms) tree.Add(transform);
+      return Status::Ok();
+    }));
+  }
+  if (roles.imu >= 0) {
+    info->camera_from_imu = tree.Rotation(frames.camera, frames.imu);
+    if (!info->camera_from_imu) {
+      spdlog::warn(
+          "{}: /tf_static does not link the camera's frame '{}' to the IMU's '{}': camera-IMU rotation unknown", path,
+          frames.camera, frames.imu);
+    }
+  }
+  if (roles.pose >= 0) {
+    // Odometry names the frame it moves; a stamped pose is taken for the IMU's frame when the tree links it
+    // to the camera, else for the camera's own.
+    frames.body = pose_kind == MessageKind::kOdometry ? pose.child_frame : frames.imu;
+    *body_from_camera = tree.Rotation(frames.body, frames.camera);
+    if (!*body_from_camera) {
+      spdlog::warn(
+          "{}, topic {}: /tf_static does not link the pose's frame '{}' to the camera's '{}': the poses are "
+          "taken for the camera's own",
+          path, bag->topics()[roles.pose].name, frames.body, frames.camera);
+    }
+    info->body_from_camera = body_from_camera->value_or(Eigen::Matrix3d::Identity());
+  }
+  std::vector<TimestampNs> times;
+  PATROLMAP_RETURN_IF_ERROR(bag->Times(roles.camera, &times));
+  info->frame_count = static_cast<std::int64_t>(times.size());
+  info->frame_rate_hz = MedianRate(times);
+  info->timing = "header stamps of " + bag->topics()[roles.camera].name;
+  info->has_imu = roles.imu >= 0;
+  info->has_poses = roles.pose >= 0;
+  info->has_speed = pose_kind == MessageKind::kOdometry;
+  return Status::Ok();
+}
+
+}  // namespace
+
+bool IsBag(const std::string& path) {
+  const fs::path location(path);
+  if (location.extension() == ".bag" || location.extension() == ".db3") return true;
+  std::error_code error;
+  return fs::is_directory(location, error) && fs::is_regular_file(location / "metadata.yaml", error);
+}
+
+Status ListBagTopics(const std::string& path, std::vector<BagTopic>* topics) {
+  std::unique_ptr<BagFile> bag;
+  PATROLMAP_RETURN_IF_ERROR(OpenBagFile(path, &bag));
+  *topics = bag->topics();
+  for (std::size_t i = 0; i < topics->size(); ++i) {
+    std::vector<TimestampNs> times;
+    PATROLMAP_RETURN_IF_ERROR(bag->Times(static_cast<int>(i), &times));
+    (*topics)[i].rate_hz = times.size() >= 2 ? MedianRate(times) : 0.0;
+  }
+  return Status::Ok();
+}
+
+Status OpenBag(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
+  std::unique_ptr<BagFile> bag;
+  PATROLMAP_RETURN_IF_ERROR(OpenBagFile(path, &bag));
+  BagRoles roles;
+  PATROLMAP_RETURN_IF_ERROR(ChooseRoles(path, bag->topics(), options.topics, &roles));
+  LogInfo info;
+  info.path = path;
+  info.kind = bag->wire() == rosmsg::Wire::kRos1 ? "ros1-bag" : "ros2-bag";
+  info.flight_id = CleanFlightId(fs::path(path).lexically_normal().stem().string());
+  if (info.flight_id.empty()) info.flight_id = CleanFlightId(fs::path(path).parent_path().filename().string());
+  std::optional<Eigen::Matrix3d> body_from_camera;
+  PATROLMAP_RETURN_IF_ERROR(ReadLogInfo(bag.get(), path, roles, &info, &body_from_camera));
+  if (options.frame_rate_hz > 0.0) {
+    spdlog::warn("{}: --fps is for logs without times; a bag's frames keep their header stamps", path);
+  }
+  std::vector<int> topics = {roles.camera};
+  for (int topic : {roles.imu, roles.gps, roles.pose}) {
+    if (topic >= 0) topics.push_back(topic);
+  }
+  std::unique_ptr<BagStream> stream;
+  PATROLMAP_RETURN_IF_ERROR(bag->Stream(topics, 0, &stream));
+  spdlog::info("{}: camera {}{}{}{}", path, bag->topics()[roles.camera].name,
+               roles.imu >= 0 ? ", imu " + bag->topics()[roles.imu].name : "",
+               roles.gps >= 0 ? ", gps " + bag->topics()[roles.gps].name : "",
+               roles.pose >= 0 ? ", pose " + bag->topics()[roles.pose].name : "");
+  *source = std::make_unique<BagSource>(std::move(info), std::move(bag), roles, std::move(stream), body_from_camera);
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::io

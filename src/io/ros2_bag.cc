@@ -1,0 +1,242 @@
+// ROS 2 bags with sqlite3 storage: a folder with metadata.yaml (the list of .db3 files, in order) and the
+// files, each with the tables topics(id, name, type, serialization_format) and messages(id, topic_id,
+// timestamp, data). Messages are stepped through with one query per file, ordered by timestamp, so a
+// bag of any size is read a message at a time.
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "bag_file.h"
+#include "image_times.h"
+#include "patrolmap/io/yaml_file.h"
+
+namespace fs = std::filesystem;
+
+namespace patrolmap::io {
+namespace {
+
+struct DatabaseCloser {
+  void operator()(sqlite3* database) const { sqlite3_close(database); }
+};
+struct StatementFinalizer {
+  void operator()(sqlite3_stmt* statement) const { sqlite3_finalize(statement); }
+};
+using Database = std::unique_ptr<sqlite3, DatabaseCloser>;
+using Statement = std::unique_ptr<sqlite3_stmt, StatementFinalizer>;
+
+Status SqlError(const std::string& path, sqlite3* database, const std::string& doing) {
+  std::string message = sqlite3_errmsg(database);
+  const int code = sqlite3_errcode(database);
+  if (code == SQLITE_CORRUPT || code == SQLITE_NOTADB) message += " (the file is truncated or damaged)";
+  return Status::DataLoss(path + ": " + doing + ": " + message);
+}
+
+Status OpenDatabase(const std::string& path, Database* database) {
+  if (!fs::is_regular_file(path)) return Status::NotFound(path + ": no such file (listed in metadata.yaml)");
+  sqlite3* raw = nullptr;
+  const int code = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  database->reset(raw);
+  if (code != SQLITE_OK) return SqlError(path, raw, "cannot open");
+  return Status::Ok();
+}
+
+Status Prepare(const std::string& path, sqlite3* database, const std::string& sql, Statement* statement) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(database, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) {
+    return SqlError(path, database, "not a ROS 2 bag database");
+  }
+  statement->reset(raw);
+  return Status::Ok();
+}
+
+std::string Text(sqlite3_stmt* statement, int column) {
+  const unsigned char* text = sqlite3_column_text(statement, column);
+  return text == nullptr ? std::string() : reinterpret_cast<const char*>(text);
+}
+
+// One .db3 file: its topic ids mapped to the bag's topic indices.
+struct BagDatabase {
+  std::string path;
+  Database database;
+  std::map<int, int> topic_of_id;  // topics.id -> index into the bag's topics
+};
+
+class Ros2Stream : public BagStream {
+ public:
+  Ros2Stream(std::vector<BagDatabase>* files, std::vector<int> topics, std::size_t limit)
+      : files_(files), topics_(std::move(topics)), limit_(limit) {}
+
+  Status Next(BagMessage* message) override {
+    while (limit_ == 0 || read_ < limit_) {
+      if (!statement_) {
+        if (next_file_ >= files_->size()) return Status::EndOfStream();
+        PATROLMAP_RETURN_IF_ERROR(StartFile((*files_)[next_file_++]));
+      }
+      const BagDatabase& file = (*files_)[next_file_ - 1];
+      const int code = sqlite3_step(statement_.get());
+      if (code == SQLITE_DONE) {
+        statement_.reset();
+        continue;
+      }
+      if (code != SQLITE_ROW) return SqlError(file.path, file.database.get(), "reading messages");
+      const auto topic = file.topic_of_id.find(sqlite3_column_int(statement_.get(), 0));
+      if (topic == file.topic_of_id.end()) continue;
+      message->topic = topic->second;
+      message->record_ns = sqlite3_column_int64(statement_.get(), 1);
+      const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_.get(), 2));
+      message->bytes.assign(data, data + sqlite3_column_bytes(statement_.get(), 2));
+      ++read_;
+      return Status::Ok();
+    }
+    return Status::EndOfStream();
+  }
+
+ private:
+  Status StartFile(const BagDatabase& file) {
+    std::string ids;
+    for (const auto& [id, index] : file.topic_of_id) {
+      if (std::find(topics_.begin(), topics_.end(), index) == topics_.end()) continue;
+      ids += (ids.empty() ? "" : ",") + std::to_string(id);
+    }
+    if (ids.empty()) ids = "-1";
+    return Prepare(
+        file.path, file.database.get(),
+        "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids + ") ORDER BY timestamp, id",
+        &statement_);
+  }
+
+  std::vector<BagDatabase>* files_;
+  std::vector<int> topics_;
+  std::size_t limit_;
+  std::size_t read_ = 0;
+  std::size_t next_file_ = 0;
+  Statement statement_;
+};
+
+class Ros2Bag : public BagFile {
+ public:
+  explicit Ros2Bag(std::string folder) : folder_(std::move(folder)) {}
+
+  Status Open() {
+    std::vector<std::string> names;
+    PATROLMAP_RETURN_IF_ERROR(ReadMetadata(&names));
+    for (const std::string& name : names) {
+      BagDatabase file;
+      file.path = folder_ + "/" + name;
+      PATROLMAP_RETURN_IF_ERROR(OpenDatabase(file.path, &file.database));
+      PATROLMAP_RETURN_IF_ERROR(ReadTopics(&file));
+      files_.push_back(std::move(file));
+    }
+    return CountMessages();
+  }
+
+  rosmsg::Wire wire() const override { return rosmsg::Wire::kCdr; }
+  const std::vector<BagTopic>& topics() const override { return topics_; }
+
+  Status Times(int topic, std::vector<TimestampNs>* times) override {
+    times->clear();
+    for (BagDatabase& file : files_) {
+      for (const auto& [id, index] : file.topic_of_id) {
+        if (index != topic) continue;
+        Statement statement;
+        PATROLMAP_RETURN_IF_ERROR(
+            Prepare(file.path, file.database.get(),
+                    "SELECT timestamp FROM messages WHERE topic_id = " + std::to_string(id) + " ORDER BY timestamp",
+                    &statement));
+        int code = SQLITE_ROW;
+        while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
+          times->push_back(sqlite3_column_int64(statement.get(), 0));
+        }
+        if (code != SQLITE_DONE) return SqlError(file.path, file.database.get(), "reading message times");
+      }
+    }
+    return Status::Ok();
+  }
+
+  Status Stream(const std::vector<int>& topics, std::size_t limit, std::unique_ptr<BagStream>* stream) override {
+    *stream = std::make_unique<Ros2Stream>(&files_, topics, limit);
+    return Status::Ok();
+  }
+
+ private:
+  Status ReadMetadata(std::vector<std::string>* names) {
+    const std::string path = folder_ + "/metadata.yaml";
+    YAML::Node root;
+    PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
+    const YAML::Node info = root["rosbag2_bagfile_information"];
+    if (!info || !info.IsMap()) return Status::DataLoss(path + ": no 'rosbag2_bagfile_information' map");
+    const std::string storage =
+        info["storage_identifier"] && info["storage_identifier"].IsScalar() ? info["storage_identifier"].Scalar() : "";
+    if (storage != "sqlite3") {
+      return Status::InvalidArgument(path + ": storage_identifier '" + storage +
+                                     "' is not sqlite3, the only ROS 2 storage read (`ros2 bag convert` "
+                                     "writes sqlite3)");
+    }
+    const YAML::Node files = info["relative_file_paths"];
+    if (!files || !files.IsSequence() || files.size() == 0) {
+      return Status::DataLoss(path + ": 'relative_file_paths' must list the bag's .db3 files");
+    }
+    for (const YAML::Node& file : files) {
+      const std::string name = file.IsScalar() ? file.Scalar() : "";
+      if (name.empty() || name.find("..") != std::string::npos || name.front() == '/') {
+        return Status::DataLoss(path + ": relative_file_paths holds '" + name + "', not a file inside the bag");
+      }
+      names->push_back(name);
+    }
+    return Status::Ok();
+  }
+
+  Status ReadTopics(BagDatabase* file) {
+    Statement statement;
+    PATROLMAP_RETURN_IF_ERROR(Prepare(file->path, file->database.get(),
+                                      "SELECT id, name, type, serialization_format FROM topics", &statement));
+    int code = SQLITE_ROW;
+    while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
+      const std::string name = Text(statement.get(), 1);
+      const std::string format = Text(statement.get(), 3);
+      if (format != "cdr") {
+        return Status::InvalidArgument(file->path + ", topic " + name + ": serialization format '" + format +
+                                       "' is not cdr, the only one read");
+      }
+      auto known = std::find_if(topics_.begin(), topics_.end(), [&](const BagTopic& t) { return t.name == name; });
+      if (known == topics_.end()) known = topics_.insert(topics_.end(), {name, Text(statement.get(), 2), 0, 0.0});
+      file->topic_of_id[sqlite3_column_int(statement.get(), 0)] = static_cast<int>(known - topics_.begin());
+    }
+    if (code != SQLITE_DONE) return SqlError(file->path, file->database.get(), "reading topics");
+    return Status::Ok();
+  }
+
+  Status CountMessages() {
+    for (BagDatabase& file : files_) {
+      Statement statement;
+      PATROLMAP_RETURN_IF_ERROR(Prepare(file.path, file.database.get(),
+                                        "SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id", &statement));
+      int code = SQLITE_ROW;
+      while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
+        const auto topic = file.topic_of_id.find(sqlite3_column_int(statement.get(), 0));
+        if (topic != file.topic_of_id.end()) topics_[topic->second].count += sqlite3_column_int64(statement.get(), 1);
+      }
+      if (code != SQLITE_DONE) return SqlError(file.path, file.database.get(), "counting messages");
+    }
+    return Status::Ok();
+  }
+
+  std::string folder_;
+  std::vector<BagDatabase> files_;
+  std::vector<BagTopic> topics_;
+};
+
+}  // namespace
+
+bool Ros2BagsSupported() { return true; }
+
+Status OpenRos2Bag(const std::string& folder, std::unique_ptr<BagFile>* bag) {
+  auto ros2 = std::make_unique<Ros2Bag>(folder);
+  PATROLMAP_RETURN_IF_ERROR(ros2->Open());
+  *bag = std::move(ros2);
+  return Status::Ok();
+}
+
+}  // namespace patrolmap::io
