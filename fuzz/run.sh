@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses (clang, AddressSanitizer + UndefinedBehaviorSanitizer) into build-fuzz/
 # and runs each for SECONDS (default 600), two at a time, starting from the checked-in corpus:
-#   fuzz/run.sh [SECONDS [HARNESS...]]     harnesses: map_file vocabulary config euroc image_times pose_file
+#   fuzz/run.sh [SECONDS [HARNESS...]]     harnesses: map_file vocabulary config euroc image_times pose_file ros_message
 # Every input that crashed, hung or ran out of memory is copied into fuzz/corpus/HARNESS/ as
 # regression-<hash>, which the test suite replays from then on (after the fix). Prints per harness the
 # executions, the coverage (edges) and the findings. Needs clang: sudo apt-get install clang.
@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-600}"
 (($# > 0)) && shift
 harnesses=("$@")
-((${#harnesses[@]})) || harnesses=(map_file vocabulary config euroc image_times pose_file)
+((${#harnesses[@]})) || harnesses=(map_file vocabulary config euroc image_times pose_file ros_message)
 command -v clang++ >/dev/null || { echo "clang++ not found: sudo apt-get install clang" >&2; exit 1; }
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DPATROLMAP_FUZZ=ON -DPATROLMAP_BUILD_BENCHMARKS=OFF >/dev/null

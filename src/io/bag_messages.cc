@@ -121,6 +121,16 @@ class WireReader {
     return ReadQuaternion("pose.orientation", rotation);
   }
 
+  // The data ends a message: bytes past it (beyond CDR's padding to 4 bytes) mean the bytes hold another type.
+  Status End(const char* what) const {
+    const std::size_t padding = wire_ == Wire::kCdr ? 3 : 0;
+    if (bytes_.size() > position_ + padding) {
+      return Status::DataLoss("the message does not hold " + std::string(what) + ": " +
+                              std::to_string(bytes_.size() - position_) + " bytes follow its data");
+    }
+    return Status::Ok();
+  }
+
   Status Skip(const char* field, std::size_t element_size, std::size_t count) {
     Align(element_size);
     if (position_ + element_size * count > bytes_.size()) {
@@ -166,7 +176,8 @@ Status DecodeImage(const std::vector<std::uint8_t>& bytes, Wire wire, bool compr
   message->compressed = compressed;
   if (compressed) {
     PATROLMAP_RETURN_IF_ERROR(reader.ReadString("format", &message->encoding));
-    return reader.ReadBytes("data", &message->data, &message->size);
+    PATROLMAP_RETURN_IF_ERROR(reader.ReadBytes("data", &message->data, &message->size));
+    return reader.End("a compressed image");
   }
   PATROLMAP_RETURN_IF_ERROR(reader.Read("height", &message->height));
   PATROLMAP_RETURN_IF_ERROR(reader.Read("width", &message->width));
@@ -175,7 +186,8 @@ Status DecodeImage(const std::vector<std::uint8_t>& bytes, Wire wire, bool compr
   PATROLMAP_RETURN_IF_ERROR(reader.Read("is_bigendian", &big_endian));
   message->big_endian = big_endian != 0;
   PATROLMAP_RETURN_IF_ERROR(reader.Read("step", &message->step));
-  return reader.ReadBytes("data", &message->data, &message->size);
+  PATROLMAP_RETURN_IF_ERROR(reader.ReadBytes("data", &message->data, &message->size));
+  return reader.End("an image");
 }
 
 Status DecodeImu(const std::vector<std::uint8_t>& bytes, Wire wire, ImuMessage* message) {
@@ -185,7 +197,8 @@ Status DecodeImu(const std::vector<std::uint8_t>& bytes, Wire wire, ImuMessage* 
   PATROLMAP_RETURN_IF_ERROR(reader.Skip("orientation", sizeof(double), 4 + 9));
   PATROLMAP_RETURN_IF_ERROR(reader.ReadVector("angular_velocity", &message->gyro));
   PATROLMAP_RETURN_IF_ERROR(reader.Skip("angular_velocity_covariance", sizeof(double), 9));
-  return reader.ReadVector("linear_acceleration", &message->accel);
+  PATROLMAP_RETURN_IF_ERROR(reader.ReadVector("linear_acceleration", &message->accel));
+  return reader.Skip("linear_acceleration_covariance", sizeof(double), 9);
 }
 
 Status DecodeNavSatFix(const std::vector<std::uint8_t>& bytes, Wire wire, NavSatFixMessage* message) {

@@ -19,6 +19,10 @@ TimestampNs ToNs(const ros::Time& time) { return static_cast<TimestampNs>(time.t
 // The message rosbag gives for a damaged bag, in words a user can act on.
 Status BagError(const std::string& path, const std::string& topic, const std::exception& error) {
   std::string message = error.what();
+  if (message.find("version line") != std::string::npos ||
+      message.find("Unsupported bag file version") != std::string::npos) {
+    return Status::DataLoss(path + ": not a ROS 1 bag of format 2.0 (rosbag: " + message + ")");
+  }
   if (message.find("unindexed") != std::string::npos || message.find("Error reading") != std::string::npos) {
     message += " (the bag is truncated or was not closed; `rosbag reindex` may recover it)";
   }
