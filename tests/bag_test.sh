@@ -78,6 +78,38 @@ for encoding in mono8 mono16 bgr8 rgb8 bgra8; do
     "$work/detect_$encoding/key_locations.csv"
 done
 
+# Depth for change detection: a depth-image topic gives the evidence grids the EuRoC logs' depth0/ gives, and a
+# stereo pair (--topic right=, calibrated from the two CameraInfo) the grids of their cam0/ and cam1/.
+"$bin" -q simulate --route street --walls 3 --speed 5 --flights 2 --depth --stereo 0.5 --resolution 376x240 \
+  --seed 3 --out "$work/depth" >/dev/null
+printf 'depth:\n  source: stereo\n' >"$work/stereo.yaml"
+for flight in flight_1 flight_2; do
+  $python "$writer" "$work/depth/$flight" "$work/depth/$flight.bag" --format ros1 --chunks lz4 --time-offset-s $offset
+done
+same_geometry() {  # same_geometry REPORT_A REPORT_B: equal evidence-grid comparisons over some voxels
+  $python - "$1" "$2" <<'PY'
+import json, sys
+a, b = (json.load(open(path))["geometry"] for path in sys.argv[1:3])
+for g in (a, b):
+    g.pop("timing_s", None)
+sys.exit(0 if a == b and a["compared_voxels"] > 1000 else 1)
+PY
+}
+for depth in images stereo; do
+  config=() topics=()
+  [[ $depth == stereo ]] && config=(--config "$work/stereo.yaml") topics=(--topic right=/cam1/image_raw)
+  "$bin" -q map "$work/depth/flight_1" "${config[@]}" --vocabulary "$vocabulary" --out "$work/d_$depth/e1" >/dev/null 2>&1
+  "$bin" -q patrol "$work/depth/flight_2" --map "$work/d_$depth/e1/map.pmap" "${config[@]}" --vocabulary "$vocabulary" \
+    --out "$work/d_$depth/e2" >/dev/null 2>&1
+  "$bin" -q map "$work/depth/flight_1.bag" "${config[@]}" "${topics[@]}" --vocabulary "$vocabulary" \
+    --out "$work/d_$depth/b1" >/dev/null 2>&1
+  "$bin" -q patrol "$work/depth/flight_2.bag" --map "$work/d_$depth/b1/map.pmap" "${config[@]}" "${topics[@]}" \
+    --vocabulary "$vocabulary" --out "$work/d_$depth/b2" >/dev/null 2>&1
+  check "depth from $depth in a bag: the EuRoC logs' evidence grids" same_geometry "$work/d_$depth/e2/changes.json" \
+    "$work/d_$depth/b2/changes.json"
+done
+check "the report names stereo depth" grep -q '"current": *"stereo"' "$work/d_stereo/b2/changes.json"
+
 # Topics are listed, and chosen by name.
 bag="$work/bags/ros1_raw/flight_1.bag"
 expect "info lists a ROS 1 bag's topics" 0 "/imu0 +sensor_msgs/Imu +[0-9]+ msgs +200.00 Hz" -- "$bin" info "$bag"

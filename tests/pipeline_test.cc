@@ -407,7 +407,7 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(0));
   frame.pose = CameraPoseSample{1000, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
   frame.detections.resize(2);
-  frame.depth = {{990, "early.png", "", frame.pose}, {1000, "own.png", "", frame.pose}};
+  frame.depth = {{990, "early.png", "", {}, {}, frame.pose}, {1000, "own.png", "", {}, {}, frame.pose}};
   std::vector<ChangeWork> work;
   recorder.Collect(frame, &work);
   ASSERT_EQ(work.size(), 3u);  // two depth images for the grid, then the detections
@@ -416,7 +416,7 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   EXPECT_EQ(work[2].detections.size(), 2u);
   EXPECT_EQ(work[2].depth_path, "own.png");
   frame.timestamp_ns = 2000;
-  frame.depth = {{1990, "early.png", "", frame.pose}, {2010, "late.png", "", frame.pose}};
+  frame.depth = {{1990, "early.png", "", {}, {}, frame.pose}, {2010, "late.png", "", {}, {}, frame.pose}};
   work.clear();
   recorder.Collect(frame, &work);
   ASSERT_EQ(work.size(), 3u);

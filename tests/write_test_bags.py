@@ -32,16 +32,30 @@ def read_table(path):
 
 
 def rotation_to_quaternion(m):
-    """(x, y, z, w) of a 3x3 rotation matrix."""
-    m = np.asarray(m, dtype=float)
-    w = math.sqrt(max(0.0, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2.0
-    x = math.sqrt(max(0.0, 1.0 + m[0, 0] - m[1, 1] - m[2, 2])) / 2.0
-    y = math.sqrt(max(0.0, 1.0 - m[0, 0] + m[1, 1] - m[2, 2])) / 2.0
-    z = math.sqrt(max(0.0, 1.0 - m[0, 0] - m[1, 1] + m[2, 2])) / 2.0
-    x = math.copysign(x, m[2, 1] - m[1, 2])
-    y = math.copysign(y, m[0, 2] - m[2, 0])
-    z = math.copysign(z, m[1, 0] - m[0, 1])
-    return x, y, z, w
+    """(x, y, z, w) of a 3x3 rotation matrix, computed as Eigen's Quaternion(Matrix3) does, operation for
+    operation, so a reader that turns the quaternion back holds the same bits as one that reads the matrix."""
+    m = [[float(v) for v in row] for row in np.asarray(m, dtype=float)]
+    q = [0.0, 0.0, 0.0, 0.0]  # x, y, z, w
+    t = m[0][0] + m[1][1] + m[2][2]
+    if t > 0:
+        t = math.sqrt(t + 1.0)
+        q[3] = 0.5 * t
+        t = 0.5 / t
+        q[0] = (m[2][1] - m[1][2]) * t
+        q[1] = (m[0][2] - m[2][0]) * t
+        q[2] = (m[1][0] - m[0][1]) * t
+    else:
+        i = 1 if m[1][1] > m[0][0] else 0
+        if m[2][2] > m[i][i]:
+            i = 2
+        j, k = (i + 1) % 3, (i + 2) % 3
+        t = math.sqrt(m[i][i] - m[j][j] - m[k][k] + 1.0)
+        q[i] = 0.5 * t
+        t = 0.5 / t
+        q[3] = (m[k][j] - m[j][k]) * t
+        q[j] = (m[j][i] + m[i][j]) * t
+        q[k] = (m[k][i] + m[i][k]) * t
+    return tuple(q)
 
 
 def sensor_transform(path):
@@ -96,6 +110,21 @@ def flight_messages(log, images, encoding):
             messages.append((t, camera_topic, "compressed", compressed_payload(path, images)))
         if camera:
             messages.append((t, "/cam0/camera_info", "camera_info", camera))
+    for row in read_table(os.path.join(root, "depth0", "data.csv")):
+        depth = cv2.imread(os.path.join(root, "depth0", "data", row[1].strip()), cv2.IMREAD_UNCHANGED)
+        messages.append((int(row[0]), "/cam0/depth/image_raw", "depth",
+                         (depth.shape[0], depth.shape[1], "16UC1", depth.strides[0], depth.tobytes())))
+    right_yaml = os.path.join(root, "cam1", "sensor.yaml")
+    if camera and os.path.exists(right_yaml):
+        right = dict(yaml.safe_load(open(right_yaml)))
+        right["baseline_m"] = baseline(camera_yaml, right_yaml)
+        for row in read_table(os.path.join(root, "cam1", "data.csv")):
+            t, path = int(row[0]), os.path.join(root, "cam1", "data", row[1].strip())
+            if images == "raw":
+                messages.append((t, "/cam1/image_raw", "image", image_payload(path, encoding)))
+            else:
+                messages.append((t, "/cam1/image_raw/compressed", "compressed", compressed_payload(path, images)))
+            messages.append((t, "/cam1/camera_info", "camera_info", right))
     for row in read_table(os.path.join(root, "imu0", "data.csv")):
         messages.append((int(row[0]), "/imu0", "imu", [float(v) for v in row[1:7]]))
     for row in read_table(os.path.join(root, "gps0", "data.csv")):
@@ -110,10 +139,19 @@ def flight_messages(log, images, encoding):
     return messages
 
 
-FRAME_OF = {"image": "cam0", "compressed": "cam0", "camera_info": "cam0", "imu": "imu0", "gps": "gps",
+def baseline(left_yaml, right_yaml):
+    """The right camera's offset along the left camera's x axis [m] (both T_BS, cameras parallel)."""
+    def transform(path):
+        return np.array(yaml.safe_load(open(path))["T_BS"]["data"], dtype=float).reshape(4, 4)
+    left, right = transform(left_yaml), transform(right_yaml)
+    in_left = left[:3, :3].T @ (right[:3, 3] - left[:3, 3])
+    return float(in_left[0])
+
+
+FRAME_OF = {"depth": "cam0", "image": "cam0", "compressed": "cam0", "camera_info": "cam0", "imu": "imu0", "gps": "gps",
             "odometry": "world"}
 
-TYPES = {"image": "sensor_msgs/Image", "compressed": "sensor_msgs/CompressedImage",
+TYPES = {"depth": "sensor_msgs/Image", "image": "sensor_msgs/Image", "compressed": "sensor_msgs/CompressedImage",
          "camera_info": "sensor_msgs/CameraInfo", "imu": "sensor_msgs/Imu", "gps": "sensor_msgs/NavSatFix",
          "odometry": "nav_msgs/Odometry", "tf": "tf2_msgs/TFMessage"}
 
@@ -122,7 +160,7 @@ def camera_matrices(camera):
     fx, fy, cx, cy = camera["intrinsics"]
     k = [fx, 0, cx, 0, fy, cy, 0, 0, 1]
     r = [1, 0, 0, 0, 1, 0, 0, 0, 1]
-    p = [fx, 0, cx, 0, 0, fy, cy, 0, 0, 0, 1, 0]
+    p = [fx, 0, cx, -fx * camera.get("baseline_m", 0.0), 0, fy, cy, 0, 0, 0, 1, 0]
     return k, r, p, [float(v) for v in camera.get("distortion_coefficients", [0, 0, 0, 0])]
 
 
@@ -141,7 +179,7 @@ def write_ros1(messages, out, chunks):
 
     with rosbag.Bag(out, "w", compression=chunks) as bag:
         for t, topic, kind, fields in messages:
-            if kind == "image":
+            if kind in ("image", "depth"):
                 msg = Image(height=fields[0], width=fields[1], encoding=fields[2], is_bigendian=0, step=fields[3],
                             data=fields[4])
             elif kind == "compressed":
@@ -221,7 +259,7 @@ def cdr_message(t, kind, fields):
             w.doubles(rotation)
         return bytes(w.data)
     w.header(t, FRAME_OF[kind])
-    if kind == "image":
+    if kind in ("image", "depth"):
         height, width, encoding, step, data = fields
         w.put("I", height)
         w.put("I", width)

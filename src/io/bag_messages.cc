@@ -1,5 +1,6 @@
 #include "bag_messages.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -59,8 +60,12 @@ class WireReader {
   Status ReadQuaternion(const char* field, Eigen::Quaterniond* rotation) {
     double x = 0, y = 0, z = 0, w = 0;
     for (double* value : {&x, &y, &z, &w}) PATROLMAP_RETURN_IF_ERROR(ReadFinite(field, value));
-    *rotation = Eigen::Quaterniond(w, x, y, z);
-    if (rotation->norm() < 1e-6) return Status::DataLoss(std::string(field) + " is not a rotation (zero length)");
+    const double largest = std::max({std::abs(x), std::abs(y), std::abs(z), std::abs(w)});
+    if (!(largest > 1e-6)) return Status::DataLoss(std::string(field) + " is not a rotation (zero length)");
+    // Huge components are scaled down first so that the norm does not overflow; others are normalised as
+    // they are, as the EuRoC reader does, so both give the same poses to the bit.
+    const double scale = largest > 1e100 ? largest : 1.0;
+    *rotation = Eigen::Quaterniond(w / scale, x / scale, y / scale, z / scale);
     rotation->normalize();
     return Status::Ok();
   }

@@ -33,15 +33,18 @@ bool IsPoseKind(MessageKind kind) {
          kind == MessageKind::kOdometry;
 }
 
-// The topic chosen for one role: the named one (which must exist and have a fitting type) or the first of
-// a fitting type. -1 when the bag has none and none was named.
+bool IsDepthName(const std::string& name) { return name.find("depth") != std::string::npos; }
+
+// The topic chosen for one role: the named one (which must exist and have a fitting type) or, when
+// `by_default`, the first of a fitting type that `default_name` accepts. -1 when there is none.
 Status ChooseTopic(const std::string& path, const std::vector<BagTopic>& topics, const char* role,
-                   const std::string& wanted, bool (*fits)(MessageKind), int* chosen) {
+                   const std::string& wanted, bool (*fits)(MessageKind), int* chosen,
+                   bool (*default_name)(const std::string&) = nullptr) {
   *chosen = -1;
   for (std::size_t i = 0; i < topics.size(); ++i) {
     if (!wanted.empty() && topics[i].name != wanted) continue;
     const bool fitting = fits(rosmsg::KindOfType(topics[i].type));
-    if (wanted.empty() && !fitting) continue;
+    if (wanted.empty() && (!fitting || (default_name != nullptr && !default_name(topics[i].name)))) continue;
     if (!fitting) {
       return Status::InvalidArgument(path + ", topic " + topics[i].name + ": type " + topics[i].type +
                                      " cannot be the " + role + " topic");
@@ -61,11 +64,14 @@ Status ChooseTopic(const std::string& path, const std::vector<BagTopic>& topics,
 // The topics a flight is read from.
 struct BagRoles {
   int camera = -1, camera_info = -1, imu = -1, gps = -1, pose = -1, transforms = -1;
+  int depth = -1, right = -1, right_info = -1;
 };
 
 Status ChooseRoles(const std::string& path, const std::vector<BagTopic>& topics, const TopicChoice& choice,
                    BagRoles* roles) {
-  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "camera", choice.camera, IsImageKind, &roles->camera));
+  // By default the camera is the first image topic not named for depth, the depth the first named for it.
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "camera", choice.camera, IsImageKind, &roles->camera,
+                                        [](const std::string& name) { return !IsDepthName(name); }));
   if (roles->camera < 0) {
     return Status::DataLoss(path + ": no sensor_msgs/Image or CompressedImage topic (patrolmap info " + path +
                             " lists its topics)");
@@ -78,6 +84,19 @@ Status ChooseRoles(const std::string& path, const std::vector<BagTopic>& topics,
   PATROLMAP_RETURN_IF_ERROR(ChooseTopic(
       path, topics, "gps", choice.gps, [](MessageKind k) { return k == MessageKind::kNavSatFix; }, &roles->gps));
   PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "pose", choice.pose, IsPoseKind, &roles->pose));
+  PATROLMAP_RETURN_IF_ERROR(ChooseTopic(
+      path, topics, "depth", choice.depth, [](MessageKind k) { return k == MessageKind::kImage; }, &roles->depth,
+      IsDepthName));
+  if (!choice.right.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(ChooseTopic(path, topics, "right", choice.right, IsImageKind, &roles->right));
+    // ROS names a camera's calibration beside its images: /cam1/image_raw -> /cam1/camera_info.
+    const std::string info = choice.right.substr(0, choice.right.rfind('/') + 1) + "camera_info";
+    for (std::size_t i = 0; i < topics.size(); ++i) {
+      if (topics[i].name == info && rosmsg::KindOfType(topics[i].type) == MessageKind::kCameraInfo) {
+        roles->right_info = static_cast<int>(i);
+      }
+    }
+  }
   for (std::size_t i = 0; i < topics.size(); ++i) {
     if (topics[i].name == "/tf_static" && rosmsg::KindOfType(topics[i].type) == MessageKind::kTransforms) {
       roles->transforms = static_cast<int>(i);
@@ -94,13 +113,13 @@ class FrameTree {
   }
 
   // The rotation taking vectors of `source` into `target`, when both frames are known and linked.
-  std::optional<Eigen::Matrix3d> Rotation(const std::string& target, const std::string& source) const {
-    if (target == source) return Eigen::Matrix3d::Identity();
+  std::optional<Eigen::Quaterniond> Rotation(const std::string& target, const std::string& source) const {
+    if (target == source) return Eigen::Quaterniond::Identity();
     std::string target_root, source_root;
     const Eigen::Quaterniond root_from_target = FromRoot(target, &target_root);
     const Eigen::Quaterniond root_from_source = FromRoot(source, &source_root);
     if (target_root != source_root || (target_root == target && source_root == source)) return std::nullopt;
-    return (root_from_target.conjugate() * root_from_source).toRotationMatrix();
+    return root_from_target.conjugate() * root_from_source;
   }
 
  private:
@@ -207,6 +226,29 @@ Status ToGrey(const rosmsg::ImageMessage& image, cv::Mat* grey) {
   return Status::Ok();
 }
 
+// Converts a depth image message (16UC1 or mono16 in millimetres, 32FC1 in metres) to metres, 0 where
+// there is no return.
+Status ToMetres(const rosmsg::ImageMessage& image, cv::Mat* metres) {
+  const bool millimetres = image.encoding == "16UC1" || image.encoding == "mono16";
+  if (!millimetres && image.encoding != "32FC1") {
+    return Status::DataLoss("depth encoding '" + image.encoding + "' is not 16UC1 [mm] or 32FC1 [m]");
+  }
+  const int type = millimetres ? CV_16UC1 : CV_32FC1;
+  const std::size_t row_bytes = static_cast<std::size_t>(image.width) * CV_ELEM_SIZE(type);
+  if (image.width == 0 || image.height == 0 || image.width > 1 << 15 || image.height > 1 << 15 ||
+      image.step < row_bytes || static_cast<std::size_t>(image.step) * image.height > image.size || image.big_endian) {
+    return Status::DataLoss("depth image of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                            " does not fit its bytes (or is big-endian)");
+  }
+  const cv::Mat view(static_cast<int>(image.height), static_cast<int>(image.width), type,
+                     const_cast<std::uint8_t*>(image.data), image.step);
+  view.convertTo(*metres, CV_32FC1, millimetres ? 0.001 : 1.0);
+  metres->forEach<float>([](float& v, const int*) {
+    if (!std::isfinite(v) || v < 0.0f) v = 0.0f;
+  });
+  return Status::Ok();
+}
+
 // A camera message waiting for its samples: its bytes and its time.
 struct PendingFrame {
   BagMessage message;
@@ -217,12 +259,12 @@ struct PendingFrame {
 class BagSource : public FrameSource {
  public:
   BagSource(LogInfo info, std::unique_ptr<BagFile> bag, BagRoles roles, std::unique_ptr<BagStream> stream,
-            std::optional<Eigen::Matrix3d> body_from_camera)
+            std::optional<Eigen::Quaterniond> body_from_camera)
       : info_(std::move(info)),
         bag_(std::move(bag)),
         roles_(roles),
         stream_(std::move(stream)),
-        body_from_camera_(body_from_camera.value_or(Eigen::Matrix3d::Identity())) {}
+        body_from_camera_(body_from_camera.value_or(Eigen::Quaterniond::Identity())) {}
 
   const LogInfo& info() const override { return info_; }
 
@@ -316,12 +358,47 @@ class BagSource : public FrameSource {
       status = rosmsg::DecodeNavSatFix(message.bytes, bag_->wire(), &fix);
       if (status.ok() && fix.status >= 0)
         AppendTimed(&gps_, StampOrRecord(fix.header, message.record_ns), fix.position);
+    } else if (message.topic == roles_.depth) {
+      status = ConsumeDepth(message);
+    } else if (message.topic == roles_.right) {
+      status = ConsumeRight(message);
     } else if (message.topic == roles_.pose) {
       rosmsg::PoseMessage pose;
       status = rosmsg::DecodePose(message.bytes, bag_->wire(), rosmsg::KindOfType(topic.type), &pose);
       if (status.ok()) AddPose(pose, StampOrRecord(pose.header, message.record_ns));
     }
     if (!status.ok()) return TopicError(info_.path, topic, status);
+    return Status::Ok();
+  }
+
+  Status ConsumeDepth(const BagMessage& message) {
+    rosmsg::ImageMessage image;
+    PATROLMAP_RETURN_IF_ERROR(rosmsg::DecodeImage(message.bytes, bag_->wire(), false, &image));
+    DepthSample sample;
+    sample.timestamp_ns = StampOrRecord(image.header, message.record_ns);
+    const Status status = ToMetres(image, &sample.image);
+    if (!status.ok()) return SkipSample(message.topic, status);
+    if (depth_.empty() || sample.timestamp_ns > depth_.back().timestamp_ns) depth_.push_back(std::move(sample));
+    return Status::Ok();
+  }
+
+  Status ConsumeRight(const BagMessage& message) {
+    rosmsg::ImageMessage image;
+    const bool compressed = rosmsg::KindOfType(Topic(message.topic).type) == MessageKind::kCompressedImage;
+    PATROLMAP_RETURN_IF_ERROR(rosmsg::DecodeImage(message.bytes, bag_->wire(), compressed, &image));
+    TimedValue<cv::Mat> right{StampOrRecord(image.header, message.record_ns), cv::Mat()};
+    const Status status = ToGrey(image, &right.value);
+    if (!status.ok()) return SkipSample(message.topic, status);
+    if (right_.empty() || right.timestamp_ns > right_.back().timestamp_ns) right_.push_back(std::move(right));
+    while (right_.size() > kMaxPendingFrames) right_.pop_front();
+    return Status::Ok();
+  }
+
+  // A sample whose content cannot be used: skipped, with a warning the first time for its topic.
+  Status SkipSample(int topic, const Status& why) {
+    if (warned_topics_.insert(topic).second) {
+      spdlog::warn("{}, topic {}: {}; such messages are skipped", info_.path, Topic(topic).name, why.message());
+    }
     return Status::Ok();
   }
 
@@ -335,7 +412,7 @@ class BagSource : public FrameSource {
     CameraPoseSample sample;
     sample.timestamp_ns = t;
     sample.position = pose.position;
-    sample.rotation = (pose.rotation * Eigen::Quaterniond(body_from_camera_)).normalized();
+    sample.rotation = (pose.rotation * body_from_camera_).normalized();
     poses_.push_back(sample);
     if (pose.has_velocity) AppendTimed(&speeds_, t, pose.velocity.norm());
   }
@@ -353,9 +430,12 @@ class BagSource : public FrameSource {
       last_imu_ns_ = imu_.front().timestamp_ns;
       imu_.pop_front();
     }
+    AttachDepth(t, frame);
     AttachPoses(t, frame);
     frame->image.release();
-    if (decode_image) {
+    while (!right_.empty() && right_.front().timestamp_ns < t) right_.pop_front();
+    const bool paired = !right_.empty() && right_.front().timestamp_ns == t && info_.has_stereo;
+    if (decode_image || paired) {
       rosmsg::ImageMessage image;
       const bool compressed = rosmsg::KindOfType(Topic(roles_.camera).type) == MessageKind::kCompressedImage;
       Status status = rosmsg::DecodeImage(pending.message.bytes, bag_->wire(), compressed, &image);
@@ -372,12 +452,35 @@ class BagSource : public FrameSource {
         return false;
       }
     }
+    if (paired) {
+      DepthSample pair;
+      pair.timestamp_ns = t;
+      pair.image = frame->image;  // a new buffer every frame (released above)
+      pair.right_image = std::move(right_.front().value);
+      pair.pose = PoseNear(t);
+      right_.pop_front();
+      frame->depth.push_back(std::move(pair));
+    }
     last_frame_ns_ = t;
     frame->timestamp_ns = t;
     frame->index = pending.index;
     frame->speed_mps = ValueAt(&speeds_, t);
     frame->gps = ValueAt(&gps_, t);
     return true;
+  }
+
+  std::optional<CameraPoseSample> PoseNear(TimestampNs t) const {
+    return file_poses_.empty() ? PoseAt(poses_, t) : PoseAt(file_poses_, t);
+  }
+
+  // Depth images up to the frame's time, each with the pose at its own time (before AttachPoses drops the
+  // poses before the frame).
+  void AttachDepth(TimestampNs t, Frame* frame) {
+    while (!depth_.empty() && depth_.front().timestamp_ns <= t) {
+      frame->depth.push_back(std::move(depth_.front()));
+      frame->depth.back().pose = PoseNear(frame->depth.back().timestamp_ns);
+      depth_.pop_front();
+    }
   }
 
   void AttachPoses(TimestampNs t, Frame* frame) {
@@ -405,7 +508,7 @@ class BagSource : public FrameSource {
   std::unique_ptr<BagFile> bag_;
   BagRoles roles_;
   std::unique_ptr<BagStream> stream_;
-  Eigen::Matrix3d body_from_camera_;
+  Eigen::Quaterniond body_from_camera_;  // kept a quaternion: the poses equal the EuRoC reader's to the bit
   std::deque<PendingFrame> pending_;
   std::vector<BagMessage> spare_;  // buffers of read messages, reused
   bool ended_ = false;
@@ -415,6 +518,9 @@ class BagSource : public FrameSource {
   std::vector<CameraPoseSample> poses_;  // from the last one at or before the last frame on
   std::deque<TimedValue<Eigen::Vector3d>> gps_;
   std::deque<TimedValue<double>> speeds_;
+  std::deque<DepthSample> depth_;          // depth images waiting for their frame
+  std::deque<TimedValue<cv::Mat>> right_;  // right images waiting for the left one of their time
+  std::set<int> warned_topics_;
   std::vector<CameraPoseSample> file_poses_;
   std::size_t next_file_pose_ = 0;
   cv::Size first_size_;
@@ -441,6 +547,44 @@ Status FirstMessage(BagFile* bag, const std::string& path, int topic, Decode dec
   });
 }
 
+CameraIntrinsics IntrinsicsOf(const rosmsg::CameraInfoMessage& info) {
+  return {info.k[0], info.k[4], info.k[2], info.k[5], static_cast<int>(info.width), static_cast<int>(info.height)};
+}
+
+// A stereo pair's calibration from the two cameras' CameraInfo (ROS's stereo convention: R rotates each
+// camera into the rectified frame, the right P holds -fx * baseline); fails saying why it cannot be used.
+Status StereoFromCameraInfo(const rosmsg::CameraInfoMessage& left, const rosmsg::CameraInfoMessage& right,
+                            StereoCalibration* pair) {
+  const std::array<const rosmsg::CameraInfoMessage*, 2> cameras = {&left, &right};
+  for (const rosmsg::CameraInfoMessage* camera : cameras) {
+    const std::string& model = camera->distortion_model;
+    if (!model.empty() && model != "plumb_bob" && model != "radial-tangential") {
+      return Status::InvalidArgument("distortion model '" + model + "' is not plumb_bob, the only one undone");
+    }
+    if (camera->distortion.size() > 4 && std::abs(camera->distortion[4]) > 1e-9) {
+      return Status::InvalidArgument("a k3 distortion term, which stereo matching does not undo");
+    }
+    if (!IntrinsicsOf(*camera).valid()) return Status::InvalidArgument("camera info without intrinsics");
+  }
+  if (!(right.p[0] > 0.0) || !(std::abs(right.p[3]) > 0.0)) {
+    return Status::InvalidArgument("the right camera info's P holds no baseline (P[3] = -fx * baseline)");
+  }
+  pair->left = IntrinsicsOf(left);
+  pair->right = IntrinsicsOf(right);
+  for (std::size_t i = 0; i < 4; ++i) {
+    pair->left_distortion[i] = i < left.distortion.size() ? left.distortion[i] : 0.0;
+    pair->right_distortion[i] = i < right.distortion.size() ? right.distortion[i] : 0.0;
+  }
+  using RowMajor = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  const Eigen::Matrix3d left_rectified = Eigen::Map<const RowMajor>(left.r.data());
+  const Eigen::Matrix3d right_rectified = Eigen::Map<const RowMajor>(right.r.data());
+  const double baseline = -right.p[3] / right.p[0];
+  // x_right = R_r^T (R_l x_left - (baseline, 0, 0))
+  pair->right_from_left_rotation = right_rectified.transpose() * left_rectified;
+  pair->right_from_left_translation = -right_rectified.transpose() * Eigen::Vector3d(baseline, 0.0, 0.0);
+  return Status::Ok();
+}
+
 // What the bag says before its frames: intrinsics, the frame rate and count, the sensors' frames and the
 // rotations between them.
 struct BagFrames {
@@ -448,7 +592,7 @@ struct BagFrames {
 };
 
 Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles, LogInfo* info,
-                   std::optional<Eigen::Matrix3d>* body_from_camera) {
+                   std::optional<Eigen::Quaterniond>* body_from_camera) {
   const rosmsg::Wire wire = bag->wire();
   const bool compressed = rosmsg::KindOfType(bag->topics()[roles.camera].type) == MessageKind::kCompressedImage;
   BagFrames frames;
@@ -468,16 +612,13 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
         return rosmsg::DecodeCameraInfo(b, wire, m);
       },
       &camera_info, &found));
+  const bool has_camera_info = found;
   if (found) {
-    const CameraIntrinsics camera{camera_info.k[0],
-                                  camera_info.k[4],
-                                  camera_info.k[2],
-                                  camera_info.k[5],
-                                  static_cast<int>(camera_info.width),
-                                  static_cast<int>(camera_info.height)};
+    const CameraIntrinsics camera = IntrinsicsOf(camera_info);
     if (camera.valid()) info->camera = camera;
-    if (!camera.valid())
+    if (!camera.valid()) {
       spdlog::warn("{}, topic {}: camera info without intrinsics", path, bag->topics()[roles.camera_info].name);
+    }
   }
   rosmsg::ImuMessage imu;
   PATROLMAP_RETURN_IF_ERROR(FirstMessage(
@@ -505,7 +646,8 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
     }));
   }
   if (roles.imu >= 0) {
-    info->camera_from_imu = tree.Rotation(frames.camera, frames.imu);
+    const std::optional<Eigen::Quaterniond> camera_from_imu = tree.Rotation(frames.camera, frames.imu);
+    if (camera_from_imu) info->camera_from_imu = camera_from_imu->toRotationMatrix();
     if (!info->camera_from_imu) {
       spdlog::warn(
           "{}: /tf_static does not link the camera's frame '{}' to the IMU's '{}': camera-IMU rotation unknown", path,
@@ -523,7 +665,30 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
           "taken for the camera's own",
           path, bag->topics()[roles.pose].name, frames.body, frames.camera);
     }
-    info->body_from_camera = body_from_camera->value_or(Eigen::Matrix3d::Identity());
+    info->body_from_camera = body_from_camera->value_or(Eigen::Quaterniond::Identity()).toRotationMatrix();
+  }
+  info->has_depth = roles.depth >= 0;
+  if (roles.right >= 0) {
+    rosmsg::CameraInfoMessage right_info;
+    PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+        bag, path, roles.right_info,
+        [&](const std::vector<std::uint8_t>& b, rosmsg::CameraInfoMessage* m) {
+          return rosmsg::DecodeCameraInfo(b, wire, m);
+        },
+        &right_info, &found));
+    StereoCalibration pair;
+    const Status status = !has_camera_info || !found
+                              ? Status::NotFound(
+                                    "no camera info for both cameras (the right one's is expected "
+                                    "beside its images, e.g. /cam1/camera_info)")
+                              : StereoFromCameraInfo(camera_info, right_info, &pair);
+    if (status.ok()) {
+      info->stereo = pair;
+      info->has_stereo = true;
+    } else {
+      spdlog::warn("{}, topic {}: {}; the stereo pair is not used", path, bag->topics()[roles.right].name,
+                   status.message());
+    }
   }
   std::vector<TimestampNs> times;
   PATROLMAP_RETURN_IF_ERROR(bag->Times(roles.camera, &times));
@@ -567,21 +732,24 @@ Status OpenBag(const std::string& path, const ImageFolderOptions& options, std::
   info.kind = bag->wire() == rosmsg::Wire::kRos1 ? "ros1-bag" : "ros2-bag";
   info.flight_id = CleanFlightId(fs::path(path).lexically_normal().stem().string());
   if (info.flight_id.empty()) info.flight_id = CleanFlightId(fs::path(path).parent_path().filename().string());
-  std::optional<Eigen::Matrix3d> body_from_camera;
+  std::optional<Eigen::Quaterniond> body_from_camera;
   PATROLMAP_RETURN_IF_ERROR(ReadLogInfo(bag.get(), path, roles, &info, &body_from_camera));
   if (options.frame_rate_hz > 0.0) {
     spdlog::warn("{}: --fps is for logs without times; a bag's frames keep their header stamps", path);
   }
   std::vector<int> topics = {roles.camera};
-  for (int topic : {roles.imu, roles.gps, roles.pose}) {
+  for (int topic : {roles.imu, roles.gps, roles.pose, roles.depth, roles.right}) {
     if (topic >= 0) topics.push_back(topic);
   }
   std::unique_ptr<BagStream> stream;
   PATROLMAP_RETURN_IF_ERROR(bag->Stream(topics, 0, &stream));
-  spdlog::info("{}: camera {}{}{}{}", path, bag->topics()[roles.camera].name,
-               roles.imu >= 0 ? ", imu " + bag->topics()[roles.imu].name : "",
-               roles.gps >= 0 ? ", gps " + bag->topics()[roles.gps].name : "",
-               roles.pose >= 0 ? ", pose " + bag->topics()[roles.pose].name : "");
+  std::string used = "camera " + bag->topics()[roles.camera].name;
+  const std::array<std::pair<const char*, int>, 5> others = {
+      {{"imu", roles.imu}, {"gps", roles.gps}, {"pose", roles.pose}, {"depth", roles.depth}, {"right", roles.right}}};
+  for (const auto& [role, topic] : others) {
+    if (topic >= 0) used += std::string(", ") + role + " " + bag->topics()[topic].name;
+  }
+  spdlog::info("{}: {}", path, used);
   *source = std::make_unique<BagSource>(std::move(info), std::move(bag), roles, std::move(stream), body_from_camera);
   return Status::Ok();
 }

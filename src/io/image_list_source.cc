@@ -80,8 +80,12 @@ void ImageListSource::AttachDepth(const std::vector<DepthEntry>& entries, Timest
                                   Frame* frame) const {
   for (; *next < entries.size() && entries[*next].timestamp_ns <= timestamp_ns; ++*next) {
     const DepthEntry& entry = entries[*next];
-    frame->depth.push_back(
-        {entry.timestamp_ns, entry.path, entry.right_path, PoseAt(sensors_.poses, entry.timestamp_ns)});
+    DepthSample sample;
+    sample.timestamp_ns = entry.timestamp_ns;
+    sample.path = entry.path;
+    sample.right_path = entry.right_path;
+    sample.pose = PoseAt(sensors_.poses, entry.timestamp_ns);
+    frame->depth.push_back(std::move(sample));
   }
 }
 

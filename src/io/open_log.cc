@@ -274,13 +274,15 @@ Status ParseTopicChoice(const std::vector<std::string>& assignments, TopicChoice
                         : role == "imu"         ? &choice->imu
                         : role == "gps"         ? &choice->gps
                         : role == "pose"        ? &choice->pose
+                        : role == "depth"       ? &choice->depth
+                        : role == "right"       ? &choice->right
                                                 : nullptr;
     if (equals == std::string::npos || equals + 1 == assignment.size()) {
       return Status::InvalidArgument("--topic " + assignment + ": expected ROLE=TOPIC, e.g. camera=/cam0/image_raw");
     }
     if (slot == nullptr) {
       return Status::InvalidArgument("--topic " + assignment + ": unknown role '" + role +
-                                     "' (camera, camera_info, imu, gps, pose)");
+                                     "' (camera, camera_info, imu, gps, pose, depth, right)");
     }
     if (!given.insert(role).second) return Status::InvalidArgument("--topic: role '" + role + "' given twice");
     *slot = assignment.substr(equals + 1);

@@ -69,6 +69,8 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
       step_work.pose = depth.pose;
       step_work.depth_path = depth.path;
       step_work.right_path = depth.right_path;
+      step_work.depth_image = depth.image;
+      step_work.right_image = depth.right_image;
       work->push_back(std::move(step_work));
     }
   }
@@ -82,6 +84,8 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
       if (!has_depth_ || depth.stereo() != use_stereo_ || depth.timestamp_ns != frame.timestamp_ns) continue;
       objects.depth_path = depth.path;
       objects.right_path = depth.right_path;
+      objects.depth_image = depth.image;
+      objects.right_image = depth.right_image;
     }
     objects.image = frame.image.clone();  // the source reuses its buffer
     work->push_back(std::move(objects));
@@ -100,8 +104,8 @@ void PatrolRecorder::CollectRest(std::vector<ChangeWork>* work) {
 }
 
 bool PatrolRecorder::ReadStereoDepth(const ChangeWork& work, cv::Mat* depth) {
-  left_ = cv::imread(work.depth_path, cv::IMREAD_GRAYSCALE);
-  right_ = cv::imread(work.right_path, cv::IMREAD_GRAYSCALE);
+  left_ = work.depth_image.empty() ? cv::imread(work.depth_path, cv::IMREAD_GRAYSCALE) : work.depth_image;
+  right_ = work.right_image.empty() ? cv::imread(work.right_path, cv::IMREAD_GRAYSCALE) : work.right_image;
   const std::string& unreadable = left_.empty() ? work.depth_path : work.right_path;
   Status status = left_.empty() || right_.empty() ? Status::DataLoss(unreadable + ": missing or unreadable image")
                                                   : stereo_->Compute(left_, right_, depth);
@@ -113,7 +117,11 @@ bool PatrolRecorder::ReadStereoDepth(const ChangeWork& work, cv::Mat* depth) {
 }
 
 bool PatrolRecorder::ReadDepth(const ChangeWork& work, cv::Mat* depth) {
-  if (!work.right_path.empty()) return ReadStereoDepth(work, depth);
+  if (!work.right_path.empty() || !work.right_image.empty()) return ReadStereoDepth(work, depth);
+  if (!work.depth_image.empty()) {
+    work.depth_image.copyTo(*depth);
+    return true;
+  }
   const Status status = io::ReadDepthImage(work.depth_path, depth);
   if (status.ok()) return true;
   spdlog::warn("{}; skipped", status.message());
@@ -128,7 +136,7 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
   if (work.kind == ChangeWork::Kind::kObjects) {
     stats_.detections += static_cast<int>(work.detections.size());
     depth_.release();
-    if (!work.depth_path.empty()) ReadDepth(work, &depth_);
+    if (!work.depth_path.empty() || !work.depth_image.empty()) ReadDepth(work, &depth_);
     mapper_.AddFrame(work.detections, *work.pose, depth_, work.image);
     return;
   }

@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
                  "matrix per image); replaces the log's state estimate")
       ->check(CLI::ExistingFile);
   app.add_option("--topic", arguments.request.topics,
-                 "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose); repeatable")
+                 "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose, depth, right); repeatable")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");

@@ -74,14 +74,17 @@ struct StereoCalibration {
   Eigen::Vector3d right_from_left_translation = Eigen::Vector3d::Zero();
 };
 
-// Depth of the log at one time, read when the change stage wants it: a depth image (depth0/), or the two
-// images of a stereo pair (cam0/ and cam1/) that the depth stage matches.
+// Depth of the log at one time: a depth image (depth0/), or the two images of a stereo pair (cam0/ and cam1/)
+// that the depth stage matches. Files are read when the change stage wants them; a log that holds its images
+// in its own file (a ROS bag) hands them over decoded.
 struct DepthSample {
   TimestampNs timestamp_ns = 0;
   std::string path;                      // the depth image; for a stereo pair the left (cam0) image
   std::string right_path;                // the right (cam1) image of a stereo pair; empty for a depth image
+  cv::Mat image;                         // instead of `path`: depth [m] (CV_32FC1, 0 = no return), or the left image
+  cv::Mat right_image;                   // instead of `right_path`: the right image (CV_8UC1)
   std::optional<CameraPoseSample> pose;  // the camera pose at its time, when the log has poses
-  bool stereo() const { return !right_path.empty(); }
+  bool stereo() const { return !right_path.empty() || !right_image.empty(); }
 };
 
 // One camera frame with the sensor data that arrived since the previous frame

@@ -16,9 +16,12 @@ constexpr double kAssumedFrameRateHz = 30.0;
 // of the role's type (bag.h).
 struct TopicChoice {
   std::string camera, camera_info, imu, gps, pose;
+  std::string depth;  // depth images (16UC1 [mm] or 32FC1 [m]); default: an image topic named "...depth..."
+  std::string right;  // the right camera of a stereo pair; default: none
 };
 
-// Sets the roles of "ROLE=NAME" assignments (roles: camera, camera_info, imu, gps, pose); fails naming an
+// Sets the roles of "ROLE=NAME" assignments (roles: camera, camera_info, imu, gps, pose, depth,
+// right); fails naming an
 // assignment without '=', an unknown role or a role given twice.
 Status ParseTopicChoice(const std::vector<std::string>& assignments, TopicChoice* choice);
 

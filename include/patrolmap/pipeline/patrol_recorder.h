@@ -48,6 +48,7 @@ struct ChangeWork {
   std::vector<ObjectObservation> detections;  // kObjects
   std::string depth_path;                     // kGrid; kObjects: the frame's depth image, if any; stereo: left
   std::string right_path;                     // stereo: the right image of the pair
+  cv::Mat depth_image, right_image;           // instead of the paths: the images a bag handed over (DepthSample)
   cv::Mat image;                              // kObjects: the frame at the camera's size
 };
 
