@@ -340,6 +340,56 @@ def attack_images(attack, work, log, rng, rounds):
                                                                str(work / "uout")] + extra, [str(folder)])
 
 
+def attack_bags(attack, work, log, rng, rounds):
+    """ROS 1 and ROS 2 bags of the log, truncated, with flipped bytes, with damaged messages."""
+    writer = Path(__file__).resolve().parents[2] / "tests" / "write_test_bags.py"
+    python = "/usr/bin/python3"
+    ros1, ros2 = work / "flight.bag", work / "flight_ros2"
+    for args in ([str(log), str(ros1), "--format", "ros1", "--chunks", "lz4", "--time-offset-s", "1700000000"],
+                 [str(log), str(ros2), "--format", "ros2"]):
+        code, text = attack.run([python, str(writer)] + args)
+        if code != 0:
+            print("  bags skipped: the writer needs python3-rosbag (scripts/install_deps.sh): " + text[-200:],
+                  file=sys.stderr)
+            return
+    original = ros1.read_bytes()
+    bad = work / "bad.bag"
+    for _ in range(rounds * 5):
+        bad.write_bytes(original[: rng.randrange(0, len(original))])
+        attack.judge("bags: ROS 1 truncated", [attack.patrolmap, "map", str(bad), "--out", str(work / "bout")],
+                     [str(bad)], keep=bad)
+    for _ in range(rounds * 5):
+        data = bytearray(original)
+        for _ in range(rng.randrange(1, 20)):
+            data[rng.randrange(0, len(data))] = rng.randrange(256)
+        bad.write_bytes(bytes(data))
+        # Flipped pixels read as other pixels: loading without a word is right for them.
+        attack.judge("bags: ROS 1 bytes flipped", [attack.patrolmap, "map", str(bad), "--out", str(work / "bout")],
+                     [str(bad)], invalid=False, keep=bad)
+    database = next(ros2.glob("*.db3"))
+    pristine = database.read_bytes()
+    for _ in range(rounds * 5):
+        database.write_bytes(pristine[: rng.randrange(0, len(pristine))])
+        attack.judge("bags: ROS 2 database truncated", [attack.patrolmap, "map", str(ros2), "--out",
+                                                        str(work / "bout")], [str(database)], keep=ros2)
+    import sqlite3
+    for _ in range(rounds * 5):
+        database.write_bytes(pristine)
+        connection = sqlite3.connect(str(database))
+        rows = connection.execute("SELECT id, data FROM messages ORDER BY RANDOM() LIMIT 5").fetchall()
+        for row_id, blob in rows:
+            damaged = blob[: rng.randrange(0, len(blob))] if rng.random() < 0.5 else os.urandom(rng.randrange(0, 64))
+            connection.execute("UPDATE messages SET data = ? WHERE id = ?", (damaged, row_id))
+        connection.commit()
+        connection.close()
+        attack.judge("bags: ROS 2 messages damaged", [attack.patrolmap, "map", str(ros2), "--out",
+                                                      str(work / "bout")], [str(ros2), "topic"], keep=ros2)
+    database.write_bytes(pristine)
+    for role in ["camera=/nope", "camera=/imu0", "imu=/cam0/image_raw", "lidar=/x", "camera", "pose=/gps"]:
+        attack.judge("bags: topic choice", [attack.patrolmap, "map", str(ros1), "--topic", role, "--out",
+                                            str(work / "bout")], [str(ros1), "--topic", "role"])
+
+
 def attack_video(attack, work, log):
     video = work / "clip.avi"
     if not shutil.which("ffmpeg"):
@@ -456,6 +506,7 @@ def main():
              lambda: attack_yaml(attack, work, log),
              lambda: attack_images(attack, work, log, rng, 1 if args.quick else 3),
              lambda: attack_video(attack, work, log),
+             lambda: attack_bags(attack, work, log, rng, 1 if args.quick else 3),
              lambda: attack_options(attack, work, log, prior),
              lambda: attack_outputs(attack, work, log, prior),
              lambda: attack_injection(attack, work, log)]

@@ -330,7 +330,15 @@ class BagSource : public FrameSource {
     rosmsg::ImageMessage image;
     const bool compressed = rosmsg::KindOfType(Topic(roles_.camera).type) == MessageKind::kCompressedImage;
     const Status status = rosmsg::DecodeImage(message.bytes, bag_->wire(), compressed, &image);
-    if (!status.ok()) return TopicError(info_.path, Topic(roles_.camera), status);
+    if (!status.ok()) {
+      // A damaged frame is skipped like an unreadable image file; a topic whose very first message does not
+      // decode was refused when the bag was opened (its type does not match).
+      RecordSkipped(next_index_, TopicError(info_.path, Topic(roles_.camera), status).message() + " (message " +
+                                     std::to_string(next_index_) + ")");
+      ++next_index_;
+      spare_.push_back(std::move(message));
+      return Status::Ok();
+    }
     const TimestampNs t = StampOrRecord(image.header, message.record_ns);
     pending_.push_back({std::move(message), t, next_index_++});
     return Status::Ok();
@@ -367,13 +375,13 @@ class BagSource : public FrameSource {
       status = rosmsg::DecodePose(message.bytes, bag_->wire(), rosmsg::KindOfType(topic.type), &pose);
       if (status.ok()) AddPose(pose, StampOrRecord(pose.header, message.record_ns));
     }
-    if (!status.ok()) return TopicError(info_.path, topic, status);
+    if (!status.ok()) return SkipSample(message.topic, status);  // damaged: the first message decoded at opening
     return Status::Ok();
   }
 
   Status ConsumeDepth(const BagMessage& message) {
     rosmsg::ImageMessage image;
-    PATROLMAP_RETURN_IF_ERROR(rosmsg::DecodeImage(message.bytes, bag_->wire(), false, &image));
+    PATROLMAP_RETURN_IF_ERROR(rosmsg::DecodeImage(message.bytes, bag_->wire(), false, &image));  // skipped above
     DepthSample sample;
     sample.timestamp_ns = StampOrRecord(image.header, message.record_ns);
     const Status status = ToMetres(image, &sample.image);
@@ -394,7 +402,7 @@ class BagSource : public FrameSource {
     return Status::Ok();
   }
 
-  // A sample whose content cannot be used: skipped, with a warning the first time for its topic.
+  // A sample that is damaged or cannot be used: skipped, with a warning the first time for its topic.
   Status SkipSample(int topic, const Status& why) {
     if (warned_topics_.insert(topic).second) {
       spdlog::warn("{}, topic {}: {}; such messages are skipped", info_.path, Topic(topic).name, why.message());
@@ -626,6 +634,26 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
       [&](const std::vector<std::uint8_t>& b, rosmsg::ImuMessage* m) { return rosmsg::DecodeImu(b, wire, m); }, &imu,
       &found));
   frames.imu = imu.header.frame_id;
+  // The other topics' first messages are decoded too, so a topic whose type does not match its bytes is
+  // refused here; later damaged messages are skipped with a warning.
+  rosmsg::NavSatFixMessage fix;
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+      bag, path, roles.gps,
+      [&](const std::vector<std::uint8_t>& b, rosmsg::NavSatFixMessage* m) {
+        return rosmsg::DecodeNavSatFix(b, wire, m);
+      },
+      &fix, &found));
+  for (const int topic : {roles.depth, roles.right}) {
+    const bool compressed_topic =
+        topic >= 0 && rosmsg::KindOfType(bag->topics()[topic].type) == MessageKind::kCompressedImage;
+    rosmsg::ImageMessage other;
+    PATROLMAP_RETURN_IF_ERROR(FirstMessage(
+        bag, path, topic,
+        [&](const std::vector<std::uint8_t>& b, rosmsg::ImageMessage* m) {
+          return rosmsg::DecodeImage(b, wire, compressed_topic, m);
+        },
+        &other, &found));
+  }
   rosmsg::PoseMessage pose;
   const MessageKind pose_kind =
       roles.pose >= 0 ? rosmsg::KindOfType(bag->topics()[roles.pose].type) : MessageKind::kOther;
