@@ -148,6 +148,10 @@ def baseline(left_yaml, right_yaml):
     return float(in_left[0])
 
 
+# Messages are recorded a little after their header stamps, as on a real robot: readers must time frames by
+# the stamps.
+RECORD_DELAY_NS = 2_000_000
+
 FRAME_OF = {"depth": "cam0", "image": "cam0", "compressed": "cam0", "camera_info": "cam0", "imu": "imu0", "gps": "gps",
             "odometry": "world"}
 
@@ -212,7 +216,8 @@ def write_ros1(messages, out, chunks):
                     msg.transforms.append(transform)
             if kind != "tf":
                 stamp(msg, t, kind)
-            bag.write(topic, msg, t=genpy.Time(t // 1_000_000_000, t % 1_000_000_000))
+            recorded = t + RECORD_DELAY_NS
+            bag.write(topic, msg, t=genpy.Time(recorded // 1_000_000_000, recorded % 1_000_000_000))
 
 
 # ---------------------------------------------------------------- ROS 2 (CDR)
@@ -332,7 +337,7 @@ def write_ros2(messages, out):
             database.execute("INSERT INTO topics VALUES (?, ?, ?, 'cdr', '')", (topic_ids[topic], topic, ros2_type(kind)))
         counts[topic] = counts.get(topic, 0) + 1
         database.execute("INSERT INTO messages (topic_id, timestamp, data) VALUES (?, ?, ?)",
-                         (topic_ids[topic], t, cdr_message(t, kind, fields)))
+                         (topic_ids[topic], t + RECORD_DELAY_NS, cdr_message(t, kind, fields)))
     database.commit()
     database.close()
     kinds = {topic: kind for _, topic, kind, _ in messages}
