@@ -151,6 +151,24 @@ EvidenceGrid::Slot* EvidenceGrid::Find(std::uint64_t key) {
   }
 }
 
+const EvidenceGrid::Slot* EvidenceGrid::Probe(std::uint64_t key) const {
+  const int bits = __builtin_ctzll(slots_.size());
+  std::size_t i = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+  const std::size_t mask = slots_.size() - 1;
+  while (slots_[i].key != 0) {
+    if (slots_[i].key == key) return &slots_[i];
+    i = (i + 1) & mask;
+  }
+  return nullptr;
+}
+
+bool EvidenceGrid::Lookup(const Eigen::Vector3i& index, VoxelEvidence* voxel) const {
+  const Slot* slot = Probe(PackKey(index));
+  if (slot == nullptr) return false;
+  *voxel = {index.x(), index.y(), index.z(), slot->hits, slot->passes};
+  return true;
+}
+
 // Puts a slot's key into the (not full) table; its counts are the caller's to copy.
 EvidenceGrid::Slot* EvidenceGrid::Insert(std::uint64_t key) {
   const int bits = __builtin_ctzll(slots_.size());
@@ -283,44 +301,55 @@ EvidenceGridData EvidenceGrid::TakeData() {
   return data;
 }
 
-// True when a voxel next to `index` is occupied in `grid`, the patrol where `index` is free: the same
-// surface seen a voxel off (an edge or a corner from a slightly different view) explains the change.
-// With `vertical` false only the horizontal neighbours count.
-bool OccupiedNeighbour(const EvidenceGridData& grid, const Eigen::Vector3i& index, int reach, bool vertical) {
+namespace {
+
+// True when a voxel next to `index` is occupied in the grid `find` reads (find(index, &voxel) -> bool), the
+// patrol where `index` is free: the same surface seen a voxel off (an edge or a corner from a slightly different
+// view) explains the change. With `vertical` false only the horizontal neighbours count.
+template <typename FindVoxelIn>
+bool OccupiedNeighbour(const FindVoxelIn& find, const Eigen::Vector3i& index, int reach, bool vertical) {
+  VoxelEvidence voxel;
   for (int dz = vertical ? -reach : 0; dz <= (vertical ? reach : 0); ++dz) {
     for (int dy = -reach; dy <= reach; ++dy) {
       for (int dx = -reach; dx <= reach; ++dx) {
         if (dx == 0 && dy == 0 && dz == 0) continue;
-        if (IsOccupied(FindVoxel(grid, index + Eigen::Vector3i(dx, dy, dz)))) return true;
+        if (find(index + Eigen::Vector3i(dx, dy, dz), &voxel) && IsOccupied(&voxel)) return true;
       }
     }
   }
   return false;
 }
 
-bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
-               GeometryChange* change) {
-  *change = GeometryChange();
-  if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size) return false;
-  change->evicted_prior = before.evicted_voxels;
-  change->evicted_current = after.evicted_voxels;
+// DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
+// `for_each_common` visits in `before`'s order.
+template <typename FindAfter, typename ForEachCommon>
+void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, const ForEachCommon& for_each_common,
+                const GeometryDiffOptions& options, GeometryChange* change) {
   const double size = before.voxel_size;
   change->voxel_size = size;
+  change->evicted_prior = before.evicted_voxels;
+  const auto find_before = [&before](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    const VoxelEvidence* found = FindVoxel(before, index);
+    if (found != nullptr) *voxel = *found;
+    return found != nullptr;
+  };
   std::vector<Eigen::Vector3i> changed;
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> deltas;
   const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
-  ForEachCommonVoxel(before, after, [&](const VoxelEvidence& a, const VoxelEvidence& b) {
+  for_each_common([&](const VoxelEvidence& a, const VoxelEvidence& b) {
     if (!observed(a) || !observed(b)) return;
     ++change->compared_voxels;
     const double delta = Occupancy(b) - Occupancy(a);
     const bool one_free = std::min(Occupancy(a), Occupancy(b)) <= options.max_free_occupancy;
     const Eigen::Vector3i index(a.x, a.y, a.z);
     if (std::abs(delta) <= options.min_occupancy_change || !one_free) return;
-    if (options.surface_tolerance_voxels > 0 &&
-        OccupiedNeighbour(delta > 0 ? before : after, index, options.surface_tolerance_voxels,
-                          options.vertical_tolerance)) {
-      return;
+    if (options.surface_tolerance_voxels > 0) {
+      const bool explained =
+          delta > 0
+              ? OccupiedNeighbour(find_before, index, options.surface_tolerance_voxels, options.vertical_tolerance)
+              : OccupiedNeighbour(find_after, index, options.surface_tolerance_voxels, options.vertical_tolerance);
+      if (explained) return;
     }
     changed.push_back(index);
     centres.push_back(index.cast<double>() * size);
@@ -342,6 +371,41 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
             [](const Eigen::Vector3i& x, const Eigen::Vector3i& y) {
               return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
             });
+}
+
+}  // namespace
+
+bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
+               GeometryChange* change) {
+  *change = GeometryChange();
+  if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size) return false;
+  change->evicted_current = after.evicted_voxels;
+  const auto find_after = [&after](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    const VoxelEvidence* found = FindVoxel(after, index);
+    if (found != nullptr) *voxel = *found;
+    return found != nullptr;
+  };
+  const auto for_each_common = [&](const auto& visit) { ForEachCommonVoxel(before, after, visit); };
+  DiffVoxels(before, find_after, for_each_common, options, change);
+  return true;
+}
+
+bool DiffGrids(const EvidenceGridData& before, const EvidenceGrid& after, const GeometryDiffOptions& options,
+               GeometryChange* change) {
+  *change = GeometryChange();
+  if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size()) return false;
+  change->evicted_current = after.evicted_voxels();
+  const auto find_after = [&after](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    return after.Lookup(index, voxel);
+  };
+  // The prior's voxels in their (sorted) order, each looked up in the live grid: the merge's order.
+  const auto for_each_common = [&](const auto& visit) {
+    VoxelEvidence current;
+    for (const VoxelEvidence& prior : before.voxels) {
+      if (after.Lookup(Eigen::Vector3i(prior.x, prior.y, prior.z), &current)) visit(prior, current);
+    }
+  };
+  DiffVoxels(before, find_after, for_each_common, options, change);
   return true;
 }
 

@@ -259,5 +259,42 @@ TEST(GeometryChange, DifferentVoxelSizesCannotBeCompared) {
   EXPECT_FALSE(DiffGrids(EvidenceGridData{}, EvidenceGridData{}, GeometryDiffOptions{}, &change));
 }
 
+// The onboard checks compare the prior with the grid still being built, in place: the same change as with
+// the grid's stored copy, voxel for voxel and region for region.
+TEST(GeometryChange, TheLiveGridGivesTheChangeItsCopyGives) {
+  EvidenceGridOptions options;
+  EvidenceGrid before(options), after(options);
+  const Eigen::Vector3d origin(0.0, 0.0, 1.0);
+  for (int pass = 0; pass < 4; ++pass) {
+    for (int y = -20; y <= 20; ++y) {
+      for (int z = 0; z <= 20; ++z) {
+        const Eigen::Vector3d wall(10.0, 0.1 * y, 0.1 * z);
+        before.TraceRay(origin, wall, true);
+        // A box 1 m wide and 1 m tall stands at x = 5 in the later patrol: the rays that reach it end there.
+        const Eigen::Vector3d at_box = origin + 0.5 * (wall - origin);
+        const bool boxed = std::abs(at_box.y()) <= 0.5 && at_box.z() <= 1.0;
+        after.TraceRay(origin, boxed ? at_box : wall, true);
+      }
+    }
+  }
+  const EvidenceGridData prior = before.ToData();
+  GeometryChange from_copy, in_place;
+  ASSERT_TRUE(DiffGrids(prior, after.ToData(), GeometryDiffOptions{}, &from_copy));
+  ASSERT_TRUE(DiffGrids(prior, after, GeometryDiffOptions{}, &in_place));
+  ASSERT_GE(from_copy.regions.size(), 1u) << from_copy.compared_voxels << " compared";
+  EXPECT_GT(from_copy.changed_voxels.size(), 10u);
+  EXPECT_EQ(in_place.compared_voxels, from_copy.compared_voxels);
+  EXPECT_EQ(in_place.changed_voxels, from_copy.changed_voxels);
+  ASSERT_EQ(in_place.regions.size(), from_copy.regions.size());
+  for (std::size_t i = 0; i < in_place.regions.size(); ++i) {
+    EXPECT_EQ(in_place.regions[i].voxels, from_copy.regions[i].voxels);
+    EXPECT_EQ(in_place.regions[i].appeared, from_copy.regions[i].appeared);
+    EXPECT_EQ(in_place.regions[i].centroid, from_copy.regions[i].centroid);
+    EXPECT_EQ(in_place.regions[i].score, from_copy.regions[i].score);
+  }
+  VoxelEvidence voxel;
+  EXPECT_FALSE(after.Lookup(Eigen::Vector3i(500, 500, 500), &voxel));
+}
+
 }  // namespace
 }  // namespace patrolmap::change

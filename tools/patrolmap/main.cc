@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
   add("map", "detect key locations and close loops between them (paper 002 III)", patrolmap::tools::AddMapCommand);
   add("patrol", "add a later flight to a map, closing loops against every earlier flight",
       patrolmap::tools::AddPatrolCommand);
-  add("info", "summarise a map file", patrolmap::tools::AddInfoCommand);
+  add("info", "summarise a map file, or list a ROS bag's topics", patrolmap::tools::AddInfoCommand);
   add("diff", "report what changed between two flights of a map", patrolmap::tools::AddDiffCommand);
   add("export", "write a map as GraphML, DOT or JSON", patrolmap::tools::AddExportCommand);
   add("vocab", "vocabulary tools: vocab build", patrolmap::tools::AddVocabCommand);

@@ -41,6 +41,9 @@ class EvidenceGrid {
   long long evicted_voxels() const { return evicted_; }
   // Updates lost because the current depth image alone filled the grid.
   long long dropped_updates() const { return dropped_; }
+  double voxel_size() const { return options_.voxel_size_m; }
+  // The voxel at `index`, when the grid holds it (into `voxel`).
+  bool Lookup(const Eigen::Vector3i& index, VoxelEvidence* voxel) const;
   EvidenceGridData ToData() const;
   // ToData(), and the table's memory given back (the grid is as a new one afterwards, its eviction count
   // kept): the end of a patrol.
@@ -54,6 +57,7 @@ class EvidenceGrid {
   };
   static_assert(sizeof(Slot) == 16, "MaxVoxels counts 16-byte slots");
   Slot* Find(std::uint64_t key);
+  const Slot* Probe(std::uint64_t key) const;  // the slot of `key`, or null; never inserts
   Slot* Insert(std::uint64_t key);
   void Grow();
   bool Evict();
@@ -97,6 +101,10 @@ struct GeometryChange {
 
 // Fails (returns false) when the grids have different voxel sizes or none.
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
+               GeometryChange* change);
+// The same against a grid still being built, read in place (no copy of its voxels): the onboard checks while
+// flying. Equal to DiffGrids(before, after.ToData(), ...).
+bool DiffGrids(const EvidenceGridData& before, const EvidenceGrid& after, const GeometryDiffOptions& options,
                GeometryChange* change);
 
 }  // namespace patrolmap::change

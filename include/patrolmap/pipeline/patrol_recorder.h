@@ -69,8 +69,11 @@ class PatrolRecorder {
   // left out.
   void Apply(const ChangeWork& work);
 
-  // Change thread: the record so far (objects, grid and the views up to `until_ns`), for change events.
+  // Change thread: the record so far (objects and the views up to `until_ns`; the grid when `with_grid`), for
+  // change events.
   PatrolRecord Snapshot(TimestampNs until_ns, bool with_grid) const;
+  // Change thread: the evidence grid being built, read in place (change::DiffGrids); null without depth.
+  const change::EvidenceGrid* grid() const { return has_depth_ ? &grid_ : nullptr; }
 
   // Change thread, after the last Apply(): the record and what it took.
   void Finish(PatrolRecord* record, PatrolRecordStats* stats);
