@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/types.h"
@@ -9,6 +10,21 @@
 
 namespace patrolmap {
 namespace {
+
+// Map sections are checksummed as they are streamed to the file: any split gives the one-shot checksum.
+TEST(ChecksumStream, AnySplitGivesTheWholeChecksum) {
+  std::string data;
+  for (int i = 0; i < 1000; ++i) data.push_back(static_cast<char>((i * 7919) % 251));
+  for (std::size_t size : {0, 1, 7, 8, 9, 63, 1000}) {
+    const std::uint64_t whole = Checksum(data.data(), size);
+    for (std::size_t piece : {1, 3, 8, 13, 64}) {
+      ChecksumStream stream(size);
+      for (std::size_t at = 0; at < size; at += piece) stream.Add(data.data() + at, std::min(piece, size - at));
+      EXPECT_EQ(stream.Finish(), whole) << size << " bytes in pieces of " << piece;
+    }
+  }
+  EXPECT_NE(Checksum(data.data(), 9), Checksum(data.data(), 8));
+}
 
 TEST(Csv, SplitsAndTrims) {
   std::vector<std::string_view> fields;

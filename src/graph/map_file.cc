@@ -20,32 +20,83 @@ constexpr std::uint32_t kVersion = 5;
 constexpr std::uint32_t kOldestVersion = 1;
 constexpr int kDescriptorWidth = 128;  // SIFT
 
+// Where a section's bytes go: counted (its length), checksummed, or written to the file. A section is built
+// once for each, so saving never holds a section in memory: the features of an hour's map are 45 MB.
+class Sink {
+ public:
+  virtual ~Sink() = default;
+  virtual void Append(const char* data, std::size_t size) = 0;
+};
+
 class Writer {
  public:
+  explicit Writer(Sink* sink) : sink_(sink) {}
   template <typename T>
   void Value(T value) {
-    bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+    sink_->Append(reinterpret_cast<const char*>(&value), sizeof(T));
   }
   void String(const std::string& text) {
     Value(static_cast<std::uint32_t>(text.size()));
-    bytes_.append(text);
+    sink_->Append(text.data(), text.size());
   }
   void Mat(const cv::Mat& mat) {
     const cv::Mat continuous = mat.isContinuous() ? mat : mat.clone();
     Value(static_cast<std::int32_t>(mat.type()));
     Value(static_cast<std::int32_t>(mat.rows));
     Value(static_cast<std::int32_t>(mat.cols));
-    bytes_.append(reinterpret_cast<const char*>(continuous.data), continuous.total() * continuous.elemSize());
+    sink_->Append(reinterpret_cast<const char*>(continuous.data), continuous.total() * continuous.elemSize());
   }
   template <typename T>
   void Vector(const std::vector<T>& values) {
     Value(static_cast<std::uint32_t>(values.size()));
-    bytes_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    sink_->Append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
   }
-  std::string& bytes() { return bytes_; }
 
  private:
-  std::string bytes_;
+  Sink* sink_;
+};
+
+class CountingSink : public Sink {
+ public:
+  void Append(const char*, std::size_t size) override { size_ += size; }
+  std::uint64_t size() const { return size_; }
+
+ private:
+  std::uint64_t size_ = 0;
+};
+
+class ChecksumSink : public Sink {
+ public:
+  explicit ChecksumSink(std::uint64_t size) : stream_(size) {}
+  void Append(const char* data, std::size_t size) override { stream_.Add(data, size); }
+  std::uint64_t checksum() const { return stream_.Finish(); }
+
+ private:
+  ChecksumStream stream_;
+};
+
+// Writes to the file in pieces of about kPiece bytes; keeps the first failure.
+class FileSink : public Sink {
+ public:
+  explicit FileSink(AtomicFile* file) : file_(file) {}
+  void Append(const char* data, std::size_t size) override {
+    buffer_.append(data, size);
+    if (buffer_.size() >= kPiece) Flush();
+  }
+  Status Finish() {
+    Flush();
+    return status_;
+  }
+
+ private:
+  static constexpr std::size_t kPiece = 1 << 20;
+  void Flush() {
+    if (status_.ok() && !buffer_.empty()) status_ = file_->Write(buffer_);
+    buffer_.clear();
+  }
+  AtomicFile* file_;
+  std::string buffer_;
+  Status status_;
 };
 
 // Reads with bounds checks; any overrun sets failed() and yields zeros.
@@ -106,8 +157,8 @@ struct KeyPointRecord {
   std::int32_t octave;
 };
 
-std::string NodeSection(const TopoMap& map) {
-  Writer w;
+void NodeSection(const TopoMap& map, Writer* out) {
+  Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.node_count()));
   for (int i = 0; i < map.node_count(); ++i) {
     const NodeData& n = map.node(i);
@@ -119,11 +170,10 @@ std::string NodeSection(const TopoMap& map) {
     const Eigen::Vector2d gps = n.gps.value_or(Eigen::Vector2d::Zero());
     for (double v : {gps.x(), gps.y(), n.layout.x(), n.layout.y(), n.heading}) w.Value(v);
   }
-  return std::move(w.bytes());
 }
 
-std::string EdgeSection(const TopoMap& map) {
-  Writer w;
+void EdgeSection(const TopoMap& map, Writer* out) {
+  Writer& w = *out;
   const std::vector<TopoMap::Edge> edges = map.Edges();
   w.Value(static_cast<std::uint32_t>(edges.size()));
   for (const TopoMap::Edge& e : edges) {
@@ -135,11 +185,10 @@ std::string EdgeSection(const TopoMap& map) {
     w.Value(static_cast<std::int32_t>(e.data.inliers));
     w.Value(e.data.log_nfa);
   }
-  return std::move(w.bytes());
 }
 
-std::string FeatureSection(const TopoMap& map) {
-  Writer w;
+void FeatureSection(const TopoMap& map, Writer* out) {
+  Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.node_count()));
   for (int i = 0; i < map.node_count(); ++i) {
     const NodeData& n = map.node(i);
@@ -150,7 +199,6 @@ std::string FeatureSection(const TopoMap& map) {
     w.Vector(n.bow.words);
     w.Vector(n.bow.weights);
   }
-  return std::move(w.bytes());
 }
 
 struct PoseRecord {
@@ -181,8 +229,8 @@ void WriteObject(const MapObject& o, Writer* w) {
   w->Value(o.last_seen_ns);
 }
 
-std::string PatrolSection(const TopoMap& map) {
-  Writer w;
+void PatrolSection(const TopoMap& map, Writer* out) {
+  Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.patrols().size()));
   for (const PatrolRecord& p : map.patrols()) {
     w.String(p.flight);
@@ -205,25 +253,32 @@ std::string PatrolSection(const TopoMap& map) {
     w.Value<std::int64_t>(p.grid.evicted_voxels);
     w.String(p.depth_source);
   }
-  return std::move(w.bytes());
 }
 
-std::string VocabularySection(const TopoMap& map) {
-  Writer w;
+void VocabularySection(const TopoMap& map, Writer* out) {
+  Writer& w = *out;
   w.Value(map.vocabulary().fingerprint);
   w.String(map.vocabulary().name);
-  return std::move(w.bytes());
 }
 
-// Writes one section (tag, length, checksum, payload): the file is written a section at a time, so saving holds
-// one section in memory besides the map, not the whole file.
-Status WriteSection(const char (&tag)[5], const std::string& payload, AtomicFile* file) {
+// Writes one section (tag, length, checksum, payload), built three times: counted, checksummed, written.
+Status WriteSection(const char (&tag)[5], const TopoMap& map, void (*build)(const TopoMap&, Writer*),
+                    AtomicFile* file) {
+  CountingSink length;
+  Writer counting(&length);
+  build(map, &counting);
+  ChecksumSink checksum(length.size());
+  Writer checksumming(&checksum);
+  build(map, &checksumming);
   std::string header(tag, 4);
-  const std::uint64_t length = payload.size(), checksum = Checksum(payload.data(), payload.size());
-  header.append(reinterpret_cast<const char*>(&length), 8);
-  header.append(reinterpret_cast<const char*>(&checksum), 8);
+  const std::uint64_t size = length.size(), sum = checksum.checksum();
+  header.append(reinterpret_cast<const char*>(&size), 8);
+  header.append(reinterpret_cast<const char*>(&sum), 8);
   PATROLMAP_RETURN_IF_ERROR(file->Write(header));
-  return file->Write(payload);
+  FileSink out(file);
+  Writer writing(&out);
+  build(map, &writing);
+  return out.Finish();
 }
 
 Status Corrupt(const std::string& path, const std::string& what) {
@@ -453,11 +508,11 @@ Status SaveMap(const TopoMap& map, const std::string& path) {
   const std::uint32_t header[2] = {kVersion, 5};
   start.append(reinterpret_cast<const char*>(header), sizeof(header));
   PATROLMAP_RETURN_IF_ERROR(file.Write(start));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("NODE", NodeSection(map), &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("EDGE", EdgeSection(map), &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("FEAT", FeatureSection(map), &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("PTRL", PatrolSection(map), &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("VOCB", VocabularySection(map), &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("NODE", map, NodeSection, &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("EDGE", map, EdgeSection, &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("FEAT", map, FeatureSection, &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("PTRL", map, PatrolSection, &file));
+  PATROLMAP_RETURN_IF_ERROR(WriteSection("VOCB", map, VocabularySection, &file));
   return file.Commit();
 }
 
