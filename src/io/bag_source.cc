@@ -543,13 +543,38 @@ Status OpenBagFile(const std::string& path, std::unique_ptr<BagFile>* bag) {
 }
 
 // The first message of `topic` decoded by `decode`; false when the topic has none.
-template <typename Message, typename Decode>
-Status FirstMessage(BagFile* bag, const std::string& path, int topic, Decode decode, Message* message, bool* found) {
+// Decodes a message of `topic` as `Message`: images compressed or not by the topic's type, poses by its kind.
+Status DecodeAs(const BagTopic& topic, rosmsg::Wire wire, const std::vector<std::uint8_t>& bytes,
+                rosmsg::ImageMessage* message) {
+  return rosmsg::DecodeImage(bytes, wire, rosmsg::KindOfType(topic.type) == MessageKind::kCompressedImage, message);
+}
+Status DecodeAs(const BagTopic& topic, rosmsg::Wire wire, const std::vector<std::uint8_t>& bytes,
+                rosmsg::PoseMessage* message) {
+  return rosmsg::DecodePose(bytes, wire, rosmsg::KindOfType(topic.type), message);
+}
+Status DecodeAs(const BagTopic&, rosmsg::Wire wire, const std::vector<std::uint8_t>& bytes,
+                rosmsg::CameraInfoMessage* message) {
+  return rosmsg::DecodeCameraInfo(bytes, wire, message);
+}
+Status DecodeAs(const BagTopic&, rosmsg::Wire wire, const std::vector<std::uint8_t>& bytes,
+                rosmsg::ImuMessage* message) {
+  return rosmsg::DecodeImu(bytes, wire, message);
+}
+Status DecodeAs(const BagTopic&, rosmsg::Wire wire, const std::vector<std::uint8_t>& bytes,
+                rosmsg::NavSatFixMessage* message) {
+  return rosmsg::DecodeNavSatFix(bytes, wire, message);
+}
+
+// The first message of `topic` (none: -1) into `message`; `found` false when there is none. A first message
+// that does not decode refuses the topic: its type does not match its bytes.
+template <typename Message>
+Status FirstMessage(BagFile* bag, const std::string& path, int topic, Message* message, bool* found) {
   *found = false;
   if (topic < 0) return Status::Ok();
+  const BagTopic& info = bag->topics()[topic];
   return ForEachMessage(bag, topic, 1, [&](const BagMessage& m) {
-    const Status status = decode(m.bytes, message);
-    if (!status.ok()) return TopicError(path, bag->topics()[topic], status);
+    const Status status = DecodeAs(info, bag->wire(), m.bytes, message);
+    if (!status.ok()) return TopicError(path, info, status);
     *found = true;
     return Status::Ok();
   });
@@ -593,131 +618,108 @@ Status StereoFromCameraInfo(const rosmsg::CameraInfoMessage& left, const rosmsg:
   return Status::Ok();
 }
 
-// What the bag says before its frames: intrinsics, the frame rate and count, the sensors' frames and the
-// rotations between them.
-struct BagFrames {
-  std::string camera, imu, body;
+// The first message of each chosen topic: the sensors' frame ids, the cameras' calibration, and a check that
+// every topic's type matches its bytes.
+struct FirstMessages {
+  rosmsg::ImageMessage image;
+  rosmsg::CameraInfoMessage camera_info, right_info;
+  rosmsg::ImuMessage imu;
+  rosmsg::PoseMessage pose;
+  bool has_camera_info = false, has_right_info = false;
 };
 
-Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles, LogInfo* info,
-                   std::optional<Eigen::Quaterniond>* body_from_camera) {
-  const rosmsg::Wire wire = bag->wire();
-  const bool compressed = rosmsg::KindOfType(bag->topics()[roles.camera].type) == MessageKind::kCompressedImage;
-  BagFrames frames;
+Status ReadFirstMessages(BagFile* bag, const std::string& path, const BagRoles& roles, FirstMessages* first) {
   bool found = false;
-  rosmsg::ImageMessage image;
-  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-      bag, path, roles.camera,
-      [&](const std::vector<std::uint8_t>& b, rosmsg::ImageMessage* m) {
-        return rosmsg::DecodeImage(b, wire, compressed, m);
-      },
-      &image, &found));
-  frames.camera = image.header.frame_id;
-  rosmsg::CameraInfoMessage camera_info;
-  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-      bag, path, roles.camera_info,
-      [&](const std::vector<std::uint8_t>& b, rosmsg::CameraInfoMessage* m) {
-        return rosmsg::DecodeCameraInfo(b, wire, m);
-      },
-      &camera_info, &found));
-  const bool has_camera_info = found;
-  if (found) {
-    const CameraIntrinsics camera = IntrinsicsOf(camera_info);
-    if (camera.valid()) info->camera = camera;
-    if (!camera.valid()) {
-      spdlog::warn("{}, topic {}: camera info without intrinsics", path, bag->topics()[roles.camera_info].name);
-    }
-  }
-  rosmsg::ImuMessage imu;
-  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-      bag, path, roles.imu,
-      [&](const std::vector<std::uint8_t>& b, rosmsg::ImuMessage* m) { return rosmsg::DecodeImu(b, wire, m); }, &imu,
-      &found));
-  frames.imu = imu.header.frame_id;
-  // The other topics' first messages are decoded too, so a topic whose type does not match its bytes is
-  // refused here; later damaged messages are skipped with a warning.
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.camera, &first->image, &found));
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.camera_info, &first->camera_info, &first->has_camera_info));
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.right_info, &first->right_info, &first->has_right_info));
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.imu, &first->imu, &found));
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.pose, &first->pose, &found));
   rosmsg::NavSatFixMessage fix;
-  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-      bag, path, roles.gps,
-      [&](const std::vector<std::uint8_t>& b, rosmsg::NavSatFixMessage* m) {
-        return rosmsg::DecodeNavSatFix(b, wire, m);
-      },
-      &fix, &found));
+  PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, roles.gps, &fix, &found));
   for (const int topic : {roles.depth, roles.right}) {
-    const bool compressed_topic =
-        topic >= 0 && rosmsg::KindOfType(bag->topics()[topic].type) == MessageKind::kCompressedImage;
-    rosmsg::ImageMessage other;
-    PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-        bag, path, topic,
-        [&](const std::vector<std::uint8_t>& b, rosmsg::ImageMessage* m) {
-          return rosmsg::DecodeImage(b, wire, compressed_topic, m);
-        },
-        &other, &found));
+    rosmsg::ImageMessage image;
+    PATROLMAP_RETURN_IF_ERROR(FirstMessage(bag, path, topic, &image, &found));
   }
-  rosmsg::PoseMessage pose;
-  const MessageKind pose_kind =
-      roles.pose >= 0 ? rosmsg::KindOfType(bag->topics()[roles.pose].type) : MessageKind::kOther;
-  PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-      bag, path, roles.pose,
-      [&](const std::vector<std::uint8_t>& b, rosmsg::PoseMessage* m) {
-        return rosmsg::DecodePose(b, wire, pose_kind, m);
-      },
-      &pose, &found));
-  FrameTree tree;
-  if (roles.transforms >= 0) {
-    PATROLMAP_RETURN_IF_ERROR(ForEachMessage(bag, roles.transforms, 0, [&](const BagMessage& m) {
-      std::vector<rosmsg::TransformMessage> transforms;
-      const Status status = rosmsg::DecodeTransforms(m.bytes, wire, &transforms);
-      if (!status.ok()) return TopicError(path, bag->topics()[roles.transforms], status);
-      for (const rosmsg::TransformMessage& transform : transforms) tree.Add(transform);
-      return Status::Ok();
-    }));
-  }
+  return Status::Ok();
+}
+
+Status ReadFrameTree(BagFile* bag, const std::string& path, int topic, FrameTree* tree) {
+  if (topic < 0) return Status::Ok();
+  return ForEachMessage(bag, topic, 0, [&](const BagMessage& m) {
+    std::vector<rosmsg::TransformMessage> transforms;
+    const Status status = rosmsg::DecodeTransforms(m.bytes, bag->wire(), &transforms);
+    if (!status.ok()) return TopicError(path, bag->topics()[topic], status);
+    for (const rosmsg::TransformMessage& transform : transforms) tree->Add(transform);
+    return Status::Ok();
+  });
+}
+
+// The rotations between the camera, the IMU and the frame the poses move, from /tf_static.
+void SetRotations(const BagFile& bag, const std::string& path, const BagRoles& roles, const FirstMessages& first,
+                  const FrameTree& tree, LogInfo* info, std::optional<Eigen::Quaterniond>* body_from_camera) {
+  const std::string& camera = first.image.header.frame_id;
+  const std::string& imu = first.imu.header.frame_id;
   if (roles.imu >= 0) {
-    const std::optional<Eigen::Quaterniond> camera_from_imu = tree.Rotation(frames.camera, frames.imu);
+    const std::optional<Eigen::Quaterniond> camera_from_imu = tree.Rotation(camera, imu);
     if (camera_from_imu) info->camera_from_imu = camera_from_imu->toRotationMatrix();
-    if (!info->camera_from_imu) {
+    if (!camera_from_imu) {
       spdlog::warn(
           "{}: /tf_static does not link the camera's frame '{}' to the IMU's '{}': camera-IMU rotation unknown", path,
-          frames.camera, frames.imu);
+          camera, imu);
     }
   }
-  if (roles.pose >= 0) {
-    // Odometry names the frame it moves; a stamped pose is taken for the IMU's frame when the tree links it
-    // to the camera, else for the camera's own.
-    frames.body = pose_kind == MessageKind::kOdometry ? pose.child_frame : frames.imu;
-    *body_from_camera = tree.Rotation(frames.body, frames.camera);
-    if (!*body_from_camera) {
-      spdlog::warn(
-          "{}, topic {}: /tf_static does not link the pose's frame '{}' to the camera's '{}': the poses are "
-          "taken for the camera's own",
-          path, bag->topics()[roles.pose].name, frames.body, frames.camera);
-    }
-    info->body_from_camera = body_from_camera->value_or(Eigen::Quaterniond::Identity()).toRotationMatrix();
+  if (roles.pose < 0) return;
+  // Odometry names the frame it moves; a stamped pose is taken for the IMU's frame when the tree links it to
+  // the camera, else for the camera's own.
+  const bool odometry = rosmsg::KindOfType(bag.topics()[roles.pose].type) == MessageKind::kOdometry;
+  const std::string& body = odometry ? first.pose.child_frame : imu;
+  *body_from_camera = tree.Rotation(body, camera);
+  if (!*body_from_camera) {
+    spdlog::warn(
+        "{}, topic {}: /tf_static does not link the pose's frame '{}' to the camera's '{}': the poses are "
+        "taken for the camera's own",
+        path, bag.topics()[roles.pose].name, body, camera);
   }
+  info->body_from_camera = body_from_camera->value_or(Eigen::Quaterniond::Identity()).toRotationMatrix();
+}
+
+// The camera's intrinsics, and the stereo pair's calibration when a right camera was chosen.
+void SetCalibration(const BagFile& bag, const std::string& path, const BagRoles& roles, const FirstMessages& first,
+                    LogInfo* info) {
+  if (first.has_camera_info) {
+    const CameraIntrinsics camera = IntrinsicsOf(first.camera_info);
+    if (camera.valid()) info->camera = camera;
+    if (!camera.valid()) {
+      spdlog::warn("{}, topic {}: camera info without intrinsics", path, bag.topics()[roles.camera_info].name);
+    }
+  }
+  if (roles.right < 0) return;
+  StereoCalibration pair;
+  const Status status = !first.has_camera_info || !first.has_right_info
+                            ? Status::NotFound(
+                                  "no camera info for both cameras (the right one's is expected beside its "
+                                  "images, e.g. /cam1/camera_info)")
+                            : StereoFromCameraInfo(first.camera_info, first.right_info, &pair);
+  if (status.ok()) {
+    info->stereo = pair;
+    info->has_stereo = true;
+  } else {
+    spdlog::warn("{}, topic {}: {}; the stereo pair is not used", path, bag.topics()[roles.right].name,
+                 status.message());
+  }
+}
+
+// What the bag says before its frames: intrinsics, the frame rate and count, the rotations between sensors.
+Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles, LogInfo* info,
+                   std::optional<Eigen::Quaterniond>* body_from_camera) {
+  FirstMessages first;
+  PATROLMAP_RETURN_IF_ERROR(ReadFirstMessages(bag, path, roles, &first));
+  FrameTree tree;
+  PATROLMAP_RETURN_IF_ERROR(ReadFrameTree(bag, path, roles.transforms, &tree));
+  SetRotations(*bag, path, roles, first, tree, info, body_from_camera);
+  SetCalibration(*bag, path, roles, first, info);
   info->has_depth = roles.depth >= 0;
-  if (roles.right >= 0) {
-    rosmsg::CameraInfoMessage right_info;
-    PATROLMAP_RETURN_IF_ERROR(FirstMessage(
-        bag, path, roles.right_info,
-        [&](const std::vector<std::uint8_t>& b, rosmsg::CameraInfoMessage* m) {
-          return rosmsg::DecodeCameraInfo(b, wire, m);
-        },
-        &right_info, &found));
-    StereoCalibration pair;
-    const Status status = !has_camera_info || !found
-                              ? Status::NotFound(
-                                    "no camera info for both cameras (the right one's is expected "
-                                    "beside its images, e.g. /cam1/camera_info)")
-                              : StereoFromCameraInfo(camera_info, right_info, &pair);
-    if (status.ok()) {
-      info->stereo = pair;
-      info->has_stereo = true;
-    } else {
-      spdlog::warn("{}, topic {}: {}; the stereo pair is not used", path, bag->topics()[roles.right].name,
-                   status.message());
-    }
-  }
   std::vector<TimestampNs> times;
   PATROLMAP_RETURN_IF_ERROR(bag->Times(roles.camera, &times));
   info->frame_count = static_cast<std::int64_t>(times.size());
@@ -725,7 +727,7 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
   info->timing = "header stamps of " + bag->topics()[roles.camera].name;
   info->has_imu = roles.imu >= 0;
   info->has_poses = roles.pose >= 0;
-  info->has_speed = pose_kind == MessageKind::kOdometry;
+  info->has_speed = roles.pose >= 0 && rosmsg::KindOfType(bag->topics()[roles.pose].type) == MessageKind::kOdometry;
   return Status::Ok();
 }
 
