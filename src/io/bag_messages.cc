@@ -199,7 +199,15 @@ Status DecodeImu(const std::vector<std::uint8_t>& bytes, Wire wire, ImuMessage* 
   WireReader reader(bytes, wire);
   PATROLMAP_RETURN_IF_ERROR(reader.Begin());
   PATROLMAP_RETURN_IF_ERROR(reader.ReadHeader(&message->header));
-  PATROLMAP_RETURN_IF_ERROR(reader.Skip("orientation", sizeof(double), 4 + 9));
+  std::array<double, 4> q{};  // x, y, z, w
+  PATROLMAP_RETURN_IF_ERROR(reader.ReadDoubles("orientation", &q));
+  std::array<double, 9> covariance{};
+  PATROLMAP_RETURN_IF_ERROR(reader.ReadDoubles("orientation_covariance", &covariance));
+  const double length = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  message->orientation.reset();
+  if (covariance[0] != -1.0 && std::isfinite(length) && std::abs(length - 1.0) < 1e-3) {
+    message->orientation = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized();
+  }
   PATROLMAP_RETURN_IF_ERROR(reader.ReadVector("angular_velocity", &message->gyro));
   PATROLMAP_RETURN_IF_ERROR(reader.Skip("angular_velocity_covariance", sizeof(double), 9));
   PATROLMAP_RETURN_IF_ERROR(reader.ReadVector("linear_acceleration", &message->accel));

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,9 @@ struct ImageMessage {
 
 struct ImuMessage {
   Header header;
+  // The attitude (world from IMU frame), when the sender gives one: ROS marks "none" with a first
+  // orientation covariance of -1, and an all-zero quaternion is none too.
+  std::optional<Eigen::Quaterniond> orientation;
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();
 };

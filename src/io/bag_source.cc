@@ -258,9 +258,11 @@ struct PendingFrame {
 
 class BagSource : public FrameSource {
  public:
+  // With `poses_from_gps` the camera poses come from the GPS fixes and the IMU's attitude (no pose topic).
   BagSource(LogInfo info, std::unique_ptr<BagFile> bag, BagRoles roles, std::unique_ptr<BagStream> stream,
-            std::optional<Eigen::Quaterniond> body_from_camera)
-      : info_(std::move(info)),
+            std::optional<Eigen::Quaterniond> body_from_camera, bool poses_from_gps)
+      : poses_from_gps_(poses_from_gps),
+        info_(std::move(info)),
         bag_(std::move(bag)),
         roles_(roles),
         stream_(std::move(stream)),
@@ -276,6 +278,7 @@ class BagSource : public FrameSource {
     if (info_.has_poses) spdlog::info("{}: camera poses from {}, not the bag's pose topic", info_.path, path);
     file_poses_ = std::move(poses);
     roles_.pose = -1;
+    poses_from_gps_ = false;
     info_.has_poses = true;
     return Status::Ok();
   }
@@ -323,7 +326,8 @@ class BagSource : public FrameSource {
   }
 
   bool WantsPose() const {
-    return roles_.pose >= 0 && (poses_.empty() || poses_.back().timestamp_ns < pending_.front().timestamp_ns);
+    return (roles_.pose >= 0 || poses_from_gps_) &&
+           (poses_.empty() || poses_.back().timestamp_ns < pending_.front().timestamp_ns);
   }
 
   Status Enqueue(BagMessage message) {
@@ -361,11 +365,15 @@ class BagSource : public FrameSource {
       if (status.ok() && (imu_.empty() || t > imu_.back().timestamp_ns) && t > last_imu_ns_) {
         imu_.push_back({t, imu.gyro, imu.accel});
       }
+      if (status.ok() && imu.orientation) attitude_ = *imu.orientation;
     } else if (message.topic == roles_.gps) {
       rosmsg::NavSatFixMessage fix;
       status = rosmsg::DecodeNavSatFix(message.bytes, bag_->wire(), &fix);
-      if (status.ok() && fix.status >= 0)
-        AppendTimed(&gps_, StampOrRecord(fix.header, message.record_ns), fix.position);
+      if (status.ok() && fix.status >= 0) {
+        const TimestampNs t = StampOrRecord(fix.header, message.record_ns);
+        AppendTimed(&gps_, t, fix.position);
+        if (poses_from_gps_ && attitude_) AddPose(PoseFromFix(fix.position), t);
+      }
     } else if (message.topic == roles_.depth) {
       status = ConsumeDepth(message);
     } else if (message.topic == roles_.right) {
@@ -413,6 +421,20 @@ class BagSource : public FrameSource {
   template <typename Value>
   static void AppendTimed(std::deque<TimedValue<Value>>* samples, TimestampNs t, const Value& value) {
     if (samples->empty() || t > samples->back().timestamp_ns) samples->push_back({t, value});
+  }
+
+  // A fix and the latest attitude as a pose: east, north, up [m] from the first fix (a plane tangent to the
+  // earth there: within centimetres over a few kilometres), turned by the IMU's attitude.
+  rosmsg::PoseMessage PoseFromFix(const Eigen::Vector3d& fix) {
+    constexpr double kEarthRadiusM = 6378137.0;
+    constexpr double kRadians = M_PI / 180.0;
+    if (!gps_origin_) gps_origin_ = fix;
+    const Eigen::Vector3d& origin = *gps_origin_;
+    rosmsg::PoseMessage pose;
+    pose.position = Eigen::Vector3d((fix.y() - origin.y()) * kRadians * kEarthRadiusM * std::cos(origin.x() * kRadians),
+                                    (fix.x() - origin.x()) * kRadians * kEarthRadiusM, fix.z() - origin.z());
+    pose.rotation = *attitude_;
+    return pose;
   }
 
   void AddPose(const rosmsg::PoseMessage& pose, TimestampNs t) {
@@ -512,6 +534,9 @@ class BagSource : public FrameSource {
     poses_.erase(poses_.begin(), poses_.begin() + static_cast<std::ptrdiff_t>(passed));
   }
 
+  bool poses_from_gps_;
+  std::optional<Eigen::Quaterniond> attitude_;  // the IMU's latest, for poses from GPS
+  std::optional<Eigen::Vector3d> gps_origin_;   // the first fix used for a pose
   LogInfo info_;
   std::unique_ptr<BagFile> bag_;
   BagRoles roles_;
@@ -657,7 +682,8 @@ Status ReadFrameTree(BagFile* bag, const std::string& path, int topic, FrameTree
 
 // The rotations between the camera, the IMU and the frame the poses move, from /tf_static.
 void SetRotations(const BagFile& bag, const std::string& path, const BagRoles& roles, const FirstMessages& first,
-                  const FrameTree& tree, LogInfo* info, std::optional<Eigen::Quaterniond>* body_from_camera) {
+                  const FrameTree& tree, LogInfo* info, std::optional<Eigen::Quaterniond>* body_from_camera,
+                  bool* poses_from_gps) {
   const std::string& camera = first.image.header.frame_id;
   const std::string& imu = first.imu.header.frame_id;
   if (roles.imu >= 0) {
@@ -669,7 +695,25 @@ void SetRotations(const BagFile& bag, const std::string& path, const BagRoles& r
           camera, imu);
     }
   }
-  if (roles.pose < 0) return;
+  if (roles.pose < 0) {
+    *poses_from_gps = roles.gps >= 0 && roles.imu >= 0 && first.imu.orientation.has_value();
+    if (!*poses_from_gps) return;
+    // No pose topic: the GPS fixes and the IMU's attitude give the IMU's pose.
+    *body_from_camera = tree.Rotation(imu, camera);
+    if (!*body_from_camera) {
+      spdlog::warn(
+          "{}: /tf_static does not link the IMU's frame '{}' to the camera's '{}': no poses from GPS and "
+          "the IMU's attitude",
+          path, imu, camera);
+      *poses_from_gps = false;
+      return;
+    }
+    spdlog::info("{}: camera poses from {} and the attitude of {}", path, bag.topics()[roles.gps].name,
+                 bag.topics()[roles.imu].name);
+    info->has_poses = true;
+    info->body_from_camera = (*body_from_camera)->toRotationMatrix();
+    return;
+  }
   // Odometry names the frame it moves; a stamped pose is taken for the IMU's frame when the tree links it to
   // the camera, else for the camera's own.
   const bool odometry = rosmsg::KindOfType(bag.topics()[roles.pose].type) == MessageKind::kOdometry;
@@ -712,12 +756,12 @@ void SetCalibration(const BagFile& bag, const std::string& path, const BagRoles&
 
 // What the bag says before its frames: intrinsics, the frame rate and count, the rotations between sensors.
 Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles, LogInfo* info,
-                   std::optional<Eigen::Quaterniond>* body_from_camera) {
+                   std::optional<Eigen::Quaterniond>* body_from_camera, bool* poses_from_gps) {
   FirstMessages first;
   PATROLMAP_RETURN_IF_ERROR(ReadFirstMessages(bag, path, roles, &first));
   FrameTree tree;
   PATROLMAP_RETURN_IF_ERROR(ReadFrameTree(bag, path, roles.transforms, &tree));
-  SetRotations(*bag, path, roles, first, tree, info, body_from_camera);
+  SetRotations(*bag, path, roles, first, tree, info, body_from_camera, poses_from_gps);
   SetCalibration(*bag, path, roles, first, info);
   info->has_depth = roles.depth >= 0;
   std::vector<TimestampNs> times;
@@ -726,7 +770,7 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
   info->frame_rate_hz = MedianRate(times);
   info->timing = "header stamps of " + bag->topics()[roles.camera].name;
   info->has_imu = roles.imu >= 0;
-  info->has_poses = roles.pose >= 0;
+  info->has_poses = info->has_poses || roles.pose >= 0;
   info->has_speed = roles.pose >= 0 && rosmsg::KindOfType(bag->topics()[roles.pose].type) == MessageKind::kOdometry;
   return Status::Ok();
 }
@@ -763,7 +807,8 @@ Status OpenBag(const std::string& path, const ImageFolderOptions& options, std::
   info.flight_id = CleanFlightId(fs::path(path).lexically_normal().stem().string());
   if (info.flight_id.empty()) info.flight_id = CleanFlightId(fs::path(path).parent_path().filename().string());
   std::optional<Eigen::Quaterniond> body_from_camera;
-  PATROLMAP_RETURN_IF_ERROR(ReadLogInfo(bag.get(), path, roles, &info, &body_from_camera));
+  bool poses_from_gps = false;
+  PATROLMAP_RETURN_IF_ERROR(ReadLogInfo(bag.get(), path, roles, &info, &body_from_camera, &poses_from_gps));
   if (options.frame_rate_hz > 0.0) {
     spdlog::warn("{}: --fps is for logs without times; a bag's frames keep their header stamps", path);
   }
@@ -780,7 +825,8 @@ Status OpenBag(const std::string& path, const ImageFolderOptions& options, std::
     if (topic >= 0) used += std::string(", ") + role + " " + bag->topics()[topic].name;
   }
   spdlog::info("{}: {}", path, used);
-  *source = std::make_unique<BagSource>(std::move(info), std::move(bag), roles, std::move(stream), body_from_camera);
+  *source = std::make_unique<BagSource>(std::move(info), std::move(bag), roles, std::move(stream), body_from_camera,
+                                        poses_from_gps);
   return Status::Ok();
 }
 

@@ -83,11 +83,24 @@ std::vector<std::uint8_t> Odometry(std::int64_t t, const Eigen::Vector3d& positi
   return w.bytes();
 }
 
-std::vector<std::uint8_t> Imu(std::int64_t t, double gyro_z) {
+// An IMU sample; with `attitude` its orientation too (else marked as none, covariance -1).
+std::vector<std::uint8_t> Imu(std::int64_t t, double gyro_z, const Eigen::Quaterniond* attitude = nullptr) {
   WireWriter w(Wire::kCdr);
-  w.Header(Sec(t), Nsec(t), "imu").Doubles({0, 0, 0, 1}).Doubles({-1, 0, 0, 0, 0, 0, 0, 0, 0});
+  w.Header(Sec(t), Nsec(t), "imu");
+  if (attitude != nullptr) {
+    w.Doubles({attitude->x(), attitude->y(), attitude->z(), attitude->w()}).Doubles({0, 0, 0, 0, 0, 0, 0, 0, 0});
+  } else {
+    w.Doubles({0, 0, 0, 1}).Doubles({-1, 0, 0, 0, 0, 0, 0, 0, 0});
+  }
   w.Doubles({0, 0, gyro_z}).Doubles({0, 0, 0, 0, 0, 0, 0, 0, 0}).Doubles({0, 0, 9.81});
   w.Doubles({0, 0, 0, 0, 0, 0, 0, 0, 0});
+  return w.bytes();
+}
+
+std::vector<std::uint8_t> Fix(std::int64_t t, double latitude, double longitude, double altitude) {
+  WireWriter w(Wire::kCdr);
+  w.Header(Sec(t), Nsec(t), "gps").Put<std::int8_t>(0).Put<std::uint16_t>(1).Doubles({latitude, longitude, altitude});
+  w.Doubles({0, 0, 0, 0, 0, 0, 0, 0, 0}).Put<std::uint8_t>(0);
   return w.bytes();
 }
 
@@ -100,18 +113,18 @@ struct Message {
 class BagSourceTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::vector<std::pair<std::string, std::string>> topics = {
-        {"/cam/image_raw", "sensor_msgs/msg/Image"},
-        {"/cam/camera_info", "sensor_msgs/msg/CameraInfo"},
-        {"/right/image_raw", "sensor_msgs/msg/Image"},
-        {"/right/camera_info", "sensor_msgs/msg/CameraInfo"},
-        {"/cam/depth/image_raw", "sensor_msgs/msg/Image"},
-        {"/imu", "sensor_msgs/msg/Imu"},
-        {"/odom", "nav_msgs/msg/Odometry"},
-        {"/tf_static", "tf2_msgs/msg/TFMessage"}};
-    std::vector<Message> messages = {{"/tf_static", kSecond / 2, Transforms()},
-                                     {"/cam/camera_info", kSecond / 2, CameraInfo(0.0)},
-                                     {"/right/camera_info", kSecond / 2, CameraInfo(0.5)}};
+    topics_ = {{"/cam/image_raw", "sensor_msgs/msg/Image"},
+               {"/cam/camera_info", "sensor_msgs/msg/CameraInfo"},
+               {"/right/image_raw", "sensor_msgs/msg/Image"},
+               {"/right/camera_info", "sensor_msgs/msg/CameraInfo"},
+               {"/cam/depth/image_raw", "sensor_msgs/msg/Image"},
+               {"/imu", "sensor_msgs/msg/Imu"},
+               {"/odom", "nav_msgs/msg/Odometry"},
+               {"/tf_static", "tf2_msgs/msg/TFMessage"}};
+    std::vector<Message>& messages = messages_;
+    messages = {{"/tf_static", kSecond / 2, Transforms()},
+                {"/cam/camera_info", kSecond / 2, CameraInfo(0.0)},
+                {"/right/camera_info", kSecond / 2, CameraInfo(0.5)}};
     for (int i = 0; i < 3; ++i) {
       const std::int64_t t = kSecond + i * kSecond / 10;
       // A red pixel in a 4x2 rgb8 image; a grey right image; 1.5 m of depth.
@@ -132,7 +145,7 @@ class BagSourceTest : public ::testing::Test {
       messages.push_back({"/odom", t, Odometry(t, Eigen::Vector3d(k, 0, 2), Turn(10.0 * k, {0, 0, 1}))});
     }
     std::filesystem::create_directories(Folder());
-    WriteBag(topics, messages);
+    WriteBag(topics_, messages_);
   }
 
   void WriteBag(const std::vector<std::pair<std::string, std::string>>& topics, const std::vector<Message>& messages) {
@@ -180,6 +193,8 @@ class BagSourceTest : public ::testing::Test {
 
   std::string Folder() const { return dir_.path() + "/flight"; }
 
+  std::vector<std::pair<std::string, std::string>> topics_;
+  std::vector<Message> messages_;
   TempDir dir_;
 };
 
@@ -283,6 +298,41 @@ TEST_F(BagSourceTest, ChosenTopicsAreChecked) {
   EXPECT_FALSE(ParseTopicChoice({"imu=/a", "imu=/b"}, &choice).ok());
   ASSERT_TRUE(ParseTopicChoice({"depth=/d", "right=/r"}, &choice).ok());
   EXPECT_EQ(choice.right, "/r");
+}
+
+// Without a pose topic, GPS fixes and the IMU's attitude give the poses: east, north and up from the first
+// fix, turned by the attitude and the camera's rotation in the IMU's frame.
+TEST_F(BagSourceTest, PosesFromGpsAndTheImusAttitude) {
+  const Eigen::Quaterniond attitude = Turn(30, {0, 0, 1});
+  std::vector<Message> messages;
+  for (const Message& m : messages_) {
+    if (m.topic == "/odom") continue;
+    messages.push_back(m.topic == "/imu" ? Message{m.topic, m.stamp, Imu(m.stamp, 0.0, &attitude)} : m);
+  }
+  // A fix every 0.1 s from 0.95 s, 1e-5 degrees further north each time (1.113 m).
+  for (int k = 0; k < 5; ++k) {
+    const std::int64_t t = kSecond - kSecond / 20 + k * kSecond / 10;
+    messages.push_back({"/gps", t, Fix(t, 47.0 + 1e-5 * k, 8.0, 400.0 + k)});
+  }
+  std::vector<std::pair<std::string, std::string>> topics;
+  for (const auto& topic : topics_) {
+    if (topic.first != "/odom") topics.push_back(topic);
+  }
+  topics.push_back({"/gps", "sensor_msgs/msg/NavSatFix"});
+  std::filesystem::remove_all(Folder());
+  std::filesystem::create_directories(Folder());
+  WriteBag(topics, messages);
+  LogInfo info;
+  const std::vector<Frame> frames = ReadAll({}, &info);
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_TRUE(info.has_poses);
+  // Frame 1 at 1.1 s: halfway between the fixes at 1.05 s (k = 1) and 1.15 s (k = 2).
+  ASSERT_TRUE(frames[1].pose.has_value());
+  const double metres_per_step = 1e-5 * M_PI / 180.0 * 6378137.0;
+  EXPECT_NEAR(frames[1].pose->position.y(), 1.5 * metres_per_step, 1e-6);
+  EXPECT_NEAR(frames[1].pose->position.x(), 0.0, 1e-9);
+  EXPECT_NEAR(frames[1].pose->position.z(), 1.5, 1e-9);
+  EXPECT_NEAR(frames[1].pose->rotation.angularDistance(attitude * kImuFromCamera), 0.0, 1e-9);
 }
 
 }  // namespace
