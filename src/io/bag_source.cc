@@ -252,6 +252,7 @@ Status ToMetres(const rosmsg::ImageMessage& image, cv::Mat* metres) {
 // A camera message waiting for its samples: its bytes and its time.
 struct PendingFrame {
   BagMessage message;
+  rosmsg::ImageMessage image;  // decoded once; its data points into message.bytes (a move keeps the buffer)
   TimestampNs timestamp_ns = 0;
   std::int64_t index = 0;
 };
@@ -344,7 +345,7 @@ class BagSource : public FrameSource {
       return Status::Ok();
     }
     const TimestampNs t = StampOrRecord(image.header, message.record_ns);
-    pending_.push_back({std::move(message), t, next_index_++});
+    pending_.push_back({std::move(message), std::move(image), t, next_index_++});
     return Status::Ok();
   }
 
@@ -466,10 +467,7 @@ class BagSource : public FrameSource {
     while (!right_.empty() && right_.front().timestamp_ns < t) right_.pop_front();
     const bool paired = !right_.empty() && right_.front().timestamp_ns == t && info_.has_stereo;
     if (decode_image || paired) {
-      rosmsg::ImageMessage image;
-      const bool compressed = rosmsg::KindOfType(Topic(roles_.camera).type) == MessageKind::kCompressedImage;
-      Status status = rosmsg::DecodeImage(pending.message.bytes, bag_->wire(), compressed, &image);
-      if (status.ok()) status = ToGrey(image, &frame->image);
+      Status status = ToGrey(pending.image, &frame->image);
       if (status.ok() && first_size_.empty()) first_size_ = frame->image.size();
       if (status.ok() && frame->image.size() != first_size_) {
         status = Status::DataLoss("image is " + std::to_string(frame->image.cols) + "x" +
