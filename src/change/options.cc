@@ -74,6 +74,13 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
       .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0);
 }
 
+void CheckRouteFrames(const RouteFrameOptions& r, OptionCheck* check) {
+  check->InRange("change.route_frames.interval_s", r.interval_s, 0.0, 3600.0)
+      .InRange("change.route_frames.max_width", r.max_width, 16, 8192)
+      .InRange("change.route_frames.jpeg_quality", r.jpeg_quality, 1, 100)
+      .InRange("change.route_frames.memory_mb", r.memory_mb, 0.1, 65536.0);
+}
+
 }  // namespace
 
 bool ChangeOptions::IsValid(std::string* error) const {
@@ -83,6 +90,7 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckObjects(objects, &check);
   CheckGrid(grid, &check);
   CheckGeometry(geometry, &check);
+  CheckRouteFrames(route_frames, &check);
   return check.ok();
 }
 

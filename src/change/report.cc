@@ -1,168 +1,249 @@
 #include "patrolmap/change/report.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <sstream>
+#include <array>
+#include <cmath>
+#include <limits>
 
-#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/core/files.h"
-#include "patrolmap/graph/export.h"
 
 namespace patrolmap::change {
 namespace {
 
-using nlohmann::json;
+constexpr double kRegionCellM = 2.0;  // geometry ids: one per region centroid in a cell this wide
+const cv::Scalar kOutline(0, 0, 230);  // BGR
 
-json Vector(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
-json Box(const cv::Rect& r) { return json::array({r.x, r.y, r.width, r.height}); }
-
-double YawDegrees(const Eigen::Matrix3d& rotation) { return std::atan2(rotation(1, 0), rotation(0, 0)) * 180.0 / M_PI; }
-
-json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
-  const AppearanceChange& a = place.appearance;
-  json regions = json::array();
-  for (const AppearanceRegion& r : a.regions) {
-    regions.push_back({{"current_box", Box(r.current_box)},
-                       {"prior_box", Box(r.prior_box)},
-                       {"area_px", r.area_px},
-                       {"score", r.score},
-                       {"prior_features", r.prior_features},
-                       {"unmatched_prior_features", r.unmatched_prior_features},
-                       {"current_features", r.current_features},
-                       {"unmatched_current_features", r.unmatched_current_features}});
+std::array<Eigen::Vector3d, 8> Corners(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int i = 0; i < 8; ++i) {
+    corners[i] = Eigen::Vector3d((i & 1) ? high.x() : low.x(), (i & 2) ? high.y() : low.y(), (i & 4) ? high.z() : low.z());
   }
-  return {{"prior_node", place.prior_node},
-          {"current_node", place.current_node},
-          {"prior_frame", map.node(place.prior_node).frame_index},
-          {"current_frame", map.node(place.current_node).frame_index},
-          {"registered", a.registered},
-          {"matches", a.matches},
-          {"inliers", a.inliers},
-          {"gain", a.gain},
-          {"offset", a.offset},
-          {"compared_fraction", a.compared_fraction},
-          {"regions", regions}};
+  return corners;
 }
 
-json ObjectJson(const ObjectChange& o) {
-  json object = {{"state", ToString(o.state)},
-                 {"label", o.label},
-                 {"confidence", o.confidence},
-                 {"prior_id", o.prior_id},
-                 {"current_id", o.current_id},
-                 {"covering_views", o.covering_views},
-                 {"expected_detections", o.expected_detections},
-                 {"before", o.before ? Vector(*o.before) : json(nullptr)},
-                 {"after", o.after ? Vector(*o.after) : json(nullptr)}};
-  if (o.state == ObjectState::kMoved) {
-    object["rotation_yaw_deg"] = YawDegrees(o.rotation);
-    object["weighted_distance"] = o.weighted_distance;
+// A kept frame and where a box lies in it (camera pixels).
+struct Sighting {
+  const RouteFrame* frame = nullptr;
+  cv::Rect2d box;
+};
+
+// Whether the patrol's evidence grid has an occupied voxel on the line of sight from `eye` to the box (its
+// centre, stopping short of the box): then the frame shows what stands in front, not the change.
+bool Occluded(const EvidenceGridData& grid, const Eigen::Vector3d& eye, const Eigen::Vector3d& low,
+              const Eigen::Vector3d& high) {
+  if (grid.voxel_size <= 0.0 || grid.voxels.empty()) return false;
+  const Eigen::Vector3d centre = (low + high) / 2.0, ray = centre - eye;
+  const double stop = ray.norm() - (high - low).norm() / 2.0 - grid.voxel_size;
+  for (double t = grid.voxel_size; t < stop; t += grid.voxel_size) {
+    const Eigen::Vector3d p = (eye + ray.normalized() * t) / grid.voxel_size;
+    VoxelEvidence key;
+    key.x = static_cast<std::int32_t>(std::lround(p.x()));
+    key.y = static_cast<std::int32_t>(std::lround(p.y()));
+    key.z = static_cast<std::int32_t>(std::lround(p.z()));
+    const auto it = std::lower_bound(grid.voxels.begin(), grid.voxels.end(), key, VoxelBefore);
+    if (it == grid.voxels.end() || VoxelBefore(key, *it)) continue;
+    if (it->hits >= 2 && 2 * it->hits >= it->passes) return true;  // occupancy at least a third
   }
-  return object;
+  return false;
 }
 
-json GeometryJson(const GeometryChange& g) {
-  json regions = json::array();
-  for (const GeometryRegion& r : g.regions) {
-    regions.push_back({{"centroid", Vector(r.centroid)},
-                       {"box_min", Vector(r.box_min)},
-                       {"box_max", Vector(r.box_max)},
-                       {"voxels", r.voxels},
-                       {"appeared", r.appeared},
-                       {"vanished", r.vanished},
-                       {"score", r.score}});
+// Times a patrol's frames may show a change from: without an evidence grid to see what stands in front of
+// a box, an object's own patrol shows it from the time it detected it.
+struct TimeWindow {
+  TimestampNs first = std::numeric_limits<TimestampNs>::min(), last = std::numeric_limits<TimestampNs>::max();
+};
+
+// The kept frame that shows the box best, unoccluded (or in `window`, without a grid): most of its projection inside the image, then the
+// larger projection up to a quarter of the image (a close view, not one that fills the frame).
+std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Vector3d& low, const Eigen::Vector3d& high,
+                                     const TimeWindow& window, const ReportOptions& options) {
+  if (!record.camera.valid()) return std::nullopt;
+  const std::array<Eigen::Vector3d, 8> corners = Corners(low, high);
+  const Eigen::Vector3d centre = (low + high) / 2.0;
+  const cv::Rect2d image(0, 0, record.camera.width, record.camera.height);
+  const bool without_grid = record.grid.voxels.empty();
+  std::optional<Sighting> best;
+  double best_score = 0.0;
+  for (const RouteFrame& frame : record.route) {
+    if (without_grid && (frame.timestamp_ns < window.first || frame.timestamp_ns > window.last)) continue;
+    if (!frame.pose || (frame.pose->position - centre).norm() > options.max_view_range_m) continue;
+    const cv::Rect2d box = ProjectCorners(record.camera, *frame.pose, corners);
+    if (box.area() <= 0.0) continue;
+    const double inside = (box & image).area() / box.area();
+    const double score = inside * inside * std::min(box.area() / image.area(), 0.25);
+    if (inside < 0.5 || score <= best_score || Occluded(record.grid, frame.pose->position, low, high)) continue;
+    best_score = score;
+    best = Sighting{&frame, box};
   }
-  return {{"voxel_size", g.voxel_size},
-          {"compared_voxels", g.compared_voxels},
-          {"evicted_voxels", {{"prior", g.evicted_prior}, {"current", g.evicted_current}}},
-          {"depth_source", {{"prior", g.depth_prior}, {"current", g.depth_current}}},
-          {"changed_voxels", g.changed_voxels.size()},
-          {"regions", regions}};
+  return best;
 }
 
-const char* DepthWords(const std::string& source) {
-  if (source == "images") return "depth images";
-  if (source == "stereo") return "stereo matching";
-  return "unrecorded";
+cv::Mat Decode(const RouteFrame& frame) {
+  if (frame.jpeg.empty()) return cv::Mat();
+  return cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
 }
 
-// The key frame with regions outlined, twice its size.
-cv::Mat Outlined(const cv::Mat& thumbnail, const std::vector<cv::Rect>& boxes) {
-  cv::Mat colour;
-  if (thumbnail.empty()) return colour;
-  cv::cvtColor(thumbnail, colour, cv::COLOR_GRAY2BGR);
-  cv::resize(colour, colour, cv::Size(), 2.0, 2.0, cv::INTER_NEAREST);
-  for (const cv::Rect& box : boxes) {
-    cv::rectangle(colour, cv::Rect(box.x * 2, box.y * 2, box.width * 2, box.height * 2), cv::Scalar(0, 0, 255), 2);
-  }
-  return colour;
+// The longer side scaled to `size` pixels.
+cv::Mat Fit(const cv::Mat& image, int size, double* scale) {
+  *scale = static_cast<double>(size) / std::max(image.cols, image.rows);
+  cv::Mat out;
+  cv::resize(image, out, cv::Size(), *scale, *scale, *scale < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  return out;
 }
 
-const char* StateColour(ObjectState state) {
-  switch (state) {
-    case ObjectState::kPersistent: return "#1f77b4";
-    case ObjectState::kNew: return "#2ca02c";
-    case ObjectState::kRemoved: return "#d62728";
-    case ObjectState::kMoved: return "#ff7f0e";
-    case ObjectState::kUnobserved: return "#999999";
-  }
-  return "#000";
+// The sighting's frame cropped around the box (with a margin), the box outlined.
+ChangeView CropView(const std::string& flight, const PatrolRecord& record, const Sighting& sighting,
+                    const ReportOptions& options) {
+  ChangeView view{flight, sighting.frame->timestamp_ns, sighting.frame->frame_index, cv::Mat()};
+  const cv::Mat frame = Decode(*sighting.frame);
+  if (frame.empty()) return view;
+  const double to_frame = static_cast<double>(frame.cols) / record.camera.width;
+  const cv::Rect2d box(sighting.box.x * to_frame, sighting.box.y * to_frame, sighting.box.width * to_frame,
+                       sighting.box.height * to_frame);
+  const double margin = options.crop_margin * std::max({box.width, box.height, 16.0});
+  const cv::Rect crop = cv::Rect(cv::Point(cvFloor(box.x - margin), cvFloor(box.y - margin)),
+                                 cv::Point(cvCeil(box.br().x + margin), cvCeil(box.br().y + margin))) &
+                        cv::Rect(0, 0, frame.cols, frame.rows);
+  if (crop.area() <= 0) return view;
+  double scale = 1.0;
+  cv::Mat grey = Fit(frame(crop), options.crop_size_px, &scale);
+  cv::cvtColor(grey, view.image, cv::COLOR_GRAY2BGR);
+  const cv::Rect2d outline((box.x - crop.x) * scale, (box.y - crop.y) * scale, box.width * scale, box.height * scale);
+  cv::rectangle(view.image, outline, kOutline, 2);
+  return view;
 }
 
-std::string Number(double value, int decimals = 2) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  return buffer;
+// What `flight` saw of the box: its best kept frame, or no picture.
+ChangeView ViewOfBox(const graph::TopoMap& map, const std::string& flight, const Eigen::Vector3d& low,
+                     const Eigen::Vector3d& high, const TimeWindow& window, const ReportOptions& options) {
+  const PatrolRecord* record = map.Patrol(flight);
+  if (record == nullptr) return ChangeView{flight, 0, -1, cv::Mat()};
+  std::optional<Sighting> sighting = BestSighting(*record, low, high, window, options);
+  if (!sighting) sighting = BestSighting(*record, low, high, TimeWindow(), options);
+  if (!sighting) return ChangeView{flight, 0, -1, cv::Mat()};
+  return CropView(flight, *record, *sighting, options);
 }
 
-// A plan (x right, y up) of the current flight's path, the objects and the geometry regions.
-std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map) {
-  std::vector<Eigen::Vector2d> points;
-  const PatrolRecord* current = map.Patrol(report.current_flight);
-  if (current != nullptr) {
-    for (const CameraPoseSample& v : current->views) points.push_back(v.position.head<2>());
+const MapObject* FindObject(const PatrolRecord* record, int id) {
+  if (record == nullptr) return nullptr;
+  const auto it =
+      std::find_if(record->objects.begin(), record->objects.end(), [id](const MapObject& o) { return o.id == id; });
+  return it == record->objects.end() ? nullptr : &*it;
+}
+
+// The node's key frame with the regions outlined: the kept frame of the same frame index, else the thumbnail.
+ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<cv::Rect>& boxes,
+                        const ReportOptions& options) {
+  const graph::NodeData& n = map.node(node);
+  ChangeView view{n.flight, n.timestamp_ns, n.frame_index, cv::Mat()};
+  cv::Mat grey;
+  const PatrolRecord* record = map.Patrol(n.flight);
+  if (record != nullptr) {
+    const auto kept = std::find_if(record->route.begin(), record->route.end(),
+                                   [&n](const RouteFrame& f) { return f.frame_index == n.frame_index; });
+    if (kept != record->route.end()) grey = Decode(*kept);
   }
-  for (const ObjectChange& o : report.objects) {
-    if (o.before) points.push_back(o.before->head<2>());
-    if (o.after) points.push_back(o.after->head<2>());
+  if (grey.empty()) grey = n.thumbnail;
+  if (grey.empty() || n.thumbnail.empty()) return view;
+  double scale = 1.0;
+  grey = Fit(grey, std::max(options.crop_size_px, std::min(2 * grey.cols, 2 * options.crop_size_px)), &scale);
+  cv::cvtColor(grey, view.image, cv::COLOR_GRAY2BGR);
+  const double to_image = static_cast<double>(view.image.cols) / n.thumbnail.cols;
+  for (const cv::Rect& b : boxes) {
+    cv::rectangle(view.image, cv::Rect2d(b.x * to_image, b.y * to_image, b.width * to_image, b.height * to_image),
+                  kOutline, 2);
   }
-  for (const GeometryRegion& r : report.geometry.regions) points.push_back(r.centroid.head<2>());
-  if (points.empty()) return "";
-  Eigen::Vector2d lo = points[0], hi = points[0];
-  for (const Eigen::Vector2d& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  lo -= Eigen::Vector2d(3, 3), hi += Eigen::Vector2d(3, 3);
-  const double scale = 800.0 / std::max(hi.x() - lo.x(), hi.y() - lo.y());
-  const auto x = [&](double v) { return Number((v - lo.x()) * scale, 1); };
-  const auto y = [&](double v) { return Number((hi.y() - v) * scale, 1); };
-  std::ostringstream svg;
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << Number((hi.x() - lo.x()) * scale, 0) << "' height='"
-      << Number((hi.y() - lo.y()) * scale, 0) << "' style='background:#fafafa;border:1px solid #ccc'>\n";
-  if (current != nullptr && !current->views.empty()) {
-    svg << "<polyline fill='none' stroke='#bbb' stroke-width='2' points='";
-    for (const CameraPoseSample& v : current->views) svg << x(v.position.x()) << "," << y(v.position.y()) << " ";
-    svg << "'/>\n";
+  return view;
+}
+
+// The camera position of the view of `flight` nearest in time to `timestamp_ns` (within a second).
+std::optional<Eigen::Vector3d> CameraAt(const graph::TopoMap& map, const std::string& flight, TimestampNs timestamp_ns) {
+  const PatrolRecord* record = map.Patrol(flight);
+  if (record == nullptr || record->views.empty()) return std::nullopt;
+  const auto nearest = std::min_element(record->views.begin(), record->views.end(),
+                                        [timestamp_ns](const CameraPoseSample& a, const CameraPoseSample& b) {
+                                          return std::llabs(a.timestamp_ns - timestamp_ns) <
+                                                 std::llabs(b.timestamp_ns - timestamp_ns);
+                                        });
+  if (std::llabs(nearest->timestamp_ns - timestamp_ns) > SecondsToNs(1.0)) return std::nullopt;
+  return nearest->position;
+}
+
+bool Reported(ObjectState state) {
+  return state == ObjectState::kNew || state == ObjectState::kRemoved || state == ObjectState::kMoved;
+}
+
+ChangeItem ObjectItem(const ChangeReport& report, const graph::TopoMap& map, const ObjectChange& o,
+                      const ReportOptions& options) {
+  ChangeItem item;
+  item.id = ObjectChangeId(o);
+  item.kind = "object";
+  item.state = ToString(o.state);
+  item.label = o.label;
+  item.confidence = o.confidence;
+  item.position = o.after ? o.after : o.before;
+  if (o.state == ObjectState::kMoved) item.from = o.before;
+  const MapObject* prior = FindObject(map.Patrol(report.prior_flight), o.prior_id);
+  const MapObject* current = FindObject(map.Patrol(report.current_flight), o.current_id);
+  // New: where it is now, then and now; removed: where it was; moved: each where it was seen. A patrol
+  // that detected the object shows it from a frame of the time it did.
+  const MapObject* then = prior != nullptr ? prior : current;
+  const MapObject* now = current != nullptr ? current : prior;
+  const auto seen = [](const MapObject* o) { return TimeWindow{o->first_seen_ns, o->last_seen_ns}; };
+  if (then != nullptr) {
+    item.before = ViewOfBox(map, report.prior_flight, then->box_min, then->box_max,
+                            prior != nullptr ? seen(prior) : TimeWindow(), options);
   }
-  for (const GeometryRegion& r : report.geometry.regions) {
-    svg << "<rect x='" << x(r.box_min.x()) << "' y='" << y(r.box_max.y()) << "' width='"
-        << Number((r.box_max.x() - r.box_min.x()) * scale + 2, 1) << "' height='"
-        << Number((r.box_max.y() - r.box_min.y()) * scale + 2, 1)
-        << "' fill='none' stroke='#9467bd' stroke-dasharray='4 2'><title>geometry: " << r.voxels
-        << " voxels</title></rect>\n";
+  if (now != nullptr) {
+    item.after = ViewOfBox(map, report.current_flight, now->box_min, now->box_max,
+                           current != nullptr ? seen(current) : TimeWindow(), options);
   }
-  for (const ObjectChange& o : report.objects) {
-    const Eigen::Vector3d& at = o.after ? *o.after : *o.before;
-    if (o.state == ObjectState::kMoved) {
-      svg << "<line x1='" << x(o.before->x()) << "' y1='" << y(o.before->y()) << "' x2='" << x(at.x()) << "' y2='"
-          << y(at.y()) << "' stroke='" << StateColour(o.state) << "' stroke-width='2'/>\n";
-    }
-    svg << "<circle cx='" << x(at.x()) << "' cy='" << y(at.y()) << "' r='6' fill='" << StateColour(o.state)
-        << "'><title>" << ToString(o.state) << " " << graph::EscapeXml(o.label) << " " << Number(o.confidence)
-        << "</title></circle>\n";
+  return item;
+}
+
+ChangeItem GeometryItem(const ChangeReport& report, const graph::TopoMap& map, const GeometryRegion& r,
+                        const ReportOptions& options) {
+  ChangeItem item;
+  item.id = GeometryChangeId(r.centroid);
+  item.kind = "geometry";
+  item.state = r.appeared >= r.vanished ? "appeared" : "vanished";
+  item.label = std::to_string(r.voxels) + " voxels";
+  item.confidence = std::clamp(r.score, 0.0, 1.0);
+  item.position = r.centroid;
+  const Eigen::Vector3d half = Eigen::Vector3d::Constant(report.geometry.voxel_size / 2.0);
+  item.before = ViewOfBox(map, report.prior_flight, r.box_min - half, r.box_max + half, TimeWindow(), options);
+  item.after = ViewOfBox(map, report.current_flight, r.box_min - half, r.box_max + half, TimeWindow(), options);
+  return item;
+}
+
+ChangeItem AppearanceItem(const graph::TopoMap& map, const PlaceChange& place, const ReportOptions& options) {
+  ChangeItem item;
+  item.id = AppearanceChangeId(place.prior_node, place.current_node);
+  item.kind = "appearance";
+  item.state = "changed";
+  const std::size_t regions = place.appearance.regions.size();
+  item.label = std::to_string(regions) + (regions == 1 ? " region" : " regions");
+  item.confidence = std::clamp(place.appearance.regions[0].score, 0.0, 1.0);
+  const graph::NodeData& node = map.node(place.current_node);
+  item.position = CameraAt(map, node.flight, node.timestamp_ns);
+  std::vector<cv::Rect> prior_boxes, current_boxes;
+  for (const AppearanceRegion& r : place.appearance.regions) {
+    prior_boxes.push_back(r.prior_box);
+    current_boxes.push_back(r.current_box);
   }
-  svg << "</svg>\n";
-  return svg.str();
+  item.before = KeyFrameView(map, place.prior_node, prior_boxes, options);
+  item.after = KeyFrameView(map, place.current_node, current_boxes, options);
+  return item;
+}
+
+Status WriteView(const ChangeView& view, const std::string& path) {
+  std::vector<unsigned char> jpeg;
+  if (!cv::imencode(".jpg", view.image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85}))
+    return Status::IoError(path + ": cannot encode the picture");
+  return WriteFileAtomically(path, std::string(jpeg.begin(), jpeg.end()));
 }
 
 }  // namespace
@@ -177,108 +258,57 @@ int ChangeReport::ObjectsIn(ObjectState state) const {
       std::count_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; }));
 }
 
-std::string ToJson(const ChangeReport& report, const graph::TopoMap& map) {
-  json places = json::array(), objects = json::array(), counts = json::object();
-  for (const PlaceChange& place : report.places) places.push_back(PlaceJson(place, map));
-  for (const ObjectChange& o : report.objects) objects.push_back(ObjectJson(o));
-  for (ObjectState s : {ObjectState::kPersistent, ObjectState::kNew, ObjectState::kRemoved, ObjectState::kMoved,
-                        ObjectState::kUnobserved}) {
-    counts[ToString(s)] = report.ObjectsIn(s);
-  }
-  const json document = {
-      {"format", "patrolmap.changes"},
-      {"version", 1},
-      {"prior_flight", report.prior_flight},
-      {"current_flight", report.current_flight},
-      {"summary",
-       {{"places_compared", report.places.size()},
-        {"places_changed", report.ChangedPlaces()},
-        {"objects", report.objects_compared ? counts : json(nullptr)},
-        {"geometry_regions", report.geometry_compared ? json(report.geometry.regions.size()) : json(nullptr)}}},
-      {"timing_s",
-       {{"appearance", report.seconds_appearance},
-        {"objects", report.seconds_objects},
-        {"geometry", report.seconds_geometry}}},
-      {"places", places},
-      {"objects", report.objects_compared ? objects : json(nullptr)},
-      {"geometry", report.geometry_compared ? GeometryJson(report.geometry) : json(nullptr)}};
-  return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+std::string ObjectChangeId(const ObjectChange& change) {
+  return "object-p" + std::to_string(change.prior_id) + "-c" + std::to_string(change.current_id);
 }
 
-std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map) {
-  std::ostringstream html;
-  const std::string title =
-      "Changes from " + graph::EscapeXml(report.prior_flight) + " to " + graph::EscapeXml(report.current_flight);
-  html << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" << title
-       << "</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-          "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}img{margin:4px;border:1px solid #888}"
-          ".place{display:inline-block;margin:0 2em 2em 0;vertical-align:top}</style></head>\n<body>\n<h1>"
-       << title << "</h1>\n<p>" << report.places.size() << " places seen by both patrols, " << report.ChangedPlaces()
-       << " with appearance changes.";
-  if (report.objects_compared) {
-    html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)
-         << " removed, " << report.ObjectsIn(ObjectState::kMoved) << " moved, "
-         << report.ObjectsIn(ObjectState::kPersistent) << " persistent, " << report.ObjectsIn(ObjectState::kUnobserved)
-         << " unobserved.";
+std::string GeometryChangeId(const Eigen::Vector3d& centroid) {
+  const Eigen::Vector3d cell = (centroid / kRegionCellM).array().floor();
+  return "geometry-" + std::to_string(static_cast<long long>(cell.x())) + "_" +
+         std::to_string(static_cast<long long>(cell.y())) + "_" + std::to_string(static_cast<long long>(cell.z()));
+}
+
+std::string AppearanceChangeId(int prior_node, int current_node) {
+  return "appearance-" + std::to_string(prior_node) + "-" + std::to_string(current_node);
+}
+
+std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::TopoMap& map,
+                                    const ReportOptions& options) {
+  std::vector<ChangeItem> items;
+  for (const ObjectChange& o : report.objects) {
+    if (Reported(o.state)) items.push_back(ObjectItem(report, map, o, options));
   }
-  if (report.geometry_compared) {
-    html << " Geometry: " << report.geometry.regions.size() << " changed regions (depth: "
-         << DepthWords(report.geometry.depth_prior) << " in the prior patrol, "
-         << DepthWords(report.geometry.depth_current) << " in this one).";
-  }
-  if (report.geometry_compared && (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0)) {
-    html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped their least "
-            "recently observed voxels: "
-         << report.geometry.evicted_prior << " of the prior patrol, " << report.geometry.evicted_current
-         << " of this one; no geometry change can be found where they were.";
-  }
-  html << "</p>\n";
-  if (report.objects_compared || report.geometry_compared) {
-    html << "<h2>Plan</h2>\n<p>Grey: the current flight; dots: objects (blue persistent, green new, red removed, "
-            "orange moved with its path, grey unobserved); dashed purple: changed geometry.</p>\n"
-         << PlanSvg(report, map);
-  }
-  html << "<h2>Places with appearance changes</h2>\n";
-  if (report.ChangedPlaces() == 0) {
-    html << "<p>None of the " << report.places.size() << " places both patrols saw changed in appearance.</p>\n";
-  }
+  for (const GeometryRegion& r : report.geometry.regions) items.push_back(GeometryItem(report, map, r, options));
   for (const PlaceChange& place : report.places) {
-    if (place.appearance.regions.empty()) continue;
-    std::vector<cv::Rect> prior_boxes, current_boxes;
-    for (const AppearanceRegion& r : place.appearance.regions) {
-      prior_boxes.push_back(r.prior_box);
-      current_boxes.push_back(r.current_box);
-    }
-    html << "<div class='place'><p>node " << place.prior_node << " (frame " << map.node(place.prior_node).frame_index
-         << ") &rarr; node " << place.current_node << " (frame " << map.node(place.current_node).frame_index << "), "
-         << place.appearance.regions.size() << " region(s), best score " << Number(place.appearance.regions[0].score)
-         << "</p><img alt='prior' src='"
-         << graph::PngDataUri(Outlined(map.node(place.prior_node).thumbnail, prior_boxes))
-         << "'><img alt='current' src='"
-         << graph::PngDataUri(Outlined(map.node(place.current_node).thumbnail, current_boxes)) << "'></div>\n";
+    if (!place.appearance.regions.empty()) items.push_back(AppearanceItem(map, place, options));
   }
-  if (report.objects_compared) {
-    html << "<h2>Objects</h2>\n<table><tr><th>state</th><th>label</th><th>confidence</th><th>before [m]</th>"
-            "<th>after [m]</th><th>covering views</th><th>expected detections</th></tr>\n";
-    const auto position = [](const std::optional<Eigen::Vector3d>& p) {
-      return p ? Number(p->x()) + ", " + Number(p->y()) + ", " + Number(p->z()) : std::string("&ndash;");
-    };
-    for (const ObjectChange& o : report.objects) {
-      html << "<tr><td style='color:" << StateColour(o.state) << "'>" << ToString(o.state) << "</td><td>"
-           << graph::EscapeXml(o.label) << "</td><td>" << Number(o.confidence) << "</td><td>" << position(o.before)
-           << "</td><td>" << position(o.after) << "</td><td>" << o.covering_views << "</td><td>"
-           << Number(o.expected_detections) << "</td></tr>\n";
-    }
-    html << "</table>\n";
-  }
-  html << "</body></html>\n";
-  return html.str();
+  for (std::size_t i = 0; i < items.size(); ++i) items[i].number = static_cast<int>(i) + 1;
+  return items;
+}
+
+std::string ViewFileName(const ChangeItem& item, bool before) {
+  return item.id + (before ? "-before.jpg" : "-after.jpg");
 }
 
 Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, const std::string& folder) {
+  constexpr char kImages[] = "changes_images";
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.json", ToJson(report, map)));
-  return WriteFileAtomically(folder + "/changes.html", ToHtml(report, map));
+  const std::vector<ChangeItem> items = ReportItems(report, map);
+  if (!items.empty()) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/" + kImages));
+  for (const ChangeItem& item : items) {
+    for (const bool before : {true, false}) {
+      const ChangeView& view = before ? item.before : item.after;
+      if (view.image.empty()) continue;
+      PATROLMAP_RETURN_IF_ERROR(WriteView(view, folder + "/" + kImages + "/" + ViewFileName(item, before)));
+    }
+  }
+  const PatrolRecord* current = map.Patrol(report.current_flight);
+  const std::optional<GeoReference> geo = current != nullptr ? FitGeoReference(*current) : std::nullopt;
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.json", ToJson(report, map, items, geo, kImages)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.html", ToHtml(report, map, items, geo, kImages)));
+  if (!geo) return Status::Ok();
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.geojson", ToGeoJson(report, map, items, *geo)));
+  return WriteFileAtomically(folder + "/changes.kml", ToKml(report, map, items, *geo, kImages));
 }
 
 }  // namespace patrolmap::change

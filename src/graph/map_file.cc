@@ -15,8 +15,10 @@ namespace patrolmap::graph {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
-// 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped
-constexpr std::uint32_t kVersion = 5;
+// 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
+// 5: the patrol's depth source; 6: the frames kept along the route
+constexpr std::uint32_t kVersion = 6;
+constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr std::uint32_t kOldestVersion = 1;
 constexpr int kDescriptorWidth = 128;  // SIFT
 
@@ -229,6 +231,32 @@ void WriteObject(const MapObject& o, Writer* w) {
   w->Value(o.last_seen_ns);
 }
 
+PoseRecord ToRecord(const CameraPoseSample& v) {
+  return {v.timestamp_ns,
+          {v.position.x(), v.position.y(), v.position.z()},
+          {v.rotation.w(), v.rotation.x(), v.rotation.y(), v.rotation.z()}};
+}
+
+CameraPoseSample FromRecord(const PoseRecord& v) {
+  return {v.timestamp_ns, Eigen::Vector3d(v.position[0], v.position[1], v.position[2]),
+          Eigen::Quaterniond(v.rotation[0], v.rotation[1], v.rotation[2], v.rotation[3])};
+}
+
+// Per frame: time, frame index, flags (1: pose, 2: GPS), the pose, latitude and longitude, the JPEG bytes.
+void WriteRoute(const std::vector<RouteFrame>& route, Writer* w) {
+  w->Value(static_cast<std::uint32_t>(route.size()));
+  for (const RouteFrame& f : route) {
+    w->Value(f.timestamp_ns);
+    w->Value(f.frame_index);
+    w->Value<std::uint8_t>((f.pose ? 1 : 0) | (f.gps ? 2 : 0));
+    w->Value(ToRecord(f.pose.value_or(CameraPoseSample())));
+    const Eigen::Vector2d gps = f.gps.value_or(Eigen::Vector2d::Zero());
+    w->Value(gps.x());
+    w->Value(gps.y());
+    w->Vector(f.jpeg);
+  }
+}
+
 void PatrolSection(const TopoMap& map, Writer* out) {
   Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.patrols().size()));
@@ -239,11 +267,7 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     w.Value<std::int32_t>(p.camera.height);
     w.Value<std::int32_t>(p.feature_image_width);
     std::vector<PoseRecord> views;
-    for (const CameraPoseSample& v : p.views) {
-      views.push_back({v.timestamp_ns,
-                       {v.position.x(), v.position.y(), v.position.z()},
-                       {v.rotation.w(), v.rotation.x(), v.rotation.y(), v.rotation.z()}});
-    }
+    for (const CameraPoseSample& v : p.views) views.push_back(ToRecord(v));
     w.Vector(views);
     w.Value<std::uint8_t>(p.has_objects ? 1 : 0);
     w.Value(static_cast<std::uint32_t>(p.objects.size()));
@@ -252,6 +276,7 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     w.Vector(p.grid.voxels);
     w.Value<std::int64_t>(p.grid.evicted_voxels);
     w.String(p.depth_source);
+    WriteRoute(p.route, &w);
   }
 }
 
@@ -401,6 +426,11 @@ bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
 
 // A patrol's camera as the pipeline records it (valid, or all zero for a log without one), and views
 // with valid times, finite positions and rotations of about unit norm.
+bool ValidPose(const CameraPoseSample& v) {
+  const double norm = v.rotation.coeffs().norm();
+  return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
+}
+
 bool ValidCameraAndViews(const PatrolRecord& p) {
   const CameraIntrinsics& c = p.camera;
   constexpr int kMaxImageSide = 100000;
@@ -408,10 +438,7 @@ bool ValidCameraAndViews(const PatrolRecord& p) {
   const bool camera_ok = unknown || (Finite({c.fx, c.fy, c.cx, c.cy}) && c.valid() && c.width <= kMaxImageSide &&
                                      c.height <= kMaxImageSide);
   if (!camera_ok || p.feature_image_width < 0 || p.feature_image_width > kMaxImageSide) return false;
-  return std::all_of(p.views.begin(), p.views.end(), [](const CameraPoseSample& v) {
-    const double norm = v.rotation.coeffs().norm();
-    return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
-  });
+  return std::all_of(p.views.begin(), p.views.end(), ValidPose);
 }
 
 bool ValidObject(const MapObject& o) {
@@ -434,6 +461,40 @@ bool ValidVoxelSize(const EvidenceGridData& grid) {
   return grid.voxels.empty() || (grid.voxel_size >= kMinVoxelM && grid.voxel_size <= kMaxVoxelM);
 }
 
+std::vector<RouteFrame> ReadRoute(Reader* r) {
+  std::vector<RouteFrame> route;
+  const std::uint32_t count = r->Value<std::uint32_t>();
+  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
+    RouteFrame f;
+    f.timestamp_ns = r->Value<TimestampNs>();
+    f.frame_index = r->Value<std::int64_t>();
+    const auto flags = r->Value<std::uint8_t>();
+    const PoseRecord pose = r->Value<PoseRecord>();
+    const double latitude = r->Value<double>(), longitude = r->Value<double>();
+    if (flags > 3) f.frame_index = -1;  // not a flag this version writes: ValidRoute refuses the frame
+    if ((flags & 1) != 0) f.pose = FromRecord(pose);
+    if ((flags & 2) != 0) f.gps = Eigen::Vector2d(latitude, longitude);
+    f.jpeg = r->Vector<unsigned char>();
+    route.push_back(std::move(f));
+  }
+  return route;
+}
+
+// Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and
+// JPEG bytes (they start with the JPEG start-of-image marker).
+bool ValidRoute(const std::vector<RouteFrame>& route) {
+  for (std::size_t i = 0; i < route.size(); ++i) {
+    const RouteFrame& f = route[i];
+    if (!ValidTimestamp(f.timestamp_ns) || f.frame_index < 0) return false;
+    if (i > 0 && f.timestamp_ns < route[i - 1].timestamp_ns) return false;
+    if (f.pose && !ValidPose(*f.pose)) return false;
+    if (f.gps && !(std::abs(f.gps->x()) <= 90.0 && std::abs(f.gps->y()) <= 180.0)) return false;
+    if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8)
+      return false;
+  }
+  return true;
+}
+
 Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
@@ -443,10 +504,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     p.camera.cx = r->Value<double>(), p.camera.cy = r->Value<double>();
     p.camera.width = r->Value<std::int32_t>(), p.camera.height = r->Value<std::int32_t>();
     p.feature_image_width = r->Value<std::int32_t>();
-    for (const PoseRecord& v : r->Vector<PoseRecord>()) {
-      p.views.push_back({v.timestamp_ns, Eigen::Vector3d(v.position[0], v.position[1], v.position[2]),
-                         Eigen::Quaterniond(v.rotation[0], v.rotation[1], v.rotation[2], v.rotation[3])});
-    }
+    for (const PoseRecord& v : r->Vector<PoseRecord>()) p.views.push_back(FromRecord(v));
     p.has_objects = r->Value<std::uint8_t>() != 0;
     const std::uint32_t objects = r->Value<std::uint32_t>();
     for (std::uint32_t k = 0; k < objects && !r->failed(); ++k) p.objects.push_back(ReadObject(r));
@@ -454,6 +512,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     p.grid.voxels = r->Vector<VoxelEvidence>();
     if (version >= 4) p.grid.evicted_voxels = r->Value<std::int64_t>();
     if (version >= 5) p.depth_source = r->String();
+    if (version >= 6) p.route = ReadRoute(r);
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
@@ -464,6 +523,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
         (p.depth_source != "" && p.depth_source != "images" && p.depth_source != "stereo")) {
       return Corrupt(path, "evidence grid of " + p.flight);
     }
+    if (!ValidRoute(p.route)) return Corrupt(path, "route frames of " + p.flight);
     map->SetPatrol(std::move(p));
   }
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();

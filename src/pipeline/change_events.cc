@@ -30,22 +30,6 @@ namespace {
 
 using Event = ChangeMonitor::Event;
 
-constexpr double kRegionCellM = 2.0;  // geometry events: one per region centroid in a cell this wide
-
-std::string GeometryId(const Eigen::Vector3d& centroid) {
-  const Eigen::Vector3d cell = (centroid / kRegionCellM).array().floor();
-  return "geometry-" + std::to_string(static_cast<long long>(cell.x())) + "_" +
-         std::to_string(static_cast<long long>(cell.y())) + "_" + std::to_string(static_cast<long long>(cell.z()));
-}
-
-std::string ObjectId(const change::ObjectChange& change) {
-  return "object-p" + std::to_string(change.prior_id) + "-c" + std::to_string(change.current_id);
-}
-
-std::string AppearanceId(int prior_node, int node) {
-  return "appearance-" + std::to_string(prior_node) + "-" + std::to_string(node);
-}
-
 json Position(const Eigen::Vector3d& p) { return json::array({p.x(), p.y(), p.z()}); }
 
 bool Reported(change::ObjectState state) {
@@ -63,7 +47,7 @@ change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::KeyPoint> 
 
 Event ObjectEvent(const change::ObjectChange& change, TimestampNs timestamp_ns) {
   Event event;
-  event.id = ObjectId(change);
+  event.id = change::ObjectChangeId(change);
   event.type = std::string("object_") + change::ToString(change.state);
   event.timestamp_ns = timestamp_ns;
   event.position = change.after ? change.after : change.before;
@@ -74,7 +58,7 @@ Event ObjectEvent(const change::ObjectChange& change, TimestampNs timestamp_ns) 
 
 Event GeometryEvent(const change::GeometryRegion& region, TimestampNs timestamp_ns) {
   Event event;
-  event.id = GeometryId(region.centroid);
+  event.id = change::GeometryChangeId(region.centroid);
   event.type = "geometry";
   event.timestamp_ns = timestamp_ns;
   event.position = region.centroid;
@@ -86,7 +70,7 @@ Event GeometryEvent(const change::GeometryRegion& region, TimestampNs timestamp_
 Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns,
                       const std::optional<Eigen::Vector3d>& position, const change::AppearanceChange& appearance) {
   Event event;
-  event.id = AppearanceId(prior_node, node);
+  event.id = change::AppearanceChangeId(prior_node, node);
   event.type = "appearance";
   event.timestamp_ns = timestamp_ns;
   event.position = position;

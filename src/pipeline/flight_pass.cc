@@ -120,6 +120,9 @@ Status FlightPass::HandKeyLocation(const KeyLocation& key_location) {
 }
 
 Status FlightPass::HandSlot(const Slot& slot) {
+  work_.clear();
+  recorder_.CollectKeyFrame(slot.timestamp_ns, slot.frame_index, slot.image, slot.pose, slot.gps, &work_);
+  for (ChangeWork& work : work_) PATROLMAP_RETURN_IF_ERROR(change_queue_.Push(std::move(work)));
   KeyFrameInput input;
   input.key_frame.flight = info_.flight_id;
   input.key_frame.timed = info_.timed;

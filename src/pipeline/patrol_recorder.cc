@@ -16,6 +16,7 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
     : grid_step_ns_(SecondsToNs(1.0 / config.change.grid.rate_hz)),
       next_view_ns_(std::numeric_limits<TimestampNs>::min()),
+      route_(config.change.route_frames),
       mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
       next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
@@ -50,6 +51,16 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
 }
 
 void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) {
+  if (!frame.image.empty() && route_.Due(frame.timestamp_ns)) {
+    ChangeWork route;
+    route.kind = ChangeWork::Kind::kRoute;
+    route.timestamp_ns = frame.timestamp_ns;
+    route.frame_index = frame.index;
+    route.pose = frame.pose;
+    route.gps = frame.gps;
+    route_.Scale(frame.image, &route.image);
+    work->push_back(std::move(route));
+  }
   if (!active_) return;
   const TimestampNs step = SecondsToNs(1.0 / kViewRateHz);
   for (const CameraPoseSample& pose : frame.poses) {
@@ -93,6 +104,21 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
   if (work->size() > first) (*work)[first].views = std::move(pending_views_), pending_views_.clear();
 }
 
+void PatrolRecorder::CollectKeyFrame(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
+                                     const std::optional<CameraPoseSample>& pose,
+                                     const std::optional<Eigen::Vector3d>& gps, std::vector<ChangeWork>* work) {
+  if (image.empty()) return;
+  ChangeWork route;
+  route.kind = ChangeWork::Kind::kRoute;
+  route.timestamp_ns = timestamp_ns;
+  route.frame_index = frame_index;
+  route.pose = pose;
+  route.gps = gps;
+  route.key_frame = true;
+  route_.Scale(image, &route.image);
+  work->push_back(std::move(route));
+}
+
 void PatrolRecorder::CollectRest(std::vector<ChangeWork>* work) {
   if (pending_views_.empty()) return;
   ChangeWork views;
@@ -130,8 +156,18 @@ bool PatrolRecorder::ReadDepth(const ChangeWork& work, cv::Mat* depth) {
   return false;
 }
 
+void PatrolRecorder::AddRouteFrame(const ChangeWork& work) {
+  RouteFrame frame;
+  frame.timestamp_ns = work.timestamp_ns;
+  frame.frame_index = work.frame_index;
+  frame.pose = work.pose;
+  if (work.gps) frame.gps = work.gps->head<2>();
+  route_.Add(std::move(frame), work.image, work.key_frame);
+}
+
 void PatrolRecorder::Apply(const ChangeWork& work) {
   base_.views.insert(base_.views.end(), work.views.begin(), work.views.end());
+  if (work.kind == ChangeWork::Kind::kRoute) return AddRouteFrame(work);
   if (!work.pose) return;
   if (work.kind == ChangeWork::Kind::kObjects) {
     stats_.detections += static_cast<int>(work.detections.size());
@@ -175,6 +211,10 @@ void PatrolRecorder::Finish(PatrolRecord* record, PatrolRecordStats* stats) {
   stats_.forgotten_objects = mapper_.forgotten();
   stats_.dropped_voxel_updates = grid_.dropped_updates();
   stats_.evicted_voxels = grid_.evicted_voxels();
+  record->route = route_.Take();
+  stats_.route_frames = static_cast<int>(record->route.size());
+  stats_.route_thinnings = route_.thinnings();
+  stats_.dropped_route_frames = route_.dropped();
   *stats = stats_;
 }
 

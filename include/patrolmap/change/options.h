@@ -94,12 +94,24 @@ struct GeometryDiffOptions {
   double min_region_width_m = 0.4;     // ... and so are narrower ones (a lone column of voxels at an edge)
 };
 
+// Frames kept along the route in the patrol record (RouteFrame): the change report's before and after
+// pictures come from them. A frame every interval_s and every key frame, grey, JPEG. When the frames of a
+// patrol pass memory_mb, every other one is dropped and the interval doubles, so a long flight keeps its
+// whole route at a coarser spacing.
+struct RouteFrameOptions {
+  double interval_s = 1.0;  // flight time between kept frames [s]; 0: none kept
+  int max_width = 376;      // wider frames are scaled down to this [px]
+  int jpeg_quality = 80;    // 0-100
+  double memory_mb = 16.0;  // a patrol's frames at most [MB] (in memory and in the map file)
+};
+
 struct ChangeOptions {
   AppearanceOptions appearance;
   ObjectMapOptions object_map;
   ObjectDiffOptions objects;
   EvidenceGridOptions grid;
   GeometryDiffOptions geometry;
+  RouteFrameOptions route_frames;
   // False with a message naming the first invalid option.
   bool IsValid(std::string* error) const;
 };

@@ -85,6 +85,16 @@ void ForEachCommonVoxel(const EvidenceGridData& a, const EvidenceGridData& b, Vi
   }
 }
 
+// One frame kept along a patrol's route (change.route_frames), for the pictures of the change report and
+// the appearance comparison along the route: the grey frame as JPEG, at most max_width pixels wide.
+struct RouteFrame {
+  TimestampNs timestamp_ns = 0;
+  std::int64_t frame_index = 0;
+  std::optional<CameraPoseSample> pose;  // the camera pose at its time, when the log has poses
+  std::optional<Eigen::Vector2d> gps;    // latitude, longitude [deg], when the log has GPS
+  std::vector<unsigned char> jpeg;
+};
+
 // What a patrol (one flight of a map) keeps for change detection.
 struct PatrolRecord {
   std::string flight;
@@ -95,6 +105,7 @@ struct PatrolRecord {
   std::vector<MapObject> objects;
   EvidenceGridData grid;     // voxel_size 0 when the log had no depth
   std::string depth_source;  // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
+  std::vector<RouteFrame> route;  // in time order; key frames among them (map format 6 on)
 };
 
 }  // namespace patrolmap

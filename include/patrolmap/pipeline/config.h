@@ -126,6 +126,10 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
   visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
+  visitor->Field("change.route_frames.interval_s", &change.route_frames.interval_s);
+  visitor->Field("change.route_frames.max_width", &change.route_frames.max_width);
+  visitor->Field("change.route_frames.jpeg_quality", &change.route_frames.jpeg_quality);
+  visitor->Field("change.route_frames.memory_mb", &change.route_frames.memory_mb);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);

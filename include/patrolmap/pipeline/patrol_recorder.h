@@ -23,6 +23,7 @@
 #include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/pipeline/config.h"
+#include "patrolmap/pipeline/route_strip.h"
 
 namespace patrolmap::pipeline {
 
@@ -35,12 +36,15 @@ struct PatrolRecordStats {
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
   long long evicted_voxels = 0;  // the grid's least recently observed voxels, dropped at its memory budget
+  int route_frames = 0;          // frames kept along the route (change.route_frames)
+  int route_thinnings = 0;       // times the route strip reached its memory budget and halved
+  long long dropped_route_frames = 0;  // key frames not kept: key frames alone filled the budget
 };
 
-// One step of the change stage: the detections of a frame, or one depth image for the grid; either carries
-// the views sampled since the previous step (kViews: those alone, at the end).
+// One step of the change stage: the detections of a frame, one depth image for the grid, or a frame for the
+// route strip; each carries the views sampled since the previous step (kViews: those alone, at the end).
 struct ChangeWork {
-  enum class Kind { kObjects, kGrid, kViews };
+  enum class Kind { kObjects, kGrid, kViews, kRoute };
   Kind kind = Kind::kGrid;
   std::vector<CameraPoseSample> views;
   TimestampNs timestamp_ns = 0;
@@ -49,7 +53,10 @@ struct ChangeWork {
   std::string depth_path;                     // kGrid; kObjects: the frame's depth image, if any; stereo: left
   std::string right_path;                     // stereo: the right image of the pair
   cv::Mat depth_image, right_image;           // instead of the paths: the images a bag handed over (DepthSample)
-  cv::Mat image;                              // kObjects: the frame at the camera's size
+  cv::Mat image;                              // kObjects: the frame at the camera's size; kRoute: scaled
+  std::int64_t frame_index = 0;               // kRoute
+  std::optional<Eigen::Vector3d> gps;         // kRoute: latitude, longitude, altitude, when the log has GPS
+  bool key_frame = false;                     // kRoute: the frame is a node's key frame
 };
 
 class PatrolRecorder {
@@ -62,6 +69,10 @@ class PatrolRecorder {
 
   // Frame thread: appends the work `frame` brings (its detections; its depth images) and the views it adds.
   void Collect(const Frame& frame, std::vector<ChangeWork>* work);
+  // Frame thread: a node's key frame for the route strip (its image at any scale, its pose and GPS if any).
+  void CollectKeyFrame(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
+                       const std::optional<CameraPoseSample>& pose, const std::optional<Eigen::Vector3d>& gps,
+                       std::vector<ChangeWork>* work);
   // Frame thread, after the last frame: the views not yet handed on.
   void CollectRest(std::vector<ChangeWork>* work);
 
@@ -83,6 +94,7 @@ class PatrolRecorder {
   void ChooseDepth(const Config& config, const io::LogInfo& info);
   bool ReadDepth(const ChangeWork& work, cv::Mat* depth);
   bool ReadStereoDepth(const ChangeWork& work, cv::Mat* depth);
+  void AddRouteFrame(const ChangeWork& work);
 
   TimestampNs grid_step_ns_;  // change.grid.rate_hz
   bool active_ = false;
@@ -93,6 +105,7 @@ class PatrolRecorder {
   TimestampNs next_view_ns_;
   std::vector<CameraPoseSample> pending_views_;
   TimestampNs next_stereo_ns_;  // stereo pairs come with every frame: only those at the grid's rate are work
+  RouteStrip route_;            // Due() and Scale() on the frame thread, the rest on the change thread
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
   cv::Mat left_, right_;

@@ -1,0 +1,210 @@
+// changes.html: one page for the inspector. A plan of both flights with every change as a numbered marker,
+// beside a table of the changes with their before and after pictures (a click on a marker selects its row and
+// a click on a row its marker), then every object with the reason for its state. Pictures are files in the
+// images folder, loaded lazily, or embedded when there is none. No network at view time. When the page has
+// initialised, <body> carries data-ready="N markers".
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "patrolmap/graph/export.h"
+#include "report_plan.h"
+
+namespace patrolmap::change {
+namespace {
+
+std::string Number(double value, int decimals = 2) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+// "1 place", "3 places".
+std::string Count(long long n, const char* one, const char* many) { return std::to_string(n) + " " + (n == 1 ? one : many); }
+
+constexpr char kStyle[] = R"(
+body{font-family:system-ui,sans-serif;margin:0;color:#1f2933;background:#fff}
+header{padding:12px 20px;border-bottom:1px solid #e4e7eb}h1{font-size:20px;margin:0 0 4px}
+.summary{margin:0;color:#52606d}
+main{display:grid;grid-template-columns:minmax(360px,42%) 1fr;gap:16px;padding:12px 20px}
+#plan svg{width:100%;height:auto;border:1px solid #d9dee4;display:block}
+.legend{font-size:12px;color:#52606d;margin:6px 0}.legend span{margin-right:12px;white-space:nowrap}
+.swatch{display:inline-block;width:12px;height:12px;border-radius:6px;vertical-align:-2px;margin-right:4px}
+table{border-collapse:collapse;width:100%;font-size:13px}th,td{border-bottom:1px solid #e4e7eb;padding:6px;
+text-align:left;vertical-align:top}th{background:#f5f7fa;position:sticky;top:0}
+#changes tr{cursor:pointer}#changes tr.selected{background:#fff7d6}
+.badge{display:inline-block;min-width:22px;height:22px;border-radius:11px;color:#fff;text-align:center;
+font-weight:bold;line-height:22px}
+.id{font-family:monospace;font-size:11px;color:#7b8794}
+figure{margin:0}figure img{display:block;border:1px solid #cbd2d9;max-width:240px;height:auto;background:#eee}
+figcaption{font-size:11px;color:#52606d}.none{color:#9aa5b1;font-size:12px}
+.marker{cursor:pointer}.marker.selected circle{stroke:#111;stroke-width:3}
+section.more{padding:0 20px 20px}
+)";
+
+constexpr char kScript[] = R"(
+const rows = new Map();
+document.querySelectorAll('#changes tr[data-id]').forEach(r => rows.set(r.dataset.id, r));
+const markers = new Map();
+document.querySelectorAll('#plan .marker').forEach(m => markers.set(m.dataset.id, m));
+function select(id, from) {
+  document.querySelectorAll('.selected').forEach(e => e.classList.remove('selected'));
+  const row = rows.get(id), marker = markers.get(id);
+  if (row) { row.classList.add('selected'); if (from === 'plan') row.scrollIntoView({block: 'center'}); }
+  if (marker) { marker.classList.add('selected'); marker.parentNode.appendChild(marker); }
+}
+markers.forEach((m, id) => m.addEventListener('click', () => select(id, 'plan')));
+rows.forEach((r, id) => r.addEventListener('click', () => select(id, 'table')));
+document.body.dataset.ready = markers.size + ' markers';
+)";
+
+std::string Where(const ChangeItem& item, const std::optional<GeoReference>& geo) {
+  if (!item.position) return "<span class='none'>no pose</span>";
+  const Eigen::Vector3d& p = *item.position;
+  std::string where = Number(p.x(), 1) + ", " + Number(p.y(), 1) + ", " + Number(p.z(), 1) + " m";
+  if (geo) {
+    const Eigen::Vector2d ll = geo->LatitudeLongitude(p);
+    where += "<br>" + Number(ll.x(), 6) + "&#176;, " + Number(ll.y(), 6) + "&#176;";
+  }
+  if (item.from) where += "<br>moved " + Number((p - *item.from).head<2>().norm(), 1) + " m";
+  return where;
+}
+
+std::string Figure(const ChangeItem& item, bool before, const std::string& images) {
+  const ChangeView& view = before ? item.before : item.after;
+  const char* word = before ? "before" : "after";
+  if (view.image.empty()) {
+    return std::string("<span class='none'>") + word + ": no kept frame of " + graph::EscapeXml(view.flight) +
+           " shows it</span>";
+  }
+  const std::string source = images.empty() ? graph::PngDataUri(view.image)
+                                            : graph::EscapeXml(images + "/" + ViewFileName(item, before));
+  std::ostringstream out;
+  out << "<figure><img loading='lazy' alt='" << word << "' src='" << source << "' width='" << view.image.cols
+      << "' height='" << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
+      << Number(NsToSeconds(view.timestamp_ns), 1) << " s, frame " << view.frame_index << "</figcaption></figure>";
+  return out.str();
+}
+
+void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoReference>& geo,
+                const std::string& images, std::ostringstream* html) {
+  *html << "<table id='changes'><tr><th>#</th><th>change</th><th>confidence</th><th>where</th><th>before</th>"
+           "<th>after</th></tr>\n";
+  for (const ChangeItem& item : items) {
+    *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id)
+          << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
+          << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state) << "</b>: "
+          << graph::EscapeXml(item.label) << "<br><span class='id'>" << graph::EscapeXml(item.id)
+          << "</span></td><td>" << Number(item.confidence) << "</td><td>" << Where(item, geo) << "</td><td>"
+          << Figure(item, true, images) << "</td><td>" << Figure(item, false, images) << "</td></tr>\n";
+  }
+  *html << "</table>\n";
+}
+
+// Why an object has its state, in an inspector's words.
+std::string Reason(const ObjectChange& o) {
+  switch (o.state) {
+    case ObjectState::kPersistent: return "seen in both patrols at the same place";
+    case ObjectState::kNew: return "not in the prior patrol's map there";
+    case ObjectState::kMoved:
+      return "moved " + Number((*o.after - *o.before).head<2>().norm(), 1) + " m, turned " +
+             Number(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) + "&#176;";
+    case ObjectState::kRemoved:
+      return Count(o.covering_views, "view", "views") + " of this patrol covered it (about " +
+             Number(o.expected_detections, 1) + " detections expected); none found it";
+    case ObjectState::kUnobserved:
+      return "this patrol did not look at it closely enough to tell (" + Count(o.covering_views, "view", "views") +
+             ", about " + Number(o.expected_detections, 1) + " detections expected)";
+  }
+  return "";
+}
+
+void ObjectTable(const ChangeReport& report, std::ostringstream* html) {
+  const auto position = [](const std::optional<Eigen::Vector3d>& p) {
+    return p ? Number(p->x(), 1) + ", " + Number(p->y(), 1) + ", " + Number(p->z(), 1) : std::string("&ndash;");
+  };
+  *html << "<section class='more'><h2>All objects</h2><table><tr><th>state</th><th>label</th><th>confidence</th>"
+           "<th>before [m]</th><th>after [m]</th><th>why</th></tr>\n";
+  for (const ObjectChange& o : report.objects) {
+    *html << "<tr><td>" << ToString(o.state) << "</td><td>" << graph::EscapeXml(o.label) << "</td><td>"
+          << Number(o.confidence) << "</td><td>" << position(o.before) << "</td><td>" << position(o.after)
+          << "</td><td>" << Reason(o) << "</td></tr>\n";
+  }
+  *html << "</table></section>\n";
+}
+
+const char* DepthWords(const std::string& source) {
+  if (source == "images") return "depth images";
+  if (source == "stereo") return "stereo matching";
+  return "unrecorded";
+}
+
+void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, std::ostringstream* html) {
+  *html << "<p class='summary'>" << Count(static_cast<long long>(items.size()), "change", "changes") << ". "
+        << Count(static_cast<long long>(report.places.size()), "place", "places") << " seen by both patrols, "
+        << report.ChangedPlaces() << " changed in appearance.";
+  if (report.objects_compared) {
+    *html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)
+          << " removed, " << report.ObjectsIn(ObjectState::kMoved) << " moved, "
+          << report.ObjectsIn(ObjectState::kPersistent) << " persistent, "
+          << report.ObjectsIn(ObjectState::kUnobserved) << " unobserved.";
+  }
+  if (report.geometry_compared) {
+    *html << " Geometry: " << Count(static_cast<long long>(report.geometry.regions.size()), "changed region",
+                                    "changed regions")
+          << " (depth from " << DepthWords(report.geometry.depth_prior) << " before, "
+          << DepthWords(report.geometry.depth_current) << " now).";
+    if (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0) {
+      *html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped "
+            << report.geometry.evicted_prior << " and " << report.geometry.evicted_current
+            << " voxels: no geometry change can be found where they were.";
+    }
+  }
+  *html << "</p>\n";
+}
+
+void Legend(const std::optional<GeoReference>& geo, std::ostringstream* html) {
+  *html << "<div class='legend'>";
+  for (const auto& [colour, words] : {std::pair{"#16a34a", "new object"}, std::pair{"#dc2626", "removed object"},
+                                      std::pair{"#ea580c", "moved object"}, std::pair{"#7c3aed", "geometry"},
+                                      std::pair{"#0891b2", "appearance"}}) {
+    *html << "<span><i class='swatch' style='background:" << colour << "'></i>" << words << "</span>";
+  }
+  *html << "<span>&#9472; this flight</span><span>- - - prior flight</span><span style='color:#2563eb'>&#9671; "
+           "place both saw</span>";
+  if (geo) {
+    *html << "<span>grid: latitude and longitude (GPS fit of " << geo->fixes << " fixes, " << Number(geo->rms_m, 1)
+          << " m rms)</span>";
+  }
+  *html << "</div>\n";
+}
+
+}  // namespace
+
+std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map, const std::vector<ChangeItem>& items,
+                   const std::optional<GeoReference>& geo, const std::string& images) {
+  std::ostringstream html;
+  const std::string title =
+      "Changes from " + graph::EscapeXml(report.prior_flight) + " to " + graph::EscapeXml(report.current_flight);
+  html << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><meta name='viewport' "
+          "content='width=device-width'><title>"
+       << title << "</title>\n<style>" << kStyle << "</style></head>\n<body>\n<header><h1>" << title << "</h1>\n";
+  Summary(report, items, &html);
+  html << "</header>\n<main>\n<section id='plan'>";
+  const std::string plan = PlanSvg(report, map, items, geo);
+  if (plan.empty()) {
+    html << "<p class='none'>No plan: the logs have no poses.</p>";
+  } else {
+    html << plan;
+    Legend(geo, &html);
+  }
+  html << "</section>\n<section id='list'>";
+  if (items.empty()) html << "<p>Nothing changed between the two patrols.</p>";
+  else ChangeRows(items, geo, images, &html);
+  html << "</section>\n</main>\n";
+  if (report.objects_compared) ObjectTable(report, &html);
+  html << "<script>" << kScript << "</script>\n</body></html>\n";
+  return html.str();
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,153 @@
+// changes.json: format "patrolmap.changes", version 2 (docs/changes.schema.json).
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "patrolmap/change/report.h"
+
+namespace patrolmap::change {
+namespace {
+
+using nlohmann::json;
+
+json Vector(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+json Box(const cv::Rect& r) { return json::array({r.x, r.y, r.width, r.height}); }
+
+double YawDegrees(const Eigen::Matrix3d& rotation) { return std::atan2(rotation(1, 0), rotation(0, 0)) * 180.0 / M_PI; }
+
+json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
+  const AppearanceChange& a = place.appearance;
+  json regions = json::array();
+  for (const AppearanceRegion& r : a.regions) {
+    regions.push_back({{"current_box", Box(r.current_box)},
+                       {"prior_box", Box(r.prior_box)},
+                       {"area_px", r.area_px},
+                       {"score", r.score},
+                       {"prior_features", r.prior_features},
+                       {"unmatched_prior_features", r.unmatched_prior_features},
+                       {"current_features", r.current_features},
+                       {"unmatched_current_features", r.unmatched_current_features}});
+  }
+  return {{"id", AppearanceChangeId(place.prior_node, place.current_node)},
+          {"prior_node", place.prior_node},
+          {"current_node", place.current_node},
+          {"prior_frame", map.node(place.prior_node).frame_index},
+          {"current_frame", map.node(place.current_node).frame_index},
+          {"registered", a.registered},
+          {"matches", a.matches},
+          {"inliers", a.inliers},
+          {"gain", a.gain},
+          {"offset", a.offset},
+          {"compared_fraction", a.compared_fraction},
+          {"regions", regions}};
+}
+
+json ObjectJson(const ObjectChange& o) {
+  json object = {{"id", ObjectChangeId(o)},
+                 {"state", ToString(o.state)},
+                 {"label", o.label},
+                 {"confidence", o.confidence},
+                 {"prior_id", o.prior_id},
+                 {"current_id", o.current_id},
+                 {"covering_views", o.covering_views},
+                 {"expected_detections", o.expected_detections},
+                 {"before", o.before ? Vector(*o.before) : json(nullptr)},
+                 {"after", o.after ? Vector(*o.after) : json(nullptr)}};
+  if (o.state == ObjectState::kMoved) {
+    object["rotation_yaw_deg"] = YawDegrees(o.rotation);
+    object["weighted_distance"] = o.weighted_distance;
+  }
+  return object;
+}
+
+json GeometryJson(const GeometryChange& g) {
+  json regions = json::array();
+  for (const GeometryRegion& r : g.regions) {
+    regions.push_back({{"id", GeometryChangeId(r.centroid)},
+                       {"centroid", Vector(r.centroid)},
+                       {"box_min", Vector(r.box_min)},
+                       {"box_max", Vector(r.box_max)},
+                       {"voxels", r.voxels},
+                       {"appeared", r.appeared},
+                       {"vanished", r.vanished},
+                       {"score", r.score}});
+  }
+  return {{"voxel_size", g.voxel_size},
+          {"compared_voxels", g.compared_voxels},
+          {"evicted_voxels", {{"prior", g.evicted_prior}, {"current", g.evicted_current}}},
+          {"depth_source", {{"prior", g.depth_prior}, {"current", g.depth_current}}},
+          {"changed_voxels", g.changed_voxels.size()},
+          {"regions", regions}};
+}
+
+json ViewJson(const ChangeItem& item, bool before, const std::string& images) {
+  const ChangeView& view = before ? item.before : item.after;
+  if (view.frame_index < 0) return {{"flight", view.flight}, {"time_s", nullptr}, {"frame", nullptr}, {"image", nullptr}};
+  const json image = view.image.empty() || images.empty() ? json(nullptr) : json(images + "/" + ViewFileName(item, before));
+  return {{"flight", view.flight}, {"time_s", NsToSeconds(view.timestamp_ns)}, {"frame", view.frame_index}, {"image", image}};
+}
+
+json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, const std::string& images) {
+  json change = {{"id", item.id},
+                 {"number", item.number},
+                 {"kind", item.kind},
+                 {"state", item.state},
+                 {"label", item.label},
+                 {"confidence", item.confidence},
+                 {"position", item.position ? Vector(*item.position) : json(nullptr)},
+                 {"from", item.from ? Vector(*item.from) : json(nullptr)},
+                 {"latitude", nullptr},
+                 {"longitude", nullptr},
+                 {"before", ViewJson(item, true, images)},
+                 {"after", ViewJson(item, false, images)}};
+  if (geo && item.position) {
+    const Eigen::Vector2d lat_lon = geo->LatitudeLongitude(*item.position);
+    change["latitude"] = lat_lon.x();
+    change["longitude"] = lat_lon.y();
+  }
+  return change;
+}
+
+}  // namespace
+
+std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const std::vector<ChangeItem>& items,
+                   const std::optional<GeoReference>& geo, const std::string& images) {
+  json places = json::array(), objects = json::array(), counts = json::object(), changes = json::array();
+  for (const PlaceChange& place : report.places) places.push_back(PlaceJson(place, map));
+  for (const ObjectChange& o : report.objects) objects.push_back(ObjectJson(o));
+  for (ObjectState s : {ObjectState::kPersistent, ObjectState::kNew, ObjectState::kRemoved, ObjectState::kMoved,
+                        ObjectState::kUnobserved}) {
+    counts[ToString(s)] = report.ObjectsIn(s);
+  }
+  for (const ChangeItem& item : items) changes.push_back(ChangeJson(item, geo, images));
+  json geo_json = nullptr;
+  if (geo) {
+    geo_json = {{"origin_latitude", geo->origin_latitude},
+                {"origin_longitude", geo->origin_longitude},
+                {"fixes", geo->fixes},
+                {"rms_m", geo->rms_m}};
+  }
+  const json document = {
+      {"format", "patrolmap.changes"},
+      {"version", 2},
+      {"prior_flight", report.prior_flight},
+      {"current_flight", report.current_flight},
+      {"summary",
+       {{"changes", items.size()},
+        {"places_compared", report.places.size()},
+        {"places_changed", report.ChangedPlaces()},
+        {"objects", report.objects_compared ? counts : json(nullptr)},
+        {"geometry_regions", report.geometry_compared ? json(report.geometry.regions.size()) : json(nullptr)}}},
+      {"timing_s",
+       {{"appearance", report.seconds_appearance},
+        {"objects", report.seconds_objects},
+        {"geometry", report.seconds_geometry}}},
+      {"geo_reference", geo_json},
+      {"changes", changes},
+      {"places", places},
+      {"objects", report.objects_compared ? objects : json(nullptr)},
+      {"geometry", report.geometry_compared ? GeometryJson(report.geometry) : json(nullptr)}};
+  return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace patrolmap::change
