@@ -3,7 +3,9 @@
 #  - two L-shaped flights with objects added, removed and moved between them, object detections and depth:
 #    `map`, then `patrol` writes changes.json and changes.html; `eval` scores them against the ground truth;
 #  - `diff` on the patrol's map repeats the patrol's report;
-#  - the report follows docs/changes.schema.json and the page holds both key frames of changed places;
+#  - the report follows docs/changes.schema.json; the page loads in headless Chromium without a console
+#    message and shows a marker per change and its before and after pictures, whose files exist;
+#    changes.geojson follows RFC 7946 and its current camera path lies within 2 m of the flight's GPS track;
 #  - a series that changes only the lighting reports no change at all;
 #  - bad requests fail with a message.
 # Usage: change_series_test.sh PATROLMAP_BINARY SOURCE_DIR
@@ -48,7 +50,7 @@ g = r['geometry']
 print('  voxels: precision %.3f recall %.3f IoU %.3f, %d regions' % (g['precision'], g['recall'], g['iou'], g['regions']))"
 }
 
-series changed
+series changed --gps
 json="$work/changed.json"
 # Measured on this series (true/false/missed): new 1/1/0, removed 1/1/0, moved 2/0/1 (one move's shape test
 # fails at this resolution), persistent 3/0/0; voxels precision 0.999, recall 0.949. The bounds allow one
@@ -66,12 +68,70 @@ schema = json.load(open('$source_dir/docs/changes.schema.json'))
 report = json.load(open('$work/changed-2/changes.json'))
 jsonschema.validate(report, schema)
 assert report['prior_flight'] == 'l-shape-1-f1' and report['current_flight'] == 'l-shape-1-f2'
-page = open('$work/changed-2/changes.html').read()
-assert '<h2>Objects</h2>' in page and '<svg' in page
-changed = sum(1 for p in report['places'] if p['regions'])
-assert page.count('<img alt=') == 2 * changed, (page.count('<img alt='), changed)
-"; then echo "ok   report follows the schema; the page shows both key frames per changed place"; else
-  echo "FAIL report schema or page"; failures=$((failures + 1)); fi
+assert report['summary']['changes'] == len(report['changes']) > 0
+"; then echo "ok   report follows the schema"; else echo "FAIL report schema"; failures=$((failures + 1)); fi
+
+# The page in headless Chromium: no console message (script errors, missing files), a marker per change with a
+# position, and every picture the report names, on disk.
+chrome_profile=$(mktemp -d)
+timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking \
+  --disable-component-update --disable-sync --user-data-dir="$chrome_profile" --enable-logging=stderr --v=0 \
+  --dump-dom "file://$work/changed-2/changes.html" > "$work/page.html" 2> "$work/page.log" || true
+rm -rf "$chrome_profile"
+if $py -c "
+import json, os, re
+report = json.load(open('$work/changed-2/changes.json'))
+dom = open('$work/page.html').read()
+console = [l for l in open('$work/page.log') if ':CONSOLE' in l]
+assert not console, console
+placed = sum(1 for c in report['changes'] if c['position'])
+assert 'data-ready=\"%d markers\"' % placed in dom, re.findall('data-ready=\"[^\"]*\"', dom)
+assert dom.count('class=\"marker\"') == placed
+images = [v['image'] for c in report['changes'] for v in (c['before'], c['after']) if v['image']]
+assert len(images) >= len(report['changes']), (len(images), len(report['changes']))
+sources = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\" src=\"([^\"]+)\"', dom)
+assert sorted(sources) == sorted(images), (len(sources), len(images))
+assert all(os.path.getsize(os.path.join('$work/changed-2', i)) > 0 for i in images)
+print('  %d changes, %d markers, %d pictures' % (len(report['changes']), placed, len(images)))
+"; then echo "ok   the page loads without a console message and shows every marker and picture"; else
+  echo "FAIL report page"; failures=$((failures + 1)); fi
+
+# changes.geojson: RFC 7946 (a FeatureCollection of Points and LineStrings in [longitude, latitude], no crs);
+# the current flight's camera path within 2 m of its GPS track (the fixes of gps0/, 1.5 m noise).
+if $py -c "
+import csv, json, math
+g = json.load(open('$work/changed-2/changes.geojson'))
+assert g['type'] == 'FeatureCollection' and 'crs' not in g
+def positions(geometry):
+  c = geometry['coordinates']
+  return [c] if geometry['type'] == 'Point' else c
+for f in g['features']:
+  assert f['type'] == 'Feature' and f['geometry']['type'] in ('Point', 'LineString')
+  for lon, lat in positions(f['geometry']):
+    assert -180 <= lon <= 180 and -90 <= lat <= 90
+report = json.load(open('$work/changed-2/changes.json'))
+points = [f for f in g['features'] if f['geometry']['type'] == 'Point']
+assert sorted(f['properties']['id'] for f in points) == sorted(c['id'] for c in report['changes'] if c['position'])
+rows = [r for r in csv.reader(open('$work/changed/flight_2/gps0/data.csv')) if not r[0].startswith('#')]
+lat0 = float(rows[0][1])
+def metres(lon, lat):
+  return ((lon - float(rows[0][2])) * math.pi / 180 * 6378137 * math.cos(lat0 * math.pi / 180),
+          (lat - lat0) * math.pi / 180 * 6378137)
+track = [metres(float(r[2]), float(r[1])) for r in rows]
+def to_track(p):
+  best = 1e9
+  for a, b in zip(track, track[1:]):
+    d = (b[0] - a[0], b[1] - a[1]); n = d[0] ** 2 + d[1] ** 2 or 1e-12
+    t = max(0, min(1, ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / n))
+    best = min(best, math.hypot(a[0] + t * d[0] - p[0], a[1] + t * d[1] - p[1]))
+  return best
+path = next(f for f in g['features'] if f['properties'].get('kind') == 'camera_path'
+            and f['properties']['flight'] == 'l-shape-1-f2')
+far = max(to_track(metres(*c)) for c in path['geometry']['coordinates'])
+print('  camera path at most %.2f m from the GPS track' % far)
+assert far <= 2.0
+"; then echo "ok   changes.geojson follows RFC 7946 and lies on the GPS track"; else
+  echo "FAIL changes.geojson"; failures=$((failures + 1)); fi
 
 "$bin" diff "$work/changed-2/map.pmap" --from l-shape-1-f1 --to l-shape-1-f2 --out "$work/diff" >/dev/null
 if $py -c "

@@ -61,7 +61,7 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   KeyKinds kinds;
   Config defaults;
   VisitConfig(&defaults, &kinds);
-  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 95u);  // every numeric key (the rest are switches)
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 99u);  // every numeric key (the rest are switches)
   const auto refused = [&](const std::string& key, const std::string& value) {
     testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
     Config config;
@@ -359,6 +359,7 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
 #include "patrolmap/pipeline/flight_pass.h"
 #include "patrolmap/pipeline/map.h"
 #include "patrolmap/pipeline/patrol_recorder.h"
+#include "patrolmap/pipeline/route_strip.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -396,6 +397,40 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
 
 // The patrol recorder turns a frame's samples into work: each depth image for the grid, and the detections
 // with the depth image of the frame's own time only (none when the depth camera missed that instant).
+// The route strip keeps a frame a second and every key frame; past its memory budget every other interval
+// frame goes and the interval doubles, key frames stay, and the frames come out in time order.
+TEST(RouteStrip, ThinsIntervalFramesPastItsBudgetAndKeepsKeyFrames) {
+  change::RouteFrameOptions options;
+  options.max_width = 32;
+  cv::Mat noise(48, 64, CV_8UC1);
+  cv::randu(noise, 0, 255);  // JPEG cannot shrink noise: every frame takes about the same bytes
+  std::vector<unsigned char> one;
+  cv::imencode(".jpg", noise(cv::Rect(0, 0, 32, 24)), one, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+  options.memory_mb = 10.5 * static_cast<double>(one.size()) / (1024.0 * 1024.0);  // about 10 frames
+  RouteStrip strip(options);
+  EXPECT_TRUE(strip.Due(0));
+  EXPECT_FALSE(strip.Due(SecondsToNs(0.5)));
+  EXPECT_TRUE(strip.Due(SecondsToNs(1.0)));
+  cv::Mat scaled;
+  strip.Scale(noise, &scaled);
+  EXPECT_EQ(scaled.size(), cv::Size(32, 24));
+  for (int i = 0; i < 16; ++i) {
+    RouteFrame frame;
+    frame.timestamp_ns = SecondsToNs(i);
+    frame.frame_index = i;
+    strip.Add(frame, noise(cv::Rect(0, 0, 32, 24)), false);
+  }
+  RouteFrame key;
+  key.timestamp_ns = SecondsToNs(4.5);
+  key.frame_index = 99;
+  strip.Add(key, noise(cv::Rect(0, 0, 32, 24)), true);
+  EXPECT_EQ(strip.thinnings(), 1);
+  const std::vector<RouteFrame> frames = strip.Take();
+  std::vector<std::int64_t> indices;
+  for (const RouteFrame& f : frames) indices.push_back(f.frame_index);
+  EXPECT_EQ(indices, (std::vector<std::int64_t>{0, 2, 4, 99, 6, 8, 10, 12, 14}));
+}
+
 TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   io::LogInfo info;
   info.camera = CameraIntrinsics{40.0, 40.0, 31.5, 23.5, 64, 48};
@@ -410,7 +445,9 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   frame.depth = {{990, "early.png", "", {}, {}, frame.pose}, {1000, "own.png", "", {}, {}, frame.pose}};
   std::vector<ChangeWork> work;
   recorder.Collect(frame, &work);
-  ASSERT_EQ(work.size(), 3u);  // two depth images for the grid, then the detections
+  ASSERT_EQ(work.size(), 4u);  // the first frame for the route strip, two depth images for the grid, the detections
+  EXPECT_EQ(work[0].kind, ChangeWork::Kind::kRoute);
+  work.erase(work.begin());
   EXPECT_EQ(work[0].kind, ChangeWork::Kind::kGrid);
   EXPECT_EQ(work[2].kind, ChangeWork::Kind::kObjects);
   EXPECT_EQ(work[2].detections.size(), 2u);

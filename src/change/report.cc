@@ -13,13 +13,14 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kRegionCellM = 2.0;  // geometry ids: one per region centroid in a cell this wide
+constexpr double kRegionCellM = 2.0;   // geometry ids: one per region centroid in a cell this wide
 const cv::Scalar kOutline(0, 0, 230);  // BGR
 
 std::array<Eigen::Vector3d, 8> Corners(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {
   std::array<Eigen::Vector3d, 8> corners;
   for (int i = 0; i < 8; ++i) {
-    corners[i] = Eigen::Vector3d((i & 1) ? high.x() : low.x(), (i & 2) ? high.y() : low.y(), (i & 4) ? high.z() : low.z());
+    corners[i] =
+        Eigen::Vector3d((i & 1) ? high.x() : low.x(), (i & 2) ? high.y() : low.y(), (i & 4) ? high.z() : low.z());
   }
   return corners;
 }
@@ -56,10 +57,12 @@ struct TimeWindow {
   TimestampNs first = std::numeric_limits<TimestampNs>::min(), last = std::numeric_limits<TimestampNs>::max();
 };
 
-// The kept frame that shows the box best, unoccluded (or in `window`, without a grid): most of its projection inside the image, then the
-// larger projection up to a quarter of the image (a close view, not one that fills the frame).
-std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Vector3d& low, const Eigen::Vector3d& high,
-                                     const TimeWindow& window, const ReportOptions& options) {
+// The kept frame that shows the box best, unoccluded (or in `window`, without a grid): most of its
+// projection inside the image, near the centre, and large up to a quarter of the image (a close view, not one
+// that fills the frame).
+std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Vector3d& low,
+                                     const Eigen::Vector3d& high, const TimeWindow& window,
+                                     const ReportOptions& options) {
   if (!record.camera.valid()) return std::nullopt;
   const std::array<Eigen::Vector3d, 8> corners = Corners(low, high);
   const Eigen::Vector3d centre = (low + high) / 2.0;
@@ -73,7 +76,10 @@ std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Ve
     const cv::Rect2d box = ProjectCorners(record.camera, *frame.pose, corners);
     if (box.area() <= 0.0) continue;
     const double inside = (box & image).area() / box.area();
-    const double score = inside * inside * std::min(box.area() / image.area(), 0.25);
+    const cv::Point2d off((box.x + box.width / 2.0) / image.width - 0.5,
+                          (box.y + box.height / 2.0) / image.height - 0.5);
+    const double centred = 1.0 - std::min(1.0, std::hypot(off.x, off.y));  // room for context on every side
+    const double score = inside * inside * centred * std::min(box.area() / image.area(), 0.25);
     if (inside < 0.5 || score <= best_score || Occluded(record.grid, frame.pose->position, low, high)) continue;
     best_score = score;
     best = Sighting{&frame, box};
@@ -160,14 +166,14 @@ ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<c
 }
 
 // The camera position of the view of `flight` nearest in time to `timestamp_ns` (within a second).
-std::optional<Eigen::Vector3d> CameraAt(const graph::TopoMap& map, const std::string& flight, TimestampNs timestamp_ns) {
+std::optional<Eigen::Vector3d> CameraAt(const graph::TopoMap& map, const std::string& flight,
+                                        TimestampNs timestamp_ns) {
   const PatrolRecord* record = map.Patrol(flight);
   if (record == nullptr || record->views.empty()) return std::nullopt;
-  const auto nearest = std::min_element(record->views.begin(), record->views.end(),
-                                        [timestamp_ns](const CameraPoseSample& a, const CameraPoseSample& b) {
-                                          return std::llabs(a.timestamp_ns - timestamp_ns) <
-                                                 std::llabs(b.timestamp_ns - timestamp_ns);
-                                        });
+  const auto nearest = std::min_element(
+      record->views.begin(), record->views.end(), [timestamp_ns](const CameraPoseSample& a, const CameraPoseSample& b) {
+        return std::llabs(a.timestamp_ns - timestamp_ns) < std::llabs(b.timestamp_ns - timestamp_ns);
+      });
   if (std::llabs(nearest->timestamp_ns - timestamp_ns) > SecondsToNs(1.0)) return std::nullopt;
   return nearest->position;
 }

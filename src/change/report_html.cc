@@ -20,7 +20,9 @@ std::string Number(double value, int decimals = 2) {
 }
 
 // "1 place", "3 places".
-std::string Count(long long n, const char* one, const char* many) { return std::to_string(n) + " " + (n == 1 ? one : many); }
+std::string Count(long long n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
 
 constexpr char kStyle[] = R"(
 body{font-family:system-ui,sans-serif;margin:0;color:#1f2933;background:#fff}
@@ -77,8 +79,8 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
     return std::string("<span class='none'>") + word + ": no kept frame of " + graph::EscapeXml(view.flight) +
            " shows it</span>";
   }
-  const std::string source = images.empty() ? graph::PngDataUri(view.image)
-                                            : graph::EscapeXml(images + "/" + ViewFileName(item, before));
+  const std::string source =
+      images.empty() ? graph::PngDataUri(view.image) : graph::EscapeXml(images + "/" + ViewFileName(item, before));
   std::ostringstream out;
   out << "<figure><img loading='lazy' alt='" << word << "' src='" << source << "' width='" << view.image.cols
       << "' height='" << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
@@ -86,15 +88,15 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   return out.str();
 }
 
-void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoReference>& geo,
-                const std::string& images, std::ostringstream* html) {
+void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoReference>& geo, const std::string& images,
+                std::ostringstream* html) {
   *html << "<table id='changes'><tr><th>#</th><th>change</th><th>confidence</th><th>where</th><th>before</th>"
            "<th>after</th></tr>\n";
   for (const ChangeItem& item : items) {
     *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id)
           << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
-          << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state) << "</b>: "
-          << graph::EscapeXml(item.label) << "<br><span class='id'>" << graph::EscapeXml(item.id)
+          << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
+          << "</b>: " << graph::EscapeXml(item.label) << "<br><span class='id'>" << graph::EscapeXml(item.id)
           << "</span></td><td>" << Number(item.confidence) << "</td><td>" << Where(item, geo) << "</td><td>"
           << Figure(item, true, images) << "</td><td>" << Figure(item, false, images) << "</td></tr>\n";
   }
@@ -146,12 +148,12 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
   if (report.objects_compared) {
     *html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)
           << " removed, " << report.ObjectsIn(ObjectState::kMoved) << " moved, "
-          << report.ObjectsIn(ObjectState::kPersistent) << " persistent, "
-          << report.ObjectsIn(ObjectState::kUnobserved) << " unobserved.";
+          << report.ObjectsIn(ObjectState::kPersistent) << " persistent, " << report.ObjectsIn(ObjectState::kUnobserved)
+          << " unobserved.";
   }
   if (report.geometry_compared) {
-    *html << " Geometry: " << Count(static_cast<long long>(report.geometry.regions.size()), "changed region",
-                                    "changed regions")
+    *html << " Geometry: "
+          << Count(static_cast<long long>(report.geometry.regions.size()), "changed region", "changed regions")
           << " (depth from " << DepthWords(report.geometry.depth_prior) << " before, "
           << DepthWords(report.geometry.depth_current) << " now).";
     if (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0) {
@@ -165,9 +167,9 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
 
 void Legend(const std::optional<GeoReference>& geo, std::ostringstream* html) {
   *html << "<div class='legend'>";
-  for (const auto& [colour, words] : {std::pair{"#16a34a", "new object"}, std::pair{"#dc2626", "removed object"},
-                                      std::pair{"#ea580c", "moved object"}, std::pair{"#7c3aed", "geometry"},
-                                      std::pair{"#0891b2", "appearance"}}) {
+  for (const auto& [colour, words] :
+       {std::pair{"#16a34a", "new object"}, std::pair{"#dc2626", "removed object"},
+        std::pair{"#ea580c", "moved object"}, std::pair{"#7c3aed", "geometry"}, std::pair{"#0891b2", "appearance"}}) {
     *html << "<span><i class='swatch' style='background:" << colour << "'></i>" << words << "</span>";
   }
   *html << "<span>&#9472; this flight</span><span>- - - prior flight</span><span style='color:#2563eb'>&#9671; "
@@ -199,8 +201,10 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map, const 
     Legend(geo, &html);
   }
   html << "</section>\n<section id='list'>";
-  if (items.empty()) html << "<p>Nothing changed between the two patrols.</p>";
-  else ChangeRows(items, geo, images, &html);
+  if (items.empty())
+    html << "<p>Nothing changed between the two patrols.</p>";
+  else
+    ChangeRows(items, geo, images, &html);
   html << "</section>\n</main>\n";
   if (report.objects_compared) ObjectTable(report, &html);
   html << "<script>" << kScript << "</script>\n</body></html>\n";

@@ -82,9 +82,14 @@ json GeometryJson(const GeometryChange& g) {
 
 json ViewJson(const ChangeItem& item, bool before, const std::string& images) {
   const ChangeView& view = before ? item.before : item.after;
-  if (view.frame_index < 0) return {{"flight", view.flight}, {"time_s", nullptr}, {"frame", nullptr}, {"image", nullptr}};
-  const json image = view.image.empty() || images.empty() ? json(nullptr) : json(images + "/" + ViewFileName(item, before));
-  return {{"flight", view.flight}, {"time_s", NsToSeconds(view.timestamp_ns)}, {"frame", view.frame_index}, {"image", image}};
+  if (view.frame_index < 0)
+    return {{"flight", view.flight}, {"time_s", nullptr}, {"frame", nullptr}, {"image", nullptr}};
+  const json image =
+      view.image.empty() || images.empty() ? json(nullptr) : json(images + "/" + ViewFileName(item, before));
+  return {{"flight", view.flight},
+          {"time_s", NsToSeconds(view.timestamp_ns)},
+          {"frame", view.frame_index},
+          {"image", image}};
 }
 
 json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, const std::string& images) {

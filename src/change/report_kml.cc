@@ -39,8 +39,8 @@ std::string Picture(const ChangeItem& item, bool before, const std::string& imag
   char caption[160];
   std::snprintf(caption, sizeof(caption), "%s: %s, %.1f s, frame %lld", before ? "before" : "after",
                 view.flight.c_str(), NsToSeconds(view.timestamp_ns), static_cast<long long>(view.frame_index));
-  return "<p>" + graph::EscapeXml(caption) + "<br/><img src=\"" + graph::EscapeXml(images + "/" + ViewFileName(item, before)) +
-         "\"/></p>";
+  return "<p>" + graph::EscapeXml(caption) + "<br/><img src=\"" +
+         graph::EscapeXml(images + "/" + ViewFileName(item, before)) + "\"/></p>";
 }
 
 }  // namespace

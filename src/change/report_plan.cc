@@ -10,9 +10,9 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kWidth = 800.0;   // SVG user units across the plan
-constexpr double kPad = 30.0;      // around the drawing
-constexpr double kMarginM = 4.0;   // world margin around what is drawn [m]
+constexpr double kWidth = 800.0;  // SVG user units across the plan
+constexpr double kPad = 30.0;     // around the drawing
+constexpr double kMarginM = 4.0;  // world margin around what is drawn [m]
 
 std::string Number(double value, int decimals = 1) {
   char buffer[32];
@@ -77,8 +77,8 @@ void ScaleBar(const PlanFrame& frame, std::ostringstream* svg) {
 
 void NorthArrow(const PlanFrame& frame, std::ostringstream* svg) {
   const double x = kWidth - 24.0, y = 40.0;
-  *svg << "<g class='north'><path d='M" << x << "," << y - 22 << " L" << x - 8 << "," << y << " L" << x << ","
-       << y - 6 << " L" << x + 8 << "," << y << " Z' fill='#111'/><text x='" << x - 4 << "' y='" << y + 14
+  *svg << "<g class='north'><path d='M" << x << "," << y - 22 << " L" << x - 8 << "," << y << " L" << x << "," << y - 6
+       << " L" << x + 8 << "," << y << " Z' fill='#111'/><text x='" << x - 4 << "' y='" << y + 14
        << "' font-size='13' font-weight='bold'>N</text></g>\n";
   (void)frame;
 }
@@ -100,8 +100,8 @@ void Graticule(const PlanFrame& frame, const GeoReference& geo, const std::vecto
       a[axis] = b[axis] = v;
       const Eigen::Vector2d p = frame(geo.WorldOf(a)), q = frame(geo.WorldOf(b));
       *svg << "<line x1='" << Number(p.x()) << "' y1='" << Number(p.y()) << "' x2='" << Number(q.x()) << "' y2='"
-           << Number(q.y()) << "'/><text stroke='none' x='" << Number(p.x() + 3) << "' y='" << Number(p.y() - 3)
-           << "'>" << Number(v, decimals) << (axis == 0 ? "&#176;N" : "&#176;E") << "</text>\n";
+           << Number(q.y()) << "'/><text stroke='none' x='" << Number(p.x() + 3) << "' y='" << Number(p.y() - 3) << "'>"
+           << Number(v, decimals) << (axis == 0 ? "&#176;N" : "&#176;E") << "</text>\n";
     }
   }
   *svg << "</g>\n";
@@ -175,8 +175,8 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
   Path(current, frame, "stroke='#374151' stroke-width='2'", &svg);
   for (const GeometryRegion& r : report.geometry.regions) {
     const Eigen::Vector2d a = frame(r.box_min.head<2>()), b = frame(r.box_max.head<2>());
-    svg << "<rect x='" << Number(std::min(a.x(), b.x())) << "' y='" << Number(std::min(a.y(), b.y()))
-        << "' width='" << Number(std::abs(b.x() - a.x()) + 2) << "' height='" << Number(std::abs(b.y() - a.y()) + 2)
+    svg << "<rect x='" << Number(std::min(a.x(), b.x())) << "' y='" << Number(std::min(a.y(), b.y())) << "' width='"
+        << Number(std::abs(b.x() - a.x()) + 2) << "' height='" << Number(std::abs(b.y() - a.y()) + 2)
         << "' fill='#7c3aed22' stroke='#7c3aed' stroke-dasharray='4 2'/>\n";
   }
   Places(report, map, frame, &svg);

@@ -489,8 +489,7 @@ bool ValidRoute(const std::vector<RouteFrame>& route) {
     if (i > 0 && f.timestamp_ns < route[i - 1].timestamp_ns) return false;
     if (f.pose && !ValidPose(*f.pose)) return false;
     if (f.gps && !(std::abs(f.gps->x()) <= 90.0 && std::abs(f.gps->y()) <= 180.0)) return false;
-    if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8)
-      return false;
+    if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8) return false;
   }
   return true;
 }

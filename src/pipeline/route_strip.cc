@@ -34,9 +34,8 @@ void RouteStrip::Add(RouteFrame frame, const cv::Mat& image, bool key_frame) {
   const long long candidate = key_frame ? -1 : candidates_++;
   if (candidate >= 0 && candidate % (1LL << thinnings_) != 0) return;  // between the kept ones since thinning
   if (image.empty() || !cv::imencode(".jpg", image, frame.jpeg, encode_parameters_)) return;
-  while (bytes_ + frame.jpeg.size() > budget && std::any_of(candidate_.begin(), candidate_.end(), [](long long c) {
-           return c > 0;
-         })) {
+  while (bytes_ + frame.jpeg.size() > budget &&
+         std::any_of(candidate_.begin(), candidate_.end(), [](long long c) { return c > 0; })) {
     Thin();
     if (candidate >= 0 && candidate % (1LL << thinnings_) != 0) return;
   }

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "patrolmap/core/checksum.h"
 
@@ -219,8 +220,9 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
 // its depth source) loads, with none dropped and no source.
 TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
   testing::TempDir dir;
-  // The evicted-voxel count (8 bytes) and the depth source ("stereo": a 4-byte length and 6 characters).
-  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 18);
+  // The evicted-voxel count (8 bytes), the depth source ("stereo": a 4-byte length and 6 characters) and the
+  // route frames (none: a 4-byte count).
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 22);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -231,12 +233,80 @@ TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
 
 TEST(MapFile, VersionFourPatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 10);
+  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 14);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v4.pmap", &map).ok()) << LoadMap(dir / "v4.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
   EXPECT_EQ(map.Patrol("b")->grid.evicted_voxels, 11);
   EXPECT_EQ(map.Patrol("b")->depth_source, "");
+}
+
+// A patrol with two kept route frames: one with a pose and GPS, one with neither.
+TopoMap WithRoute() {
+  TopoMap map = TwoFlights();
+  PatrolRecord record = *map.Patrol("b");
+  std::vector<unsigned char> jpeg;
+  cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC1, cv::Scalar(90)), jpeg);
+  RouteFrame first;
+  first.timestamp_ns = 5;
+  first.frame_index = 3;
+  first.pose = CameraPoseSample{5, Eigen::Vector3d(1, 2, 3), Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5)};
+  first.gps = Eigen::Vector2d(47.3572123456789, 8.5);
+  first.jpeg = jpeg;
+  RouteFrame second;
+  second.timestamp_ns = 9;
+  second.frame_index = 4;
+  second.jpeg = jpeg;
+  record.route = {first, second};
+  map.SetPatrol(record);
+  return map;
+}
+
+TEST(MapFile, RouteFramesRoundTrip) {
+  testing::TempDir dir;
+  const TopoMap map = WithRoute();
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  const std::vector<RouteFrame>& a = map.Patrol("b")->route;
+  const std::vector<RouteFrame>& b = loaded.Patrol("b")->route;
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[0].timestamp_ns, 5);
+  EXPECT_EQ(b[0].frame_index, 3);
+  ASSERT_TRUE(b[0].pose && b[0].gps);
+  EXPECT_EQ(b[0].pose->position, a[0].pose->position);
+  EXPECT_EQ(b[0].pose->rotation.coeffs(), a[0].pose->rotation.coeffs());
+  EXPECT_EQ(b[0].gps->x(), 47.3572123456789);
+  EXPECT_FALSE(b[1].pose || b[1].gps);
+  EXPECT_EQ(b[1].jpeg, a[1].jpeg);
+  EXPECT_EQ(cv::imdecode(b[1].jpeg, cv::IMREAD_GRAYSCALE).cols, 32);
+}
+
+// Route frames out of time order, or bytes that are not JPEG, make the map corrupt, named.
+TEST(MapFile, DamagedRouteFramesAreNamed) {
+  testing::TempDir dir;
+  for (int damage = 0; damage < 2; ++damage) {
+    TopoMap map = WithRoute();
+    PatrolRecord record = *map.Patrol("b");
+    if (damage == 0) record.route[1].timestamp_ns = 1;
+    if (damage == 1) record.route[0].jpeg[0] = 'P';
+    map.SetPatrol(record);
+    ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+    TopoMap loaded;
+    const Status status = LoadMap(dir / "m.pmap", &loaded);
+    EXPECT_FALSE(status.ok());
+    EXPECT_NE(status.message().find("route frames of b"), std::string::npos) << status.message();
+  }
+}
+
+// A version-5 map (before the route frames) loads without them.
+TEST(MapFile, VersionFivePatrolRecordsStillLoad) {
+  testing::TempDir dir;
+  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 4);
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v5.pmap", &map).ok()) << LoadMap(dir / "v5.pmap", &map).message();
+  EXPECT_EQ(map.Patrol("b")->depth_source, "stereo");
+  EXPECT_TRUE(map.Patrol("b")->route.empty());
 }
 
 TEST(MapFile, VersionOneFilesStillLoad) {

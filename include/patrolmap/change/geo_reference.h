@@ -12,7 +12,7 @@
 namespace patrolmap::change {
 
 struct GeoReference {
-  double origin_latitude = 0.0, origin_longitude = 0.0;  // [deg]: east, north = 0, 0
+  double origin_latitude = 0.0, origin_longitude = 0.0;    // [deg]: east, north = 0, 0
   Eigen::Matrix2d rotation = Eigen::Matrix2d::Identity();  // east-north from world x-y
   Eigen::Vector2d translation = Eigen::Vector2d::Zero();
   int fixes = 0;       // frames the fit used
@@ -22,7 +22,7 @@ struct GeoReference {
   Eigen::Vector2d LatitudeLongitude(const Eigen::Vector3d& world) const;  // [deg]
   Eigen::Vector2d EastNorthOf(const Eigen::Vector2d& latitude_longitude) const;
   Eigen::Vector2d WorldOf(const Eigen::Vector2d& latitude_longitude) const;  // the world's x, y
-  Eigen::Vector2d NorthInWorld() const;  // unit vector in the world's x-y plane
+  Eigen::Vector2d NorthInWorld() const;                                      // unit vector in the world's x-y plane
 };
 
 // None when fewer than `min_fixes` kept frames have a pose and a fix, or they span less than `min_span_m`.

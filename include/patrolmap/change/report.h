@@ -62,19 +62,19 @@ struct ChangeView {
 // place whose appearance changed.
 struct ChangeItem {
   std::string id;
-  int number = 0;     // 1, 2, ... in report order: the plan's markers and the table's rows
-  std::string kind;   // "object", "geometry", "appearance"
-  std::string state;  // objects: new, removed, moved; geometry: appeared, vanished; appearance: changed
-  std::string label;  // objects: the class; geometry: "N voxels"; appearance: "N regions"
-  double confidence = 0.0;                  // in [0, 1]
+  int number = 0;           // 1, 2, ... in report order: the plan's markers and the table's rows
+  std::string kind;         // "object", "geometry", "appearance"
+  std::string state;        // objects: new, removed, moved; geometry: appeared, vanished; appearance: changed
+  std::string label;        // objects: the class; geometry: "N voxels"; appearance: "N regions"
+  double confidence = 0.0;  // in [0, 1]
   std::optional<Eigen::Vector3d> position;  // world frame [m]; the camera's for appearance; none without poses
   std::optional<Eigen::Vector3d> from;      // moved objects: the prior position
   ChangeView before, after;
 };
 
 struct ReportOptions {
-  int crop_size_px = 240;       // the longer side of each before/after picture
-  double crop_margin = 0.6;     // a crop extends the change's box by this share of its size on each side
+  int crop_size_px = 240;          // the longer side of each before/after picture
+  double crop_margin = 0.6;        // a crop extends the change's box by this share of its size on each side
   double max_view_range_m = 30.0;  // kept frames farther from the change do not show it
 };
 

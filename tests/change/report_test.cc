@@ -1,0 +1,171 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "change/fixtures.h"
+#include "patrolmap/change/report.h"
+#include "test_util.h"
+
+namespace patrolmap::change {
+namespace {
+
+using testing_fixtures::kCamera;
+using testing_fixtures::LookingAlongX;
+
+// A patrol that kept two frames: frame 0 from the origin, frame 1 from 3 m further back and 2 m to the left,
+// both looking along x at the box 10 m ahead.
+PatrolRecord Patrol(const std::string& flight, TimestampNs offset_ns) {
+  PatrolRecord record;
+  record.flight = flight;
+  record.camera = kCamera;
+  std::vector<unsigned char> jpeg;
+  cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC1, cv::Scalar(128)), jpeg);
+  for (int i = 0; i < 2; ++i) {
+    RouteFrame frame;
+    frame.timestamp_ns = offset_ns + i;
+    frame.frame_index = i;
+    frame.pose = LookingAlongX(Eigen::Vector3d(-3.0 * i, 2.0 * i, 0.0));
+    frame.jpeg = jpeg;
+    record.route.push_back(frame);
+    record.views.push_back(*frame.pose);
+  }
+  return record;
+}
+
+struct Scene {
+  graph::TopoMap map;
+  ChangeReport report;
+};
+
+// Object 7 of patrol b, a crate at 10 m, is new.
+Scene NewCrate() {
+  Scene scene;
+  PatrolRecord prior = Patrol("a", 0), current = Patrol("b", 100);
+  MapObject crate;
+  crate.id = 7;
+  crate.label = "crate";
+  crate.box_min = Eigen::Vector3d(9.5, -0.5, -0.5);
+  crate.box_max = Eigen::Vector3d(10.5, 0.5, 0.5);
+  current.objects.push_back(crate);
+  scene.map.SetPatrol(prior);
+  scene.map.SetPatrol(current);
+  scene.report.prior_flight = "a";
+  scene.report.current_flight = "b";
+  scene.report.objects_compared = true;
+  ObjectChange change;
+  change.state = ObjectState::kNew;
+  change.label = "crate";
+  change.confidence = 0.8;
+  change.current_id = 7;
+  change.after = Eigen::Vector3d(10.0, 0.0, 0.0);
+  scene.report.objects.push_back(change);
+  return scene;
+}
+
+int RedPixels(const cv::Mat& bgr) {
+  int red = 0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+      red += p[2] > 180 && p[1] < 80 && p[0] < 80;
+    }
+  }
+  return red;
+}
+
+TEST(ReportItems, ANewObjectIsShownFromBothPatrolsBestFrames) {
+  const Scene scene = NewCrate();
+  const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  ASSERT_EQ(items.size(), 1u);
+  const ChangeItem& item = items[0];
+  EXPECT_EQ(item.id, "object-p-1-c7");
+  EXPECT_EQ(item.number, 1);
+  EXPECT_EQ(item.kind, "object");
+  EXPECT_EQ(item.state, "new");
+  EXPECT_EQ(item.after.flight, "b");
+  EXPECT_EQ(item.after.frame_index, 0);  // the nearer, straight-on view
+  EXPECT_EQ(item.after.timestamp_ns, 100);
+  EXPECT_EQ(item.before.flight, "a");  // where it now stands, seen by the prior patrol
+  EXPECT_EQ(item.before.frame_index, 0);
+  ASSERT_FALSE(item.after.image.empty());
+  EXPECT_EQ(std::max(item.after.image.cols, item.after.image.rows), ReportOptions().crop_size_px);
+  EXPECT_GT(RedPixels(item.after.image), 50);  // the box is outlined
+}
+
+// A voxel the current patrol found occupied between the first frame and the crate: the other frame shows it.
+TEST(ReportItems, AFrameWhoseViewTheGridBlocksIsPassedOver) {
+  Scene scene = NewCrate();
+  PatrolRecord current = *scene.map.Patrol("b");
+  current.grid.voxel_size = 0.2;
+  VoxelEvidence wall;
+  wall.x = 25;  // 5 m ahead of the first frame, beside the second one's line of sight
+  wall.hits = 6;
+  current.grid.voxels.push_back(wall);
+  scene.map.SetPatrol(current);
+  const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  ASSERT_EQ(items.size(), 1u);
+  EXPECT_EQ(items[0].after.frame_index, 1);
+  EXPECT_EQ(items[0].before.frame_index, 0);  // the prior patrol's grid is empty
+}
+
+TEST(ReportItems, NothingShowsAChangeOutOfEveryFramesView) {
+  Scene scene = NewCrate();
+  PatrolRecord current = *scene.map.Patrol("b");
+  current.objects[0].box_min = Eigen::Vector3d(-10.5, -0.5, -0.5);  // behind the camera
+  current.objects[0].box_max = Eigen::Vector3d(-9.5, 0.5, 0.5);
+  scene.map.SetPatrol(current);
+  const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  ASSERT_EQ(items.size(), 1u);
+  EXPECT_EQ(items[0].after.frame_index, -1);
+  EXPECT_TRUE(items[0].after.image.empty());
+}
+
+TEST(ChangeReportPage, HasAMarkerARowAndBothPicturesPerChange) {
+  const Scene scene = NewCrate();
+  const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  const std::string html = ToHtml(scene.report, scene.map, items, std::nullopt, "pictures");
+  EXPECT_NE(html.find("class='marker' data-id='object-p-1-c7'"), std::string::npos);
+  EXPECT_NE(html.find("<tr id='row-object-p-1-c7'"), std::string::npos);
+  EXPECT_NE(html.find("src='pictures/object-p-1-c7-before.jpg'"), std::string::npos);
+  EXPECT_NE(html.find("src='pictures/object-p-1-c7-after.jpg'"), std::string::npos);
+  EXPECT_NE(html.find("1 change."), std::string::npos);
+  EXPECT_NE(html.find("not in the prior patrol's map"), std::string::npos);
+  // Without a folder the pictures are embedded.
+  EXPECT_NE(ToHtml(scene.report, scene.map, items, std::nullopt, "").find("src='data:image/png;base64,"),
+            std::string::npos);
+}
+
+TEST(ChangeReportGeo, PutsTheChangeAtItsLongitudeAndLatitude) {
+  const Scene scene = NewCrate();
+  const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  GeoReference geo;
+  geo.origin_latitude = 47.0;
+  geo.origin_longitude = 8.0;
+  const nlohmann::json document = nlohmann::json::parse(ToGeoJson(scene.report, scene.map, items, geo));
+  EXPECT_EQ(document["type"], "FeatureCollection");
+  const nlohmann::json& point = document["features"].back();
+  EXPECT_EQ(point["properties"]["id"], "object-p-1-c7");
+  const Eigen::Vector2d expected = geo.LatitudeLongitude(Eigen::Vector3d(10.0, 0.0, 0.0));
+  EXPECT_DOUBLE_EQ(point["geometry"]["coordinates"][0].get<double>(), expected.y());  // longitude first
+  EXPECT_DOUBLE_EQ(point["geometry"]["coordinates"][1].get<double>(), expected.x());
+  EXPECT_NEAR(expected.y() - 8.0, 10.0 / (6378137.0 * std::cos(47.0 * M_PI / 180.0)) * 180.0 / M_PI, 1e-12);
+  const std::string kml = ToKml(scene.report, scene.map, items, geo, "pictures");
+  EXPECT_NE(kml.find("<Placemark id=\"object-p-1-c7\">"), std::string::npos);
+  EXPECT_NE(kml.find("pictures/object-p-1-c7-after.jpg"), std::string::npos);
+}
+
+TEST(WriteChangeReport, WritesThePicturesBesideThePage) {
+  testing::TempDir dir;
+  const Scene scene = NewCrate();
+  ASSERT_TRUE(WriteChangeReport(scene.report, scene.map, dir / "out").ok());
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/changes_images/object-p-1-c7-after.jpg"));
+  EXPECT_FALSE(cv::imread(dir / "out/changes_images/object-p-1-c7-before.jpg").empty());
+  const nlohmann::json json = nlohmann::json::parse(testing::ReadText(dir / "out/changes.json"));
+  EXPECT_EQ(json["changes"][0]["after"]["image"], "changes_images/object-p-1-c7-after.jpg");
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/changes.geojson"));  // no GPS
+}
+
+}  // namespace
+}  // namespace patrolmap::change
