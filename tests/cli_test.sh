@@ -84,7 +84,7 @@ expect "geojson without gps" 1 "no node has a GPS position" -- "$bin" export "$w
 # The HTML page in headless Chromium: it initialises without a script error and shows node 0's key frame.
 expect "export html" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format html --out "$work/map.html"
 chrome_profile=$(mktemp -d)
-expect "html in chromium" 0 'data-ready="6 nodes".*node 0 - street-1.*src="data:image/png;base64,' -- \
+expect "html in chromium" 0 'data-ready="6 nodes, [0-9]+ loop closures?".*node 0 \(street-1.*src="data:image/png;base64,' -- \
   bash -c "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
     --disable-background-networking --disable-component-update --disable-sync --user-data-dir=$chrome_profile \
     --dump-dom file://$work/map.html 2>/dev/null | tr -d '\n'"

@@ -183,8 +183,9 @@ Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_poin
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
                         const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
                         const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups,
-                        const std::vector<std::uint32_t>* candidate_groups) {
+                        const std::vector<std::uint32_t>* candidate_groups, std::vector<std::pair<int, int>>* inliers) {
   Verification verification;
+  if (inliers != nullptr) inliers->clear();
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
   std::vector<std::pair<int, int>> matches;
   if (query_groups != nullptr && candidate_groups != nullptr) {
@@ -207,6 +208,9 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPo
       cv::findFundamentalMat(from, to, MethodFlag(options.method), options.inlier_threshold_px, 0.999, 2000, mask);
   if (f.rows < 3 || f.cols != 3) return verification;
   verification.inliers = cv::countNonZero(mask);
+  for (std::size_t k = 0; inliers != nullptr && k < mask.size(); ++k) {
+    if (mask[k] != 0) inliers->push_back(matches[k]);
+  }
   verification.log_nfa = LogNumberOfFalseAlarms(cv::Matx33d(f.rowRange(0, 3)), from, to, ExtentOf(query_points),
                                                 ExtentOf(candidate_points));
   verification.accepted = verification.inliers >= options.min_inliers && verification.log_nfa <= options.max_log_nfa;

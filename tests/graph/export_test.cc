@@ -83,5 +83,24 @@ TEST(Export, SvgColoursLoopClosuresByTruth) {
   EXPECT_NE(judged.find("missed loop closure"), std::string::npos);
 }
 
+// Two nodes of one place laid out at one spot: their loop closure is a ring around them, not a line of no
+// length; the others are curves. Each is a clickable group naming its index.
+TEST(Export, ClosuresBetweenCoincidentNodesAreRings) {
+  TopoMap map = TwoFlights();
+  map.mutable_node(4).layout = map.node(1).layout;  // closure 4~1
+  const std::string svg = ToSvg(map);
+  EXPECT_EQ(CountOf(svg, "class='closure'"), 3u);
+  EXPECT_NE(svg.find("<g class='closure' data-edge='0'><circle"), std::string::npos);
+  EXPECT_NE(svg.find("<g class='closure' data-edge='1'><path d='M"), std::string::npos);
+  // The page keeps the legend out of the drawing and carries each closure's matches.
+  std::vector<ClosureMatches> matches(3);
+  matches[1].pairs = {{1.5f, 2.0f, 3.0f, 4.0f}};
+  const std::string html = ToHtml(map, nullptr, &matches);
+  EXPECT_EQ(html.find("<text x='10' y='18'"), std::string::npos);
+  EXPECT_NE(html.find("<div class='legend'>"), std::string::npos);
+  EXPECT_NE(html.find("\"matches\":[[1.5,2.0,3.0,4.0]]"), std::string::npos);
+  EXPECT_NE(html.find("7 nodes, 3 loop closures, 2 flights."), std::string::npos);
+}
+
 }  // namespace
 }  // namespace patrolmap::graph

@@ -11,6 +11,7 @@
 #include "patrolmap/graph/export.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
+#include "patrolmap/pipeline/closure_matches.h"
 
 namespace patrolmap::tools {
 namespace {
@@ -54,13 +55,15 @@ Status SvgTruthFromLogs(const graph::TopoMap& map, const std::vector<std::string
 }
 
 // SVG or HTML, with the loop closures judged when logs are given.
+// The page shows each loop closure's verified matches (found again with the default place options).
 std::string Picture(const graph::TopoMap& map, const ExportArguments& arguments, Status* status) {
-  const bool html = arguments.format == "html";
-  if (arguments.logs.empty()) return html ? graph::ToHtml(map) : graph::ToSvg(map);
   graph::SvgTruth truth;
-  *status = SvgTruthFromLogs(map, arguments.logs, &truth);
+  if (!arguments.logs.empty()) *status = SvgTruthFromLogs(map, arguments.logs, &truth);
   if (!status->ok()) return std::string();
-  return html ? graph::ToHtml(map, &truth) : graph::ToSvg(map, &truth);
+  const graph::SvgTruth* judged = arguments.logs.empty() ? nullptr : &truth;
+  if (arguments.format != "html") return graph::ToSvg(map, judged);
+  const std::vector<graph::ClosureMatches> matches = pipeline::MatchClosures(map, place::PlaceOptions());
+  return graph::ToHtml(map, judged, &matches);
 }
 
 int RunExport(const ExportArguments& arguments) {

@@ -1,4 +1,4 @@
-// Exports of the topological map for the tools people already use.
+// Exports of the topological map for the tools people already use, one file per format (export_*.cc).
 //  - GraphML (NetworkX, Gephi, yEd) with typed attributes at full precision
 //    (17 significant digits: Boost's write_graphml keeps 6, which loses metres
 //    of a latitude);
@@ -8,6 +8,7 @@
 //  - SVG of the layout.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -32,11 +33,20 @@ std::string ToSvg(const TopoMap& map, const SvgTruth* truth = nullptr);
 // a point per node, a line per flight, a line per loop closure. Only for maps
 // whose nodes have GPS positions (HasGps).
 bool HasGps(const TopoMap& map);
-// One self-contained HTML page (no network at view time): the layout picture,
-// pan by dragging and zoom with the wheel; clicking a node shows its key-frame
-// thumbnail (embedded as PNG), flight, time and loop closures; node 0 is shown
-// at first. When the page has initialised, <body> carries data-ready="N nodes".
-std::string ToHtml(const TopoMap& map, const SvgTruth* truth = nullptr);
+// The verified matches of one loop closure, in its two nodes' thumbnail pixels: x, y in the first node's
+// (the edge's a), then x, y in the second's (pipeline::MatchClosures).
+struct ClosureMatches {
+  std::vector<std::array<float, 4>> pairs;
+};
+
+// One self-contained HTML page (no network at view time): the layout picture, fitted to the window, pan by
+// dragging and zoom with the wheel, the legend beside it. Clicking a node shows its key-frame thumbnail
+// (embedded as PNG), flight, time and loop closures; clicking a loop closure shows both key frames side by
+// side with its verified matches drawn (`matches`: one per closure in Edges() order, or null). Node 0 is shown
+// at first, or the one the address names (map.html#node=3, map.html#closure=1). When the page has initialised, <body>
+// carries data-ready="N nodes, M loop closures".
+std::string ToHtml(const TopoMap& map, const SvgTruth* truth = nullptr,
+                   const std::vector<ClosureMatches>* matches = nullptr);
 std::string ToGeoJson(const TopoMap& map);
 std::string ToKml(const TopoMap& map);
 

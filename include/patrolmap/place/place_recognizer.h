@@ -112,10 +112,12 @@ struct PlaceResult {
 
 // Verifies two described frames: ratio-test matching (within equal direct-index groups when both are given),
 // the matched-fraction rule, a fundamental matrix by `options.method`, and the inlier and a-contrario rules.
+// With `inliers`, the fundamental matrix's inlier matches as (query feature, candidate feature) pairs.
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
                         const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
                         const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups = nullptr,
-                        const std::vector<std::uint32_t>* candidate_groups = nullptr);
+                        const std::vector<std::uint32_t>* candidate_groups = nullptr,
+                        std::vector<std::pair<int, int>>* inliers = nullptr);
 
 class PlaceRecognizer {
  public:
