@@ -79,6 +79,41 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
 }
 
 // A run's warnings say why nothing was found and what to change.
+// The response plot labels key locations with their node ids, draws the ground truth and marks the false
+// key locations; without truth it does not offer a legend entry for it.
+TEST(ResponsePlot, DrawsTheTruthAndTheNodeIdsOfNodesCsv) {
+  DetectionResult result;
+  for (int i = 0; i < 50; ++i) {
+    FlowSample sample;
+    sample.timestamp_ns = SecondsToNs(0.1 * i);
+    sample.raw_response = sample.smoothed_response = 0.1 + 0.01 * (i % 7);
+    result.samples.push_back(sample);
+  }
+  result.key_locations = {{0, SecondsToNs(1.0), 10, 0.12, ExtremumKind::kPeak},
+                          {1, SecondsToNs(3.0), 30, 0.11, ExtremumKind::kValley}};
+  const std::string plain = ResponsePlotSvg(result, PlotTruth());
+  EXPECT_EQ(plain.find("ground-truth edge"), std::string::npos);
+  EXPECT_NE(plain.find("2 key locations"), std::string::npos);
+  const std::size_t valley = plain.find("fill='#1d4ed8'/><text");  // the second key location's marker
+  ASSERT_NE(valley, std::string::npos);
+  EXPECT_EQ(plain.find("</text>", valley) - plain.find(">", plain.find("<text", valley)), 2u);  // labelled "1"
+  const auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  PlotTruth truth;
+  truth.times_s = {1.05, 2.0};
+  truth.correct = {true, false};
+  truth.node_ids = {17, 18};
+  const std::string judged = ResponsePlotSvg(result, truth);
+  EXPECT_NE(judged.find("ground-truth edge"), std::string::npos);
+  EXPECT_EQ(count(judged, "stroke='#2a9d3a' stroke-dasharray='4 3'"), 3u);  // two edges and the legend's
+  EXPECT_EQ(count(judged, "class='false'"), 1u);
+  EXPECT_NE(judged.find(">17</text>"), std::string::npos);
+  EXPECT_NE(judged.find(">18</text>"), std::string::npos);
+}
+
 TEST(DetectionWarnings, ShortFlatAndUntimedLogsAreExplained) {
   io::LogInfo info;
   info.path = "log";

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "patrolmap/eval/key_location_score.h"
 #include "patrolmap/pipeline/detect.h"
 
 namespace patrolmap::pipeline {
@@ -77,21 +78,32 @@ void Axes(const PlotFrame& frame, std::ostringstream* svg) {
        << "transform='rotate(-90 18 " << (frame.top + frame.bottom) / 2 << ")'>response [image widths / s]</text>\n";
 }
 
+// A key location: filled by its kind (peak red, valley blue); judged false, a hollow ring with a cross.
 void Markers(const DetectionResult& result, const PlotTruth& truth, const PlotFrame& frame, std::ostringstream* svg) {
   for (double t : truth.times_s) {
     *svg << "<line x1='" << Number(frame.X(t)) << "' x2='" << Number(frame.X(t)) << "' y1='" << frame.top << "' y2='"
          << frame.bottom << "' stroke='#2a9d3a' stroke-dasharray='4 3'/>\n";
   }
-  for (const KeyLocation& node : result.key_locations) {
+  for (std::size_t k = 0; k < result.key_locations.size(); ++k) {
+    const KeyLocation& node = result.key_locations[k];
     const double x = frame.X(NsToSeconds(node.timestamp_ns)), y = frame.Y(node.response);
     const char* colour = node.kind == ExtremumKind::kPeak ? "#d62828" : "#1d4ed8";
-    *svg << "<circle cx='" << Number(x) << "' cy='" << Number(y) << "' r='6' fill='" << colour << "'/>"
-         << "<text x='" << Number(x) << "' y='" << Number(y - 10) << "' font-size='11' text-anchor='middle'>"
-         << node.node_index << "</text>\n";
+    const bool wrong = k < truth.correct.size() && !truth.correct[k];
+    const int id = k < truth.node_ids.size() ? truth.node_ids[k] : node.node_index;
+    if (wrong) {
+      *svg << "<circle class='false' cx='" << Number(x) << "' cy='" << Number(y) << "' r='6' fill='white' stroke='"
+           << colour << "' stroke-width='2'/><path d='M" << Number(x - 4) << "," << Number(y - 4)
+           << " l8,8 m0,-8 l-8,8'"
+           << " stroke='" << colour << "' stroke-width='1.5'/>";
+    } else {
+      *svg << "<circle cx='" << Number(x) << "' cy='" << Number(y) << "' r='6' fill='" << colour << "'/>";
+    }
+    *svg << "<text x='" << Number(x) << "' y='" << Number(y - 10) << "' font-size='11' text-anchor='middle'>"
+         << (id >= 0 ? std::to_string(id) : std::string("-")) << "</text>\n";
   }
 }
 
-void Legend(const PlotFrame& frame, std::ostringstream* svg) {
+void Legend(const PlotFrame& frame, const PlotTruth& truth, std::ostringstream* svg) {
   const double x = frame.left + 10, y = frame.top + 14;
   *svg << "<g font-size='11'>"
        << "<line x1='" << x << "' x2='" << x + 20 << "' y1='" << y << "' y2='" << y << "' stroke='#999'/>"
@@ -101,10 +113,15 @@ void Legend(const PlotFrame& frame, std::ostringstream* svg) {
        << "<circle cx='" << x + 150 << "' cy='" << y << "' r='5' fill='#d62828'/><text x='" << x + 158 << "' y='"
        << y + 4 << "'>peak</text>"
        << "<circle cx='" << x + 200 << "' cy='" << y << "' r='5' fill='#1d4ed8'/><text x='" << x + 208 << "' y='"
-       << y + 4 << "'>valley</text>"
-       << "<line x1='" << x + 255 << "' x2='" << x + 275 << "' y1='" << y << "' y2='" << y
-       << "' stroke='#2a9d3a' stroke-dasharray='4 3'/><text x='" << x + 279 << "' y='" << y + 4
-       << "'>ground-truth edge</text></g>\n";
+       << y + 4 << "'>valley</text>";
+  if (!truth.times_s.empty()) {
+    *svg << "<line x1='" << x + 255 << "' x2='" << x + 275 << "' y1='" << y << "' y2='" << y
+         << "' stroke='#2a9d3a' stroke-dasharray='4 3'/><text x='" << x + 279 << "' y='" << y + 4
+         << "'>ground-truth edge</text><circle cx='" << x + 390 << "' cy='" << y << "' r='5' fill='white' "
+         << "stroke='#444' stroke-width='2'/><text x='" << x + 398 << "' y='" << y + 4 << "'>false key location</text>";
+  }
+  *svg << "<text x='" << x + (truth.times_s.empty() ? 255 : 515) << "' y='" << y + 4 << "'>"
+       << (truth.node_ids.empty() ? "numbers: key locations" : "numbers: node ids of nodes.csv") << "</text></g>\n";
 }
 
 }  // namespace
@@ -129,20 +146,30 @@ std::string ResponseCsv(const std::vector<FlowSample>& samples) {
   return csv.str();
 }
 
+PlotTruth LoadPlotTruth(const std::string& log, const std::vector<KeyLocation>& key_locations) {
+  PlotTruth truth;
+  std::vector<eval::TruthEdge> edges;
+  if (!eval::ReadTruthEdges(log, &edges).ok()) return truth;
+  for (const eval::TruthEdge& edge : edges) truth.times_s.push_back(NsToSeconds(edge.timestamp_ns));
+  const eval::KeyLocationScore score = eval::ScoreKeyLocations(key_locations, edges);
+  for (eval::Verdict verdict : score.verdicts) truth.correct.push_back(verdict == eval::Verdict::kTruePositive);
+  return truth;
+}
+
 std::string ResponsePlotSvg(const DetectionResult& result, const PlotTruth& truth) {
   std::ostringstream svg;
   svg << "<?xml version='1.0' encoding='UTF-8'?>\n"
       << "<svg xmlns='http://www.w3.org/2000/svg' width='1160' height='380' font-family='sans-serif'>\n"
       << "<rect width='100%' height='100%' fill='#f4f4f4'/>\n"
-      << "<text x='580' y='22' font-size='14' text-anchor='middle'>scene-flow response and key locations ("
-      << result.key_locations.size() << " nodes)</text>\n";
+      << "<text x='580' y='22' font-size='14' text-anchor='middle'>scene-flow response: " << result.key_locations.size()
+      << (result.key_locations.size() == 1 ? " key location" : " key locations") << "</text>\n";
   if (!result.samples.empty()) {
     const PlotFrame frame = FitFrame(result.samples);
     Axes(frame, &svg);
     Polyline(result.samples, frame, false, "stroke='#999' stroke-width='1'", &svg);
     Polyline(result.samples, frame, true, "stroke='black' stroke-width='2'", &svg);
     Markers(result, truth, frame, &svg);
-    Legend(frame, &svg);
+    Legend(frame, truth, &svg);
   }
   svg << "</svg>\n";
   return svg.str();

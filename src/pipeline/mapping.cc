@@ -72,11 +72,25 @@ void LogRecord(const FlightResult& flight) {
   }
 }
 
-Status WriteFlightOutputs(const MappingRequest& request, const io::LogInfo& info, const FlightResult& flight) {
+// The plot's truth (when the log has it) and each key location's node id in nodes.csv.
+PlotTruth FlightPlotTruth(const io::LogInfo& info, const FlightResult& flight, const MapResult& places) {
+  PlotTruth truth = LoadPlotTruth(info.path, flight.detection.key_locations);
+  for (const KeyLocation& key_location : flight.detection.key_locations) {
+    const auto node = std::find_if(places.nodes.begin(), places.nodes.end(), [&](const MapNode& n) {
+      return n.flight == info.flight_id && n.frame_index == key_location.frame_index;
+    });
+    truth.node_ids.push_back(node == places.nodes.end() ? -1 : node->node);
+  }
+  return truth;
+}
+
+Status WriteFlightOutputs(const MappingRequest& request, const io::LogInfo& info, const FlightResult& flight,
+                          const MapResult& places) {
   switch (request.outputs) {
     case FlightOutputs::kDetection:
       return WriteDetectionOutputs(flight.detection,
-                                   request.sources.size() > 1 ? request.out + "/" + info.flight_id : request.out);
+                                   request.sources.size() > 1 ? request.out + "/" + info.flight_id : request.out,
+                                   FlightPlotTruth(info, flight, places));
     case FlightOutputs::kKeyLocations:
       return WriteFileAtomically(request.out + "/key_locations.csv", KeyLocationsCsv(flight.detection.key_locations));
     case FlightOutputs::kNone: return Status::Ok();
@@ -105,7 +119,7 @@ Status MapSource(const MappingRequest& request, const std::string& spec, const C
   if (run.drive.interrupted) spdlog::info("{}: stop requested: writing the map", spec);
   for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
   LogRecord(run.result);
-  return WriteFlightOutputs(request, info, run.result);
+  return WriteFlightOutputs(request, info, run.result, outcome->places);
 }
 
 // The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes.

@@ -37,14 +37,6 @@ Status ApplyOverrides(const DetectArguments& arguments, pipeline::Config* config
   return Status::Ok();
 }
 
-pipeline::PlotTruth LoadPlotTruth(const std::string& log) {
-  pipeline::PlotTruth truth;
-  std::vector<eval::TruthEdge> edges;
-  if (!eval::ReadTruthEdges(log, &edges).ok()) return truth;
-  for (const eval::TruthEdge& edge : edges) truth.times_s.push_back(NsToSeconds(edge.timestamp_ns));
-  return truth;
-}
-
 void PrintSummary(const DetectArguments& arguments, const pipeline::DetectionResult& result) {
   int peaks = 0;
   for (const KeyLocation& node : result.key_locations) peaks += node.kind == ExtremumKind::kPeak;
@@ -82,7 +74,8 @@ int RunDetect(const DetectArguments& arguments) {
   if (config.flow.response.derotate_with_imu && !result.derotated && source->info().has_imu) {
     spdlog::warn("{}: IMU present but camera extrinsics unknown: flow not de-rotated", arguments.log);
   }
-  status = pipeline::WriteDetectionOutputs(result, arguments.out, LoadPlotTruth(arguments.log));
+  status = pipeline::WriteDetectionOutputs(result, arguments.out,
+                                           pipeline::LoadPlotTruth(arguments.log, result.key_locations));
   if (!status.ok()) return Fail(status);
   PrintSummary(arguments, result);
   return 0;

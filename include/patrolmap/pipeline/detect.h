@@ -36,10 +36,17 @@ using FrameProgress = std::function<void(std::int64_t, std::int64_t)>;
 Status RunDetection(io::FrameSource* source, const flow::KeyLocationOptions& options, DetectionResult* result,
                     const FrameProgress& progress = {});
 
-// Optional ground truth to draw on the plot: times of true key locations [s].
+// What the plot can add to the detection: the ground truth where the log has it, and the map's node ids.
 struct PlotTruth {
-  std::vector<double> times_s;
+  std::vector<double> times_s;  // true key locations (groundtruth/key_locations.csv) [s]; none: no truth
+  std::vector<bool> correct;    // per key location, as `patrolmap eval` judges it (empty: unjudged)
+  std::vector<int> node_ids;    // per key location: its id in nodes.csv, -1 when it made no node
+                                // (empty: the detector's own numbering)
 };
+
+// The plot truth of the key locations of `log` (its groundtruth/ folder; nothing when it has none), judged as
+// `patrolmap eval` does.
+PlotTruth LoadPlotTruth(const std::string& log, const std::vector<KeyLocation>& key_locations);
 
 // Writes DIR/key_locations.csv, DIR/response.csv and DIR/response.svg (a plot
 // like paper 002 Fig. 3: raw and smoothed response, key locations marked).
