@@ -42,12 +42,12 @@ expect "eval without outputs" 1 "holds none of key_locations.csv, loop_closures.
 expect "unknown route" 2 "unknown route 'zigzag'" -- "$bin" simulate --route zigzag --out "$work/z"
 
 # Place recognition: map the sample with the shipped vocabulary; bad vocabularies are named.
-expect "map sample" 0 "1 log\(s\): 3 nodes" -- \
+expect "map sample" 0 "1 log: 3 nodes" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/map"
 [[ -s "$work/map/nodes.csv" && -s "$work/map/loop_closures.csv" ]] || { echo "FAIL map outputs missing"; failures=$((failures + 1)); }
-expect "info" 0 "map.pmap: .* KB, 1 flights, 3 nodes, 2 traversals" -- "$bin" info "$work/map/map.pmap"
+expect "info" 0 "map.pmap: .* KB, 1 flight, 3 nodes, 2 traversals" -- "$bin" info "$work/map/map.pmap"
 "$bin" -q simulate --route street --walls 3 --speed 4 --resolution 160x102 --plain-lighting --seed 2 --out "$work/second" >/dev/null
-expect "patrol" 0 "1 log\\(s\\): 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
+expect "patrol" 0 "1 log: 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"
 expect "patrol extends the map" 0 "2 flights, 6 nodes" -- "$bin" info "$work/patrol/map.pmap"
 head -c 300 "$work/map/map.pmap" > "$work/cut.pmap"
@@ -103,7 +103,7 @@ expect "vocab build bad k" 1 "branching k must be in" -- \
 
 # Real use: run from another folder with the shipped vocabulary found beside the binary's sources; a missing
 # log is named before anything else; a patrol with another vocabulary names both files.
-expect "map from another folder" 0 "1 log\(s\): 3 nodes" -- \
+expect "map from another folder" 0 "1 log: 3 nodes" -- \
   bash -c "cd '$work' && '$bin' map '$source_dir/flight_logs/sample' --out '$work/elsewhere'"
 expect "missing log first" 1 "$work/no_log: no such file or folder" -- \
   "$bin" map "$work/no_log" --vocabulary "$work/nothing.pmvoc" --config "$work/nothing.yaml" --out "$work/m4"

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "patrolmap/core/words.h"
 #include "patrolmap/graph/export.h"
 #include "report_plan.h"
 
@@ -20,7 +21,7 @@ std::string Number(double value, int decimals = 2) {
 }
 
 // "1 place", "3 places".
-std::string Count(long long n, const char* one, const char* many) {
+std::string Counted(long long n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
@@ -112,10 +113,10 @@ std::string Reason(const ObjectChange& o) {
       return "moved " + Number((*o.after - *o.before).head<2>().norm(), 1) + " m, turned " +
              Number(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) + "&#176;";
     case ObjectState::kRemoved:
-      return Count(o.covering_views, "view", "views") + " of this patrol covered it (about " +
+      return Counted(o.covering_views, "view", "views") + " of this patrol covered it (about " +
              Number(o.expected_detections, 1) + " detections expected); none found it";
     case ObjectState::kUnobserved:
-      return "this patrol did not look at it closely enough to tell (" + Count(o.covering_views, "view", "views") +
+      return "this patrol did not look at it closely enough to tell (" + Counted(o.covering_views, "view", "views") +
              ", about " + Number(o.expected_detections, 1) + " detections expected)";
   }
   return "";
@@ -142,8 +143,8 @@ const char* DepthWords(const std::string& source) {
 }
 
 void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, std::ostringstream* html) {
-  *html << "<p class='summary'>" << Count(static_cast<long long>(items.size()), "change", "changes") << ". "
-        << Count(static_cast<long long>(report.places.size()), "place", "places") << " seen by both patrols, "
+  *html << "<p class='summary'>" << Counted(static_cast<long long>(items.size()), "change", "changes") << ". "
+        << Counted(static_cast<long long>(report.places.size()), "place", "places") << " seen by both patrols, "
         << report.ChangedPlaces() << " changed in appearance.";
   if (report.objects_compared) {
     *html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)
@@ -153,7 +154,7 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
   }
   if (report.geometry_compared) {
     *html << " Geometry: "
-          << Count(static_cast<long long>(report.geometry.regions.size()), "changed region", "changed regions")
+          << Counted(static_cast<long long>(report.geometry.regions.size()), "changed region", "changed regions")
           << " (depth from " << DepthWords(report.geometry.depth_prior) << " before, "
           << DepthWords(report.geometry.depth_current) << " now).";
     if (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0) {

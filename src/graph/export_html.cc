@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "export_common.h"
+#include "patrolmap/core/words.h"
 #include "patrolmap/graph/export.h"
 
 namespace patrolmap::graph {
@@ -119,19 +120,15 @@ void Legend(const TopoMap& map, const SvgTruth* truth, std::ostringstream* out) 
   *out << "</div>";
 }
 
-std::string Counted(std::size_t n, const char* one, const char* many) {
-  return std::to_string(n) + " " + (n == 1 ? one : many);
-}
-
 }  // namespace
 
 std::string ToHtml(const TopoMap& map, const SvgTruth* truth, const std::vector<ClosureMatches>* matches) {
   std::ostringstream out;
   out << "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>patrolmap map</title>\n<style>" << kStyle
       << "</style></head>\n<body>\n<div id='map'>" << SvgDrawing(map, truth, false) << "</div>\n<div id='side'><h3>"
-      << "patrolmap</h3><p class='muted'>" << Counted(static_cast<std::size_t>(map.node_count()), "node", "nodes")
-      << ", " << Counted(static_cast<std::size_t>(map.loop_closure_count()), "loop closure", "loop closures") << ", "
-      << Counted(map.Flights().size(), "flight", "flights")
+      << "patrolmap</h3><p class='muted'>" << Counted(map.node_count(), "node", "nodes") << ", "
+      << Counted(map.loop_closure_count(), "loop closure", "loop closures") << ", "
+      << Counted(static_cast<long long>(map.Flights().size()), "flight", "flights")
       << ". Drag to pan, wheel to zoom; click a node or a loop closure.</p>";
   Legend(map, truth, &out);
   out << "<p id='title'></p><img id='thumb' alt=''><canvas id='pair'></canvas><p id='about' class='muted'></p>"

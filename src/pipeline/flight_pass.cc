@@ -1,4 +1,5 @@
 #include "patrolmap/pipeline/flight_pass.h"
+#include "patrolmap/core/words.h"
 
 #include <algorithm>
 #include <chrono>
@@ -232,8 +233,9 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
                        "appearance change only");
   }
   if (result.stats.lost_key_frames > 0) {
-    warnings.push_back(info.path + ": " + std::to_string(result.stats.lost_key_frames) +
-                       " key location(s) were confirmed after their frame left the ring of recent frames and are "
+    warnings.push_back(info.path + ": " +
+                       Counted(result.stats.lost_key_frames, "key location was", "key locations were") +
+                       " confirmed after their frame left the ring of recent frames and are "
                        "not in the map; raise the ring (--ring-s)");
   }
   if (result.record_stats.forgotten_objects > 0) {

@@ -53,10 +53,11 @@ void AddFpsOption(CLI::App* app, double* fps) {
 }
 
 void AddTopicOption(CLI::App* app, std::vector<std::string>* topics) {
-  app->add_option("--topic", *topics,
-                  "a ROS bag's topic for a role, as ROLE=TOPIC (roles: camera, camera_info, imu, gps, pose, depth, right); "
-                  "repeat for several; default: the first topic of each role's message type (patrolmap info BAG "
-                  "lists them)")
+  app->add_option(
+         "--topic", *topics,
+         "a ROS bag's topic for a role, as ROLE=TOPIC (roles: camera, camera_info, imu, gps, pose, depth, right); "
+         "repeat for several; default: the first topic of each role's message type (patrolmap info BAG "
+         "lists them)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }

@@ -1,4 +1,5 @@
 // patrolmap eval RUN --log LOG [--log LOG ...] [--json] [--tolerance S] [--min-span S] [--radius M] ...
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -259,10 +260,24 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
   return Status::Ok();
 }
 
+// A score right-aligned in `width` columns, or an em dash when it has no cases (a recall with nothing to find,
+// a precision with nothing reported).
+std::string Score(double value, bool defined, int width) {
+  char text[32];
+  if (defined) {
+    std::snprintf(text, sizeof(text), "%*.2f", width, value);
+    return text;
+  }
+  return std::string(static_cast<std::size_t>(std::max(0, width - 1)), ' ') + "\u2014";
+}
+
 void PrintCounts(const char* name, const nlohmann::json& c) {
-  std::printf("%-18s %5d %6d %7d %10.2f %7.2f %6.2f\n", name, c["true_positives"].get<int>(),
-              c["false_positives"].get<int>(), c["false_negatives"].get<int>(), c["precision"].get<double>(),
-              c["recall"].get<double>(), c["f1"].get<double>());
+  const int tp = c["true_positives"].get<int>(), fp = c["false_positives"].get<int>();
+  const int fn = c["false_negatives"].get<int>();
+  std::printf("%-18s %5d %6d %7d %s %s %s\n", name, tp, fp, fn,
+              Score(c["precision"].get<double>(), tp + fp > 0, 10).c_str(),
+              Score(c["recall"].get<double>(), tp + fn > 0, 7).c_str(),
+              Score(c["f1"].get<double>(), tp + fp > 0 && tp + fn > 0, 6).c_str());
 }
 
 void PrintChangeTable(const nlohmann::json& c) {
@@ -278,11 +293,13 @@ void PrintChangeTable(const nlohmann::json& c) {
   if (c.contains("appearance")) {
     const nlohmann::json& a = c["appearance"];
     const double p = a["precision"].get<double>(), r = a["recall"].get<double>();
-    std::printf("%-18s %5d %6d %7d %10.2f %7.2f %6.2f\n", "appearance regions", a["regions_on_change"].get<int>(),
-                a["regions"].get<int>() - a["regions_on_change"].get<int>(),
-                a["changes"].get<int>() - a["changes_found"].get<int>(), p, r, p + r > 0 ? 2 * p * r / (p + r) : 0.0);
+    const int regions = a["regions"].get<int>(), changes = a["changes"].get<int>();
+    std::printf("%-18s %5d %6d %7d %s %s %s\n", "appearance regions", a["regions_on_change"].get<int>(),
+                regions - a["regions_on_change"].get<int>(), changes - a["changes_found"].get<int>(),
+                Score(p, regions > 0, 10).c_str(), Score(r, changes > 0, 7).c_str(),
+                Score(p + r > 0 ? 2 * p * r / (p + r) : 0.0, regions > 0 && changes > 0, 6).c_str());
     std::printf("appearance: %d regions, %d object changes visible in the key frames of %d registered places\n",
-                a["regions"].get<int>(), a["changes"].get<int>(), a["places"].get<int>());
+                regions, changes, a["places"].get<int>());
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);
@@ -298,10 +315,11 @@ void PrintTables(const nlohmann::json& report) {
     std::printf("key locations (paper 002 Table II), tolerance %.2f s\n", k["tolerance_s"].get<double>());
     std::printf("%-20s %8s %6s %9s %5s %6s %7s %10s %7s\n", "flight", "frames", "nodes", "expected", "true", "false",
                 "missed", "precision", "recall");
-    std::printf("%-20s %8lld %6d %9d %5d %6d %7d %10.2f %7.2f\n", k["flight"].get<std::string>().c_str(),
+    std::printf("%-20s %8lld %6d %9d %5d %6d %7d %s %s\n", k["flight"].get<std::string>().c_str(),
                 k["frames"].get<long long>(), k["nodes"].get<int>(), k["expected"].get<int>(),
                 k["true_positives"].get<int>(), k["false_positives"].get<int>(), k["missed"].get<int>(),
-                k["precision"].get<double>(), k["recall"].get<double>());
+                Score(k["precision"].get<double>(), k["nodes"].get<int>() > 0, 10).c_str(),
+                Score(k["recall"].get<double>(), k["expected"].get<int>() > 0, 7).c_str());
   }
   if (report.contains("loop_closures")) {
     const nlohmann::json& l = report["loop_closures"];
@@ -309,9 +327,10 @@ void PrintTables(const nlohmann::json& report) {
                 l["radius_m"].get<double>(), l["max_heading_deg"].get<double>());
     std::printf("%6s %9s %6s %9s %6s %10s %7s\n", "nodes", "possible", "found", "reported", "false", "precision",
                 "recall");
-    std::printf("%6d %9d %6d %9d %6d %10.2f %7.2f\n", l["nodes"].get<int>(), l["possible"].get<int>(),
-                l["found"].get<int>(), l["reported"].get<int>(), l["false_positives"].get<int>(),
-                l["precision"].get<double>(), l["recall"].get<double>());
+    std::printf("%6d %9d %6d %9d %6d %s %s\n", l["nodes"].get<int>(), l["possible"].get<int>(), l["found"].get<int>(),
+                l["reported"].get<int>(), l["false_positives"].get<int>(),
+                Score(l["precision"].get<double>(), l["reported"].get<int>() > 0, 10).c_str(),
+                Score(l["recall"].get<double>(), l["possible"].get<int>() > 0, 7).c_str());
   }
   if (report.contains("changes")) PrintChangeTable(report["changes"]);
 }

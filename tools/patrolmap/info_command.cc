@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "patrolmap/core/words.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/bag.h"
 
@@ -42,9 +43,12 @@ int RunInfo(const std::string& path, bool verbose) {
     else
       ++across;
   }
-  std::printf("%s: %.1f KB, %zu flights, %d nodes, %d traversals, %d loop closures (%d within flights, %d across)\n",
-              path.c_str(), std::filesystem::file_size(path) / 1024.0, map.Flights().size(), map.node_count(),
-              traversals, within + across, within, across);
+  std::printf("%s: %.1f KB, %s, %s, %s, %s (%d within flights, %d across)\n", path.c_str(),
+              std::filesystem::file_size(path) / 1024.0,
+              Counted(static_cast<long long>(map.Flights().size()), "flight", "flights").c_str(),
+              Counted(map.node_count(), "node", "nodes").c_str(),
+              Counted(traversals, "traversal", "traversals").c_str(),
+              Counted(within + across, "loop closure", "loop closures").c_str(), within, across);
   for (const std::string& flight : map.Flights()) {
     int nodes = 0;
     double first = 0.0, last = 0.0;
@@ -54,7 +58,8 @@ int RunInfo(const std::string& path, bool verbose) {
       if (nodes++ == 0) first = t;
       last = t;
     }
-    std::printf("  flight %-24s %4d nodes, %.1f-%.1f s", flight.c_str(), nodes, first, last);
+    std::printf("  flight %-24s %9s, %.1f-%.1f s", flight.c_str(), Counted(nodes, "node", "nodes").c_str(), first,
+                last);
     const PatrolRecord* record = map.Patrol(flight);
     if (record != nullptr && record->has_objects) {
       const auto confirmed =
@@ -64,6 +69,12 @@ int RunInfo(const std::string& path, bool verbose) {
     }
     if (record != nullptr && record->grid.voxel_size > 0) {
       std::printf(", evidence grid %zu voxels of %.2f m", record->grid.voxels.size(), record->grid.voxel_size);
+    }
+    if (record != nullptr && !record->route.empty()) {
+      std::size_t bytes = 0;
+      for (const RouteFrame& frame : record->route) bytes += frame.jpeg.size();
+      std::printf(", %s along the route (%.1f MB)",
+                  Counted(static_cast<long long>(record->route.size()), "frame", "frames").c_str(), bytes / 1048576.0);
     }
     std::printf("\n");
     if (record == nullptr || !verbose) continue;

@@ -6,6 +6,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "patrolmap/core/words.h"
 #include "patrolmap/pipeline/mapping.h"
 #include "progress.h"
 
@@ -21,11 +22,13 @@ void PrintSummary(const pipeline::MappingOutcome& outcome, const std::string& ou
   const pipeline::MapResult& result = outcome.places;
   const double nodes = std::max<std::size_t>(1, result.nodes.size());
   std::printf(
-      "%zu log(s): %zu nodes, %zu loop closures; per key frame %.1f ms features, %.2f ms query, %.1f ms "
+      "%s: %s, %s; per key frame %.1f ms features, %.2f ms query, %.1f ms "
       "verification, %.2f ms database update; outputs in %s\n",
-      outcome.flights.size(), result.nodes.size(), result.loop_closures.size(), 1e3 * result.seconds_features / nodes,
-      1e3 * result.seconds_query / nodes, 1e3 * result.seconds_verify / nodes, 1e3 * result.seconds_add / nodes,
-      out.c_str());
+      Counted(static_cast<long long>(outcome.flights.size()), "log", "logs").c_str(),
+      Counted(static_cast<long long>(result.nodes.size()), "node", "nodes").c_str(),
+      Counted(static_cast<long long>(result.loop_closures.size()), "loop closure", "loop closures").c_str(),
+      1e3 * result.seconds_features / nodes, 1e3 * result.seconds_query / nodes, 1e3 * result.seconds_verify / nodes,
+      1e3 * result.seconds_add / nodes, out.c_str());
 }
 
 int RunMap(MapArguments arguments) {
