@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -288,7 +289,13 @@ std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::Top
   for (const PlaceChange& place : report.places) {
     if (!place.appearance.regions.empty()) items.push_back(AppearanceItem(map, place, options));
   }
-  for (std::size_t i = 0; i < items.size(); ++i) items[i].number = static_cast<int>(i) + 1;
+  // Regions in one 2 m cell share their id (one onboard event each); in the report the later ones get "-2", ...
+  std::map<std::string, int> seen;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    items[i].number = static_cast<int>(i) + 1;
+    const int repeat = ++seen[items[i].id];
+    if (repeat > 1) items[i].id += "-" + std::to_string(repeat);
+  }
   return items;
 }
 

@@ -2,7 +2,7 @@
 // beside a table of the changes with their before and after pictures (a click on a marker selects its row and
 // a click on a row its marker), then every object with the reason for its state. Pictures are files in the
 // images folder, loaded lazily, or embedded when there is none. No network at view time. When the page has
-// initialised, <body> carries data-ready="N markers".
+// initialised, <body> carries data-ready="N markers" and data-ready-ms, the milliseconds it took to get there.
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -31,7 +31,8 @@ header{padding:12px 20px;border-bottom:1px solid #e4e7eb}h1{font-size:20px;margi
 .summary{margin:0;color:#52606d}
 main{display:grid;grid-template-columns:minmax(360px,42%) 1fr;gap:16px;padding:12px 20px}
 #plan svg{width:100%;height:auto;border:1px solid #d9dee4;display:block}
-.legend{font-size:12px;color:#52606d;margin:6px 0}.legend span{margin-right:12px;white-space:nowrap}
+.legend{font-size:12px;color:#52606d;margin:6px 0}.legend span{margin-right:12px;display:inline-block}
+#plan{position:sticky;top:0;align-self:start}
 .swatch{display:inline-block;width:12px;height:12px;border-radius:6px;vertical-align:-2px;margin-right:4px}
 table{border-collapse:collapse;width:100%;font-size:13px}th,td{border-bottom:1px solid #e4e7eb;padding:6px;
 text-align:left;vertical-align:top}th{background:#f5f7fa;position:sticky;top:0}
@@ -59,6 +60,7 @@ function select(id, from) {
 markers.forEach((m, id) => m.addEventListener('click', () => select(id, 'plan')));
 rows.forEach((r, id) => r.addEventListener('click', () => select(id, 'table')));
 document.body.dataset.ready = markers.size + ' markers';
+document.body.dataset.readyMs = Math.round(performance.now());  // since navigation started
 )";
 
 std::string Where(const ChangeItem& item, const std::optional<GeoReference>& geo) {

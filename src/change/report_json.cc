@@ -60,10 +60,16 @@ json ObjectJson(const ObjectChange& o) {
   return object;
 }
 
-json GeometryJson(const GeometryChange& g) {
+// Region ids as the changes list has them (made unique there), in region order.
+json GeometryJson(const GeometryChange& g, const std::vector<ChangeItem>& items) {
+  std::vector<std::string> ids;
+  for (const ChangeItem& item : items) {
+    if (item.kind == "geometry") ids.push_back(item.id);
+  }
   json regions = json::array();
-  for (const GeometryRegion& r : g.regions) {
-    regions.push_back({{"id", GeometryChangeId(r.centroid)},
+  for (std::size_t k = 0; k < g.regions.size(); ++k) {
+    const GeometryRegion& r = g.regions[k];
+    regions.push_back({{"id", k < ids.size() ? ids[k] : GeometryChangeId(r.centroid)},
                        {"centroid", Vector(r.centroid)},
                        {"box_min", Vector(r.box_min)},
                        {"box_max", Vector(r.box_max)},
@@ -151,7 +157,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
       {"changes", changes},
       {"places", places},
       {"objects", report.objects_compared ? objects : json(nullptr)},
-      {"geometry", report.geometry_compared ? GeometryJson(report.geometry) : json(nullptr)}};
+      {"geometry", report.geometry_compared ? GeometryJson(report.geometry, items) : json(nullptr)}};
   return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 

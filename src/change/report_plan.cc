@@ -133,8 +133,8 @@ void Marker(const ChangeItem& item, const PlanFrame& frame, std::ostringstream* 
          << Number(p.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='2' marker-end='url(#arrow)'/>\n";
   }
   *svg << "<g class='marker' data-id='" << graph::EscapeXml(item.id) << "' transform='translate(" << Number(p.x())
-       << " " << Number(p.y()) << ")'><circle r='10' fill='" << ChangeColour(item)
-       << "' stroke='white' stroke-width='2'/><text text-anchor='middle' dy='4' font-size='11' fill='white' "
+       << " " << Number(p.y()) << ")'><circle r='13' fill='" << ChangeColour(item)
+       << "' stroke='white' stroke-width='2'/><text text-anchor='middle' dy='5' font-size='14' fill='white' "
           "font-weight='bold'>"
        << item.number << "</text><title>" << item.number << ": " << graph::EscapeXml(item.kind + " " + item.state)
        << " " << graph::EscapeXml(item.label) << "</title></g>\n";

@@ -45,6 +45,7 @@ struct ChangeReport {
 
 // Stable ids: "object-p<prior id>-c<current id>" (-1 where the object is not in that patrol),
 // "geometry-<x>_<y>_<z>" (the 2 m cell of the region's centroid), "appearance-<prior node>-<current node>".
+// In a report, a later change with the same id (two regions in one cell) gets "-2", "-3", ... appended.
 std::string ObjectChangeId(const ObjectChange& change);
 std::string GeometryChangeId(const Eigen::Vector3d& centroid);
 std::string AppearanceChangeId(int prior_node, int current_node);
