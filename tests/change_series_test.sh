@@ -89,7 +89,7 @@ assert 'data-ready=\"%d markers\"' % placed in dom, re.findall('data-ready=\"[^\
 assert dom.count('class=\"marker\"') == placed
 images = [v['image'] for c in report['changes'] for v in (c['before'], c['after']) if v['image']]
 assert len(images) >= len(report['changes']), (len(images), len(report['changes']))
-sources = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\" src=\"([^\"]+)\"', dom)
+sources = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\" (?:data-)?src=\"([^\"]+)\"', dom)
 assert sorted(sources) == sorted(images), (len(sources), len(images))
 assert all(os.path.getsize(os.path.join('$work/changed-2', i)) > 0 for i in images)
 print('  %d changes, %d markers, %d pictures' % (len(report['changes']), placed, len(images)))

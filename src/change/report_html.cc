@@ -1,7 +1,7 @@
 // changes.html: one page for the inspector. A plan of both flights with every change as a numbered marker,
 // beside a table of the changes with their before and after pictures (a click on a marker selects its row and
 // a click on a row its marker), then every object with the reason for its state. Pictures are files in the
-// images folder, loaded lazily, or embedded when there is none. No network at view time. When the page has
+// images folder, loaded as their rows come into view, or embedded when there is no folder. No network at view time. When the page has
 // initialised, <body> carries data-ready="N markers" and data-ready-ms, the milliseconds it took to get there.
 #include <cmath>
 #include <cstdio>
@@ -58,6 +58,16 @@ function select(id, from) {
   if (marker) { marker.classList.add('selected'); marker.parentNode.appendChild(marker); }
 }
 markers.forEach((m, id) => m.addEventListener('click', () => select(id, 'plan')));
+const pictures = document.querySelectorAll('img[data-src]');
+const show = im => { im.src = im.dataset.src; im.removeAttribute('data-src'); };
+if ('IntersectionObserver' in window) {
+  const near = new IntersectionObserver(seen => seen.forEach(e => {
+    if (e.isIntersecting) { show(e.target); near.unobserve(e.target); }
+  }), {rootMargin: '800px'});
+  pictures.forEach(im => near.observe(im));
+} else {
+  pictures.forEach(show);
+}
 rows.forEach((r, id) => r.addEventListener('click', () => select(id, 'table')));
 document.body.dataset.ready = markers.size + ' markers';
 document.body.dataset.readyMs = Math.round(performance.now());  // since navigation started
@@ -82,10 +92,13 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
     return std::string("<span class='none'>") + word + ": no kept frame of " + graph::EscapeXml(view.flight) +
            " shows it</span>";
   }
+  // A file is loaded when its row comes near the view (data-src; the script), so a report of hundreds of
+  // changes opens at once: Chromium loads file:// images eagerly even with loading='lazy'.
   const std::string source =
-      images.empty() ? graph::PngDataUri(view.image) : graph::EscapeXml(images + "/" + ViewFileName(item, before));
+      images.empty() ? "src='" + graph::PngDataUri(view.image) + "'"
+                     : "data-src='" + graph::EscapeXml(images + "/" + ViewFileName(item, before)) + "'";
   std::ostringstream out;
-  out << "<figure><img loading='lazy' alt='" << word << "' src='" << source << "' width='" << view.image.cols
+  out << "<figure><img loading='lazy' alt='" << word << "' " << source << " width='" << view.image.cols
       << "' height='" << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
       << Number(NsToSeconds(view.timestamp_ns), 1) << " s, frame " << view.frame_index << "</figcaption></figure>";
   return out.str();

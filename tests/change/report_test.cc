@@ -128,8 +128,8 @@ TEST(ChangeReportPage, HasAMarkerARowAndBothPicturesPerChange) {
   const std::string html = ToHtml(scene.report, scene.map, items, std::nullopt, "pictures");
   EXPECT_NE(html.find("class='marker' data-id='object-p-1-c7'"), std::string::npos);
   EXPECT_NE(html.find("<tr id='row-object-p-1-c7'"), std::string::npos);
-  EXPECT_NE(html.find("src='pictures/object-p-1-c7-before.jpg'"), std::string::npos);
-  EXPECT_NE(html.find("src='pictures/object-p-1-c7-after.jpg'"), std::string::npos);
+  EXPECT_NE(html.find("data-src='pictures/object-p-1-c7-before.jpg'"), std::string::npos);
+  EXPECT_NE(html.find("data-src='pictures/object-p-1-c7-after.jpg'"), std::string::npos);
   EXPECT_NE(html.find("1 change."), std::string::npos);
   EXPECT_NE(html.find("not in the prior patrol's map"), std::string::npos);
   // Without a folder the pictures are embedded.
