@@ -72,15 +72,17 @@ assert report['summary']['changes'] == len(report['changes']) > 0
 "; then echo "ok   report follows the schema"; else echo "FAIL report schema"; failures=$((failures + 1)); fi
 
 # The page in headless Chromium: no console message (script errors, missing files), a marker per change with a
-# position, and every picture the report names, on disk.
-chrome_profile=$(mktemp -d)
-timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking \
-  --disable-component-update --disable-sync --user-data-dir="$chrome_profile" --enable-logging=stderr --v=0 \
-  --dump-dom "file://$work/changed-2/changes.html" > "$work/page.html" 2> "$work/page.log" || true
-rm -rf "$chrome_profile"
-if $py -c "
+# position, and every picture the report names, on disk; at least MIN_APPEARANCE appearance changes.
+check_page() {  # check_page NAME REPORT_DIR MIN_APPEARANCE
+  local profile
+  profile=$(mktemp -d)
+  timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
+    --disable-background-networking --disable-component-update --disable-sync --user-data-dir="$profile" \
+    --enable-logging=stderr --v=0 --dump-dom "file://$2/changes.html" > "$work/page.html" 2> "$work/page.log" || true
+  rm -rf "$profile"
+  if $py -c "
 import json, os, re
-report = json.load(open('$work/changed-2/changes.json'))
+report = json.load(open('$2/changes.json'))
 dom = open('$work/page.html').read()
 console = [l for l in open('$work/page.log') if ':CONSOLE' in l]
 assert not console, console
@@ -91,10 +93,20 @@ images = [v['image'] for c in report['changes'] for v in (c['before'], c['after'
 assert len(images) >= len(report['changes']), (len(images), len(report['changes']))
 sources = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\" (?:data-)?src=\"([^\"]+)\"', dom)
 assert sorted(sources) == sorted(images), (len(sources), len(images))
-assert all(os.path.getsize(os.path.join('$work/changed-2', i)) > 0 for i in images)
-print('  %d changes, %d markers, %d pictures' % (len(report['changes']), placed, len(images)))
-"; then echo "ok   the page loads without a console message and shows every marker and picture"; else
-  echo "FAIL report page"; failures=$((failures + 1)); fi
+assert all(os.path.getsize(os.path.join('$2', i)) > 0 for i in images)
+appearance = [c for c in report['changes'] if c['kind'] == 'appearance']
+assert len(appearance) >= $3 and all(c['before']['image'] and c['after']['image'] for c in appearance)
+print('  %d changes (%d appearance), %d markers, %d pictures' % (len(report['changes']), len(appearance), placed,
+                                                                 len(images)))
+"; then echo "ok   $1: the page loads without a console message and shows every marker and picture"; else
+    echo "FAIL $1 page"; failures=$((failures + 1)); fi
+}
+check_page "objects and geometry" "$work/changed-2" 0
+# Appearance regions, with the appearance filters loosened so that this patrol has some.
+printf 'change:\n  appearance:\n    min_structure_change: 0.2\n    min_unmatched_share: 0\n    min_area_fraction: 0.002\n    max_shifted_similarity: 1.0\n' \
+  > "$work/appearance.yaml"
+"$bin" diff "$work/changed-2/map.pmap" -c "$work/appearance.yaml" --out "$work/appearance" >/dev/null
+check_page "appearance regions" "$work/appearance" 1
 
 # changes.geojson: RFC 7946 (a FeatureCollection of Points and LineStrings in [longitude, latitude], no crs);
 # the current flight's camera path within 2 m of its GPS track (the fixes of gps0/, 1.5 m noise).
