@@ -90,7 +90,7 @@ std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Ve
 
 cv::Mat Decode(const RouteFrame& frame) {
   if (frame.jpeg.empty()) return cv::Mat();
-  return cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
+  return cv::imdecode(frame.jpeg, cv::IMREAD_COLOR);  // BGR, grey frames too
 }
 
 // The longer side scaled to `size` pixels.
@@ -116,8 +116,7 @@ ChangeView CropView(const std::string& flight, const PatrolRecord& record, const
                         cv::Rect(0, 0, frame.cols, frame.rows);
   if (crop.area() <= 0) return view;
   double scale = 1.0;
-  cv::Mat grey = Fit(frame(crop), options.crop_size_px, &scale);
-  cv::cvtColor(grey, view.image, cv::COLOR_GRAY2BGR);
+  view.image = Fit(frame(crop), options.crop_size_px, &scale);
   const cv::Rect2d outline((box.x - crop.x) * scale, (box.y - crop.y) * scale, box.width * scale, box.height * scale);
   cv::rectangle(view.image, outline, kOutline, 2);
   return view;
@@ -146,18 +145,17 @@ ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<c
                         const ReportOptions& options) {
   const graph::NodeData& n = map.node(node);
   ChangeView view{n.flight, n.timestamp_ns, n.frame_index, cv::Mat()};
-  cv::Mat grey;
+  cv::Mat frame;
   const PatrolRecord* record = map.Patrol(n.flight);
   if (record != nullptr) {
     const auto kept = std::find_if(record->route.begin(), record->route.end(),
                                    [&n](const RouteFrame& f) { return f.frame_index == n.frame_index; });
-    if (kept != record->route.end()) grey = Decode(*kept);
+    if (kept != record->route.end()) frame = Decode(*kept);
   }
-  if (grey.empty()) grey = n.thumbnail;
-  if (grey.empty() || n.thumbnail.empty()) return view;
+  if (frame.empty() && !n.thumbnail.empty()) cv::cvtColor(n.thumbnail, frame, cv::COLOR_GRAY2BGR);
+  if (frame.empty() || n.thumbnail.empty()) return view;
   double scale = 1.0;
-  grey = Fit(grey, std::max(options.crop_size_px, std::min(2 * grey.cols, 2 * options.crop_size_px)), &scale);
-  cv::cvtColor(grey, view.image, cv::COLOR_GRAY2BGR);
+  view.image = Fit(frame, std::max(options.crop_size_px, std::min(2 * frame.cols, 2 * options.crop_size_px)), &scale);
   const double to_image = static_cast<double>(view.image.cols) / n.thumbnail.cols;
   for (const cv::Rect& b : boxes) {
     cv::rectangle(view.image, cv::Rect2d(b.x * to_image, b.y * to_image, b.width * to_image, b.height * to_image),

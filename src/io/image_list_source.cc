@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "patrolmap/io/pose_file.h"
 
@@ -50,7 +51,10 @@ Status ImageListSource::Next(bool decode_image, Frame* frame) {
     AttachSensors(next_entry_ == entries_.size() ? std::numeric_limits<TimestampNs>::max() : entry.timestamp_ns, frame);
     frame->pose = PoseAt(sensors_.poses, entry.timestamp_ns);
     frame->image.release();
-    if ((decode_image || !frame->detections.empty()) && !Decode(index, entry.path, &frame->image)) continue;
+    frame->colour.release();
+    if ((decode_image || !frame->detections.empty()) && !Decode(index, entry.path, &frame->image, &frame->colour)) {
+      continue;
+    }
     frame->timestamp_ns = entry.timestamp_ns;
     frame->index = index;
     frame->speed_mps = SpeedAt(entry.timestamp_ns);
@@ -60,8 +64,17 @@ Status ImageListSource::Next(bool decode_image, Frame* frame) {
   return Status::EndOfStream();
 }
 
-bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Mat* image) {
-  *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Mat* image, cv::Mat* colour) {
+  if (keep_colour()) {
+    const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (raw.type() == CV_8UC3) *colour = raw;
+    if (raw.type() == CV_8UC4) cv::cvtColor(raw, *colour, cv::COLOR_BGRA2BGR);
+  }
+  if (!colour->empty()) {
+    cv::cvtColor(*colour, *image, cv::COLOR_BGR2GRAY);
+  } else {
+    *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  }
   if (image->empty()) {
     RecordSkipped(index, path + ": missing or unreadable image");
     return false;

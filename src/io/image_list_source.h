@@ -44,7 +44,7 @@ class ImageListSource : public FrameSource {
                    Frame* frame) const;
   std::optional<double> SpeedAt(TimestampNs timestamp_ns) const;
   std::optional<Eigen::Vector3d> GpsAt(TimestampNs timestamp_ns) const;
-  bool Decode(std::int64_t index, const std::string& path, cv::Mat* image);
+  bool Decode(std::int64_t index, const std::string& path, cv::Mat* image, cv::Mat* colour);
 
   LogInfo info_;
   std::vector<ImageEntry> entries_;

@@ -140,12 +140,14 @@ class VideoSource : public FrameSource {
       if (frame->index == 0) start_ = now;
       frame->timestamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now - start_).count();
     }
+    frame->colour.release();
     if (decode_image) {
       capture_.retrieve(buffer_);
       if (buffer_.channels() == 1) {
         buffer_.copyTo(frame->image);
       } else {
         cv::cvtColor(buffer_, frame->image, cv::COLOR_BGR2GRAY);
+        if (keep_colour() && buffer_.type() == CV_8UC3) frame->colour = buffer_;  // valid until the next read
       }
     }
     return Status::Ok();

@@ -192,7 +192,11 @@ Status Drive(io::FrameSource* source, FlightPass* pass, const DriveOptions& opti
   Status status;
   std::optional<TimestampNs> first_ns;
   const auto stopped = [&options] { return options.stop != nullptr && options.stop->load(); };
-  while (!stopped() && (status = source->Next(pass->NeedsImage(), &frame)).ok()) {
+  const auto next = [&] {
+    source->KeepColour(pass->WantsColour());  // the route strip keeps a colour frame where the log has colour
+    return source->Next(pass->NeedsImage(), &frame);
+  };
+  while (!stopped() && (status = next()).ok()) {
     if (!first_ns) first_ns = frame.timestamp_ns;
     const double flight_s = NsToSeconds(frame.timestamp_ns - *first_ns);
     if (options.max_seconds > 0.0 && flight_s > options.max_seconds) break;

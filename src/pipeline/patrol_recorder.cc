@@ -51,6 +51,8 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
 }
 
 void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) {
+  frame_spacing_ns_ = frame.timestamp_ns - last_frame_ns_;
+  last_frame_ns_ = frame.timestamp_ns;
   if (!frame.image.empty() && route_.Due(frame.timestamp_ns)) {
     ChangeWork route;
     route.kind = ChangeWork::Kind::kRoute;
@@ -58,7 +60,7 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
     route.frame_index = frame.index;
     route.pose = frame.pose;
     route.gps = frame.gps;
-    route_.Scale(frame.image, &route.image);
+    route_.Scale(frame.colour.empty() ? frame.image : frame.colour, &route.image);
     work->push_back(std::move(route));
   }
   if (!active_) return;

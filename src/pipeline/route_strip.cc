@@ -19,6 +19,10 @@ bool RouteStrip::Due(TimestampNs timestamp_ns) {
   return true;
 }
 
+bool RouteStrip::DueSoon(TimestampNs last_ns, TimestampNs spacing_ns) const {
+  return options_.interval_s > 0.0 && last_ns + 2 * std::max<TimestampNs>(spacing_ns, 0) >= next_due_ns_;
+}
+
 void RouteStrip::Scale(const cv::Mat& image, cv::Mat* scaled) const {
   if (image.cols <= options_.max_width) {
     image.copyTo(*scaled);

@@ -38,6 +38,30 @@ TEST(ImageFolder, ReadsInNaturalOrderWithTimestampsFromRate) {
   EXPECT_EQ(frames[2].timestamp_ns, 200000000);
 }
 
+// Asked for it, a colour image keeps its colour beside the grey one; grey images and frames read without
+// asking have none.
+TEST(ImageFolder, KeepsTheColourImageWhenAsked) {
+  TempDir dir;
+  cv::imwrite(dir / "0.png", cv::Mat(24, 32, CV_8UC3, cv::Scalar(10, 100, 200)));
+  cv::imwrite(dir / "1.png", TestImage(7));
+  cv::imwrite(dir / "2.png", cv::Mat(24, 32, CV_8UC3, cv::Scalar(10, 100, 200)));
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir.path(), {10.0, {}}, &source).ok());
+  Frame frame;
+  source->KeepColour(true);
+  ASSERT_TRUE(source->Next(true, &frame).ok());
+  ASSERT_EQ(frame.colour.type(), CV_8UC3);
+  EXPECT_EQ(frame.colour.at<cv::Vec3b>(2, 3), cv::Vec3b(10, 100, 200));
+  EXPECT_EQ(frame.image.type(), CV_8UC1);
+  EXPECT_NEAR(frame.image.at<uchar>(2, 3), 0.114 * 10 + 0.587 * 100 + 0.299 * 200, 1.0);
+  ASSERT_TRUE(source->Next(true, &frame).ok());
+  EXPECT_TRUE(frame.colour.empty());  // a grey image
+  source->KeepColour(false);
+  ASSERT_TRUE(source->Next(true, &frame).ok());
+  EXPECT_TRUE(frame.colour.empty());
+  EXPECT_EQ(frame.image.type(), CV_8UC1);
+}
+
 // A folder without times is read at the assumed rate and says so; one given a rate is timed.
 TEST(ImageFolder, WithoutTimesTheRateIsAssumedAndMarked) {
   TempDir dir;

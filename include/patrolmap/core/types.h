@@ -94,6 +94,8 @@ struct Frame {
   TimestampNs timestamp_ns = 0;
   std::int64_t index = 0;              // position in the log, counting unreadable frames too
   cv::Mat image;                       // CV_8UC1; empty when the caller asked not to decode
+  cv::Mat colour;                      // CV_8UC3 BGR when the caller asked (FrameSource::KeepColour) and the
+                                       // image is colour (image folders, EuRoC, videos); else empty
   std::vector<ImuSample> imu;          // samples with previous timestamp < t <= timestamp_ns
   std::optional<double> speed_mps;     // known platform speed, when the log carries it
   std::optional<Eigen::Vector3d> gps;  // latitude, longitude [deg], altitude [m], when the log carries it

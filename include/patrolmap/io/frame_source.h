@@ -75,11 +75,17 @@ class FrameSource {
 
   const std::vector<SkippedFrame>& skipped() const { return skipped_; }
 
+  // Whether the next decoded frame should also keep its colour image (Frame::colour). Image folders, EuRoC
+  // logs and videos do; ROS bags and grey images leave it empty.
+  void KeepColour(bool keep) { keep_colour_ = keep; }
+
  protected:
   void RecordSkipped(std::int64_t index, std::string reason);
+  bool keep_colour() const { return keep_colour_; }
 
  private:
   std::vector<SkippedFrame> skipped_;
+  bool keep_colour_ = false;
 };
 
 }  // namespace patrolmap::io

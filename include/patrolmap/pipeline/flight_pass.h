@@ -74,6 +74,8 @@ class FlightPass {
 
   // Whether the next frame needs its image (so a reader can skip decoding the others).
   bool NeedsImage() const;
+  // Whether the next frame's colour image is wanted (io::FrameSource::KeepColour).
+  bool WantsColour() const { return recorder_.WantsColour(); }
 
   // Takes every frame in order. Fails when a stage has failed (the error it gave).
   Status AddFrame(const Frame& frame);

@@ -35,9 +35,9 @@ struct PatrolRecordStats {
   int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
-  long long evicted_voxels = 0;  // the grid's least recently observed voxels, dropped at its memory budget
-  int route_frames = 0;          // frames kept along the route (change.route_frames)
-  int route_thinnings = 0;       // times the route strip reached its memory budget and halved
+  long long evicted_voxels = 0;        // the grid's least recently observed voxels, dropped at its memory budget
+  int route_frames = 0;                // frames kept along the route (change.route_frames)
+  int route_thinnings = 0;             // times the route strip reached its memory budget and halved
   long long dropped_route_frames = 0;  // key frames not kept: key frames alone filled the budget
 };
 
@@ -67,6 +67,8 @@ class PatrolRecorder {
   // Whether the record has anything to build (poses, a camera, and detections or depth).
   bool active() const { return active_; }
 
+  // Frame thread: whether the next frame's colour image is wanted (for the route strip).
+  bool WantsColour() const { return route_.DueSoon(last_frame_ns_, frame_spacing_ns_); }
   // Frame thread: appends the work `frame` brings (its detections; its depth images) and the views it adds.
   void Collect(const Frame& frame, std::vector<ChangeWork>* work);
   // Frame thread: a node's key frame for the route strip (its image at any scale, its pose and GPS if any).
@@ -106,6 +108,7 @@ class PatrolRecorder {
   std::vector<CameraPoseSample> pending_views_;
   TimestampNs next_stereo_ns_;  // stereo pairs come with every frame: only those at the grid's rate are work
   RouteStrip route_;            // Due() and Scale() on the frame thread, the rest on the change thread
+  TimestampNs last_frame_ns_ = 0, frame_spacing_ns_ = 0;
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
   cv::Mat left_, right_;

@@ -26,7 +26,10 @@ class RouteStrip {
   // Frame thread: whether an interval frame is due at `timestamp_ns` (false when frames are not kept); a due
   // frame moves the next one on.
   bool Due(TimestampNs timestamp_ns);
-  // Frame thread: `image` scaled down to max_width (a copy either way: the caller's buffer is reused).
+  // Frame thread: whether the frame after one at `last_ns` (frames `spacing_ns` apart) may be due, so its
+  // colour image is worth decoding.
+  bool DueSoon(TimestampNs last_ns, TimestampNs spacing_ns) const;
+  // Frame thread: `image` (grey or BGR) scaled down to max_width (a copy either way: the caller's buffer is reused).
   void Scale(const cv::Mat& image, cv::Mat* scaled) const;
 
   // Change thread: keeps `frame` with `image` (scaled) as JPEG; key frames are never thinned out.
