@@ -1,5 +1,6 @@
 // Writes the binary seeds of the fuzzing corpus: a small map file with every section (the graph tests'
-// sample map, tests/sample_map.h) and a small vocabulary, both through the real writers.
+// sample map, tests/sample_map.h), the same with route frames, and a small vocabulary, all through the real
+// writers.
 // Text seeds (configuration, EuRoC tables, times) are plain files in fuzz/corpus/.
 //   seed_writer CORPUS_FOLDER
 #include <cstdio>
@@ -37,6 +38,23 @@ int main(int argc, char** argv) {
   graph::TopoMap map = testing::TwoFlights();
   map.set_vocabulary({vocabulary.Fingerprint(), "seed"});
   if (status.ok()) status = graph::SaveMap(map, (corpus / "map_file/seed.pmap").string());
+  // The same with two route frames (format 6): one with a pose and GPS, one without. Their bytes only start
+  // like JPEG; the reader does not decode them.
+  PatrolRecord record = *map.Patrol("b");
+  RouteFrame frame;
+  frame.timestamp_ns = 5;
+  frame.frame_index = 3;
+  frame.pose = record.views[0];
+  frame.gps = Eigen::Vector2d(47.5, 8.25);
+  frame.jpeg = {0xFF, 0xD8, 0xFF, 0xE0, 0x00, 0x10, 0xFF, 0xD9};
+  record.route.push_back(frame);
+  frame.timestamp_ns = 9;
+  frame.frame_index = 4;
+  frame.pose.reset();
+  frame.gps.reset();
+  record.route.push_back(frame);
+  map.SetPatrol(record);
+  if (status.ok()) status = graph::SaveMap(map, (corpus / "map_file/seed_route.pmap").string());
   if (!status.ok()) {
     std::fprintf(stderr, "%s\n", status.message().c_str());
     return 1;

@@ -91,7 +91,9 @@ assert 'data-ready=\"%d markers\"' % placed in dom, re.findall('data-ready=\"[^\
 assert dom.count('class=\"marker\"') == placed
 images = [v['image'] for c in report['changes'] for v in (c['before'], c['after']) if v['image']]
 assert len(images) >= len(report['changes']), (len(images), len(report['changes']))
-sources = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\" (?:data-)?src=\"([^\"]+)\"', dom)
+# A picture's file is in data-src until its row comes near the view, then in src (added last).
+tags = re.findall('<img loading=\"lazy\" alt=\"(?:before|after)\"[^>]*>', dom)
+sources = [re.search(' (?:data-)?src=\"([^\"]+)\"', t).group(1) for t in tags]
 assert sorted(sources) == sorted(images), (len(sources), len(images))
 assert all(os.path.getsize(os.path.join('$2', i)) > 0 for i in images)
 appearance = [c for c in report['changes'] if c['kind'] == 'appearance']
