@@ -54,14 +54,8 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
   frame_spacing_ns_ = frame.timestamp_ns - last_frame_ns_;
   last_frame_ns_ = frame.timestamp_ns;
   if (!frame.image.empty() && route_.Due(frame.timestamp_ns)) {
-    ChangeWork route;
-    route.kind = ChangeWork::Kind::kRoute;
-    route.timestamp_ns = frame.timestamp_ns;
-    route.frame_index = frame.index;
-    route.pose = frame.pose;
-    route.gps = frame.gps;
-    route_.Scale(frame.colour.empty() ? frame.image : frame.colour, &route.image);
-    work->push_back(std::move(route));
+    PushRouteWork(frame.timestamp_ns, frame.index, frame.colour.empty() ? frame.image : frame.colour, frame.pose,
+                  frame.gps, false, work);
   }
   if (!active_) return;
   const TimestampNs step = SecondsToNs(1.0 / kViewRateHz);
@@ -109,14 +103,20 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
 void PatrolRecorder::CollectKeyFrame(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
                                      const std::optional<CameraPoseSample>& pose,
                                      const std::optional<Eigen::Vector3d>& gps, std::vector<ChangeWork>* work) {
-  if (image.empty()) return;
+  if (!image.empty()) PushRouteWork(timestamp_ns, frame_index, image, pose, gps, true, work);
+}
+
+void PatrolRecorder::PushRouteWork(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
+                                   const std::optional<CameraPoseSample>& pose,
+                                   const std::optional<Eigen::Vector3d>& gps, bool key_frame,
+                                   std::vector<ChangeWork>* work) {
   ChangeWork route;
   route.kind = ChangeWork::Kind::kRoute;
   route.timestamp_ns = timestamp_ns;
   route.frame_index = frame_index;
   route.pose = pose;
   route.gps = gps;
-  route.key_frame = true;
+  route.key_frame = key_frame;
   route_.Scale(image, &route.image);
   work->push_back(std::move(route));
 }

@@ -97,6 +97,10 @@ class PatrolRecorder {
   bool ReadDepth(const ChangeWork& work, cv::Mat* depth);
   bool ReadStereoDepth(const ChangeWork& work, cv::Mat* depth);
   void AddRouteFrame(const ChangeWork& work);
+  // Frame thread: a frame for the route strip, scaled, as work for the change thread.
+  void PushRouteWork(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
+                     const std::optional<CameraPoseSample>& pose, const std::optional<Eigen::Vector3d>& gps,
+                     bool key_frame, std::vector<ChangeWork>* work);
 
   TimestampNs grid_step_ns_;  // change.grid.rate_hz
   bool active_ = false;
