@@ -51,6 +51,8 @@ lines = [json.loads(l) for l in open(out + "/lines.jsonl")]
 total = {}
 geo = [0, 0, 0]
 app = [0, 0, 0, 0]  # regions, on a change, visible changes, found
+route = [0, 0, 0, 0, 0, 0]  # changes, on a change, visible, found, frames, compared pairs
+lighting_route = 0  # changes reported on lighting-only patrols
 for r in lines:
     c = r["changes"]
     states = c.get("objects", {})
@@ -68,6 +70,13 @@ for r in lines:
     if a:
         app[0] += a["regions"]; app[1] += a["regions_on_change"]; app[2] += a["changes"]; app[3] += a["changes_found"]
         row.append(f"regions {a['regions_on_change']}/{a['regions']} on changes, {a['changes_found']}/{a['changes']} changes found")
+    ro = c.get("route")
+    if ro:
+        for i, k in enumerate(("changes", "changes_on_change", "visible", "found", "frames", "pairs")):
+            route[i] += ro[k]
+        if r["series"] == "lighting-only":
+            lighting_route += ro["changes"]
+        row.append(f"route {ro['changes_on_change']}/{ro['changes']} on changes, {ro['found']}/{ro['visible']} found, {ro['pairs']}/{ro['frames']} frames")
     row.append(f"places {c['places_changed']}/{c['places_compared']} changed")
     print("  ".join(row))
 def prf(tp, fp, fn):
@@ -89,5 +98,12 @@ r = app[3] / app[2] if app[2] else 0.0
 summary["appearance"] = {"regions": app[0], "regions_on_change": app[1], "changes": app[2], "changes_found": app[3],
                          "precision": p, "recall": r}
 print(f"  appearance {app[1]}/{app[0]} regions on object changes (P {p:.2f}), {app[3]}/{app[2]} visible changes found (R {r:.2f})")
+p = route[1] / route[0] if route[0] else 0.0
+r = route[3] / route[2] if route[2] else 0.0
+share = route[5] / route[4] if route[4] else 0.0
+summary["route"] = {"changes": route[0], "changes_on_change": route[1], "visible": route[2], "found": route[3],
+                    "frames": route[4], "pairs": route[5], "precision": p, "recall": r, "compared_share": share,
+                    "lighting_only_changes": lighting_route}
+print(f"  route      {route[1]}/{route[0]} changes on object changes (P {p:.2f}), {route[3]}/{route[2]} visible changes found (R {r:.2f}), {share:.0%} of the route compared, {lighting_route} changes on lighting-only patrols")
 json.dump(summary, open(out + "/summary.json", "w"), indent=1)
 PY

@@ -5,6 +5,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 namespace patrolmap::change {
 namespace {
@@ -92,6 +93,30 @@ cv::Mat BestOverShifts(const cv::Mat& a, const cv::Mat& b, int radius, bool larg
   return best;
 }
 
+// Registers `warped` (the prior image, carried onto the current one by the homography) onto `current`
+// locally: DIS dense flow from the current image to the gain-compensated prior, flows longer than
+// `max_flow_px` left at zero (what the flow cannot explain stays for the comparison), and `warped` resampled
+// along it. Parallax off the homography's plane is then registered too.
+void FollowFlow(const cv::Mat& current, double gain, double offset, double max_flow_px, cv::Mat* warped) {
+  cv::Mat current8, prior8, flow;
+  current.convertTo(current8, CV_8U);
+  warped->convertTo(prior8, CV_8U, gain, offset);
+  cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM)->calc(current8, prior8, flow);
+  cv::Mat map(flow.size(), CV_32FC2);
+  const float max_squared = static_cast<float>(max_flow_px * max_flow_px);
+  for (int y = 0; y < flow.rows; ++y) {
+    const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
+    cv::Vec2f* m = map.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < flow.cols; ++x) {
+      const bool kept = f[x].dot(f[x]) <= max_squared;
+      m[x] = cv::Vec2f(static_cast<float>(x) + (kept ? f[x][0] : 0.0f), static_cast<float>(y) + (kept ? f[x][1] : 0.0f));
+    }
+  }
+  cv::Mat resampled;
+  cv::remap(*warped, resampled, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  *warped = resampled;
+}
+
 cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const cv::Size& prior_size) {
   std::vector<cv::Point2f> corners = {box.tl(),
                                       {static_cast<float>(box.br().x), static_cast<float>(box.y)},
@@ -125,21 +150,35 @@ bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions
   return features == 0 || unmatched >= options.min_unmatched_share * features;
 }
 
-AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
-                                        const AppearanceOptions& options) {
-  AppearanceChange result;
-  const std::vector<cv::DMatch> matches = Match(prior, current, options.ratio);
-  result.matches = static_cast<int>(matches.size());
-  if (result.matches < std::max(4, options.min_inliers)) return result;
+Registration Register(const KeyFrameView& prior, const KeyFrameView& current, const AppearanceOptions& options) {
+  Registration registration;
+  registration.matches = Match(prior, current, options.ratio);
+  if (static_cast<int>(registration.matches.size()) < std::max(4, options.min_inliers)) return registration;
   std::vector<cv::Point2f> from, to;
-  for (const cv::DMatch& m : matches) {
+  for (const cv::DMatch& m : registration.matches) {
     from.push_back(prior.keypoints[m.trainIdx].pt / prior.feature_scale);
     to.push_back(current.keypoints[m.queryIdx].pt / current.feature_scale);
   }
   std::vector<unsigned char> inlier;
   cv::Mat h = cv::findHomography(from, to, cv::RANSAC, options.inlier_threshold_px, inlier, 2000, 0.999);
-  result.inliers = h.empty() ? 0 : cv::countNonZero(inlier);
-  if (result.inliers < options.min_inliers) return result;
+  registration.inliers = h.empty() ? 0 : cv::countNonZero(inlier);
+  if (!h.empty()) registration.current_from_prior = h;
+  return registration;
+}
+
+AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
+                                        const AppearanceOptions& options) {
+  return CompareRegistered(prior, current, Register(prior, current, options), options);
+}
+
+AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
+                                   const Registration& registration, const AppearanceOptions& options) {
+  AppearanceChange result;
+  const std::vector<cv::DMatch>& matches = registration.matches;
+  result.matches = static_cast<int>(matches.size());
+  result.inliers = registration.inliers;
+  if (result.inliers < options.min_inliers || registration.current_from_prior.empty()) return result;
+  const cv::Mat& h = registration.current_from_prior;
   result.registered = true;
   result.homography = h;
 
@@ -158,6 +197,7 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
   result.compared_fraction = static_cast<double>(compared) / mask.total();
   if (compared == 0) return result;
   FitLighting(warped, current_f, mask, &result.gain, &result.offset);
+  if (options.dense_flow) FollowFlow(current_f, result.gain, result.offset, options.max_flow_px, &warped);
 
   const int r = options.search_radius_px;
   const cv::Mat global = BestOverShifts(current_f, warped * result.gain + result.offset, r, false,
@@ -166,13 +206,14 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
                           return ContrastStructure(a, b, options.structure_sigma_px);
                         });
   cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
-  cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), 2);
+  cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), options.closing_px);
   cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
   changed &= mask;
 
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8, CV_32S);
   const int min_area = std::max(1, static_cast<int>(options.min_area_fraction * compared));
+  const double min_side = options.min_side_fraction * std::min(current_f.cols, current_f.rows);
   std::vector<bool> matched_prior(prior.keypoints.size(), false), matched_current(current.keypoints.size(), false);
   for (const cv::DMatch& m : matches) matched_prior[m.trainIdx] = matched_current[m.queryIdx] = true;
   std::vector<cv::Point2f> prior_points, prior_in_current;
@@ -184,6 +225,7 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
     if (region.area_px < min_area) continue;
     region.current_box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                                   stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    if (std::min(region.current_box.width, region.current_box.height) < min_side) continue;  // a seam, not a thing
     region.prior_box = PriorBox(region.current_box, h, prior.image.size());
     region.score = cv::mean(local, labels == label)[0];
     const cv::Rect2f box(region.current_box);

@@ -14,10 +14,13 @@ void CheckAppearance(const AppearanceOptions& a, OptionCheck* check) {
       .InRange("change.appearance.min_difference", a.min_difference, 0.0, 255.0)
       .InRange("change.appearance.min_structure_change", a.min_structure_change, 0.0, 2.0)
       .AboveAtMost("change.appearance.structure_sigma_px", a.structure_sigma_px, 0.0, 50.0)
+      .InRange("change.appearance.closing_px", a.closing_px, 0, 50)
       .InRange("change.appearance.min_area_fraction", a.min_area_fraction, 0.0, 1.0)
+      .InRange("change.appearance.min_side_fraction", a.min_side_fraction, 0.0, 1.0)
       .InRange("change.appearance.min_unmatched_share", a.min_unmatched_share, 0.0, 1.0)
       .InRange("change.appearance.parallax_search_px", a.parallax_search_px, 0, 100)
-      .InRange("change.appearance.max_shifted_similarity", a.max_shifted_similarity, -1.0, 1.0);
+      .InRange("change.appearance.max_shifted_similarity", a.max_shifted_similarity, -1.0, 1.0)
+      .InRange("change.appearance.max_flow_px", a.max_flow_px, 0.0, 1000.0);
 }
 
 void CheckObjectMap(const ObjectMapOptions& m, OptionCheck* check) {
@@ -81,6 +84,14 @@ void CheckRouteFrames(const RouteFrameOptions& r, OptionCheck* check) {
       .InRange("change.route_frames.memory_mb", r.memory_mb, 0.1, 65536.0);
 }
 
+void CheckRoute(const RouteCompareOptions& r, OptionCheck* check) {
+  check->InRange("change.route.search_window_s", r.search_window_s, 0.0, 3600.0)
+      .InRange("change.route.max_features", r.max_features, 16, 100000)
+      .InRange("change.route.max_candidates", r.max_candidates, 1, 1000)
+      .InRange("change.route.min_votes", r.min_votes, 1, 1000)
+      .InRange("change.route.min_overlap", r.min_overlap, 0.0, 1.0);
+}
+
 }  // namespace
 
 bool ChangeOptions::IsValid(std::string* error) const {
@@ -91,6 +102,7 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckGrid(grid, &check);
   CheckGeometry(geometry, &check);
   CheckRouteFrames(route_frames, &check);
+  CheckRoute(route, &check);
   return check.ok();
 }
 

@@ -140,6 +140,19 @@ const MapObject* FindObject(const PatrolRecord* record, int id) {
   return it == record->objects.end() ? nullptr : &*it;
 }
 
+// A whole frame with boxes (in pixels of a `reference_width` wide image) outlined, at most twice crop_size_px.
+cv::Mat OutlinedFrame(const cv::Mat& frame, int reference_width, const std::vector<cv::Rect>& boxes,
+                      const ReportOptions& options) {
+  double scale = 1.0;
+  cv::Mat image = Fit(frame, std::max(options.crop_size_px, std::min(2 * frame.cols, 2 * options.crop_size_px)), &scale);
+  const double to_image = static_cast<double>(image.cols) / reference_width;
+  for (const cv::Rect& b : boxes) {
+    cv::rectangle(image, cv::Rect2d(b.x * to_image, b.y * to_image, b.width * to_image, b.height * to_image), kOutline,
+                  2);
+  }
+  return image;
+}
+
 // The node's key frame with the regions outlined: the kept frame of the same frame index, else the thumbnail.
 ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<cv::Rect>& boxes,
                         const ReportOptions& options) {
@@ -154,13 +167,16 @@ ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<c
   }
   if (frame.empty() && !n.thumbnail.empty()) cv::cvtColor(n.thumbnail, frame, cv::COLOR_GRAY2BGR);
   if (frame.empty() || n.thumbnail.empty()) return view;
-  double scale = 1.0;
-  view.image = Fit(frame, std::max(options.crop_size_px, std::min(2 * frame.cols, 2 * options.crop_size_px)), &scale);
-  const double to_image = static_cast<double>(view.image.cols) / n.thumbnail.cols;
-  for (const cv::Rect& b : boxes) {
-    cv::rectangle(view.image, cv::Rect2d(b.x * to_image, b.y * to_image, b.width * to_image, b.height * to_image),
-                  kOutline, 2);
-  }
+  view.image = OutlinedFrame(frame, n.thumbnail.cols, boxes, options);
+  return view;
+}
+
+// A route frame with one region outlined (its box in the frame's pixels).
+ChangeView RouteView(const std::string& flight, const RouteFrame& frame, const cv::Rect& box,
+                     const ReportOptions& options) {
+  ChangeView view{flight, frame.timestamp_ns, frame.frame_index, cv::Mat()};
+  const cv::Mat image = Decode(frame);
+  if (!image.empty()) view.image = OutlinedFrame(image, image.cols, {box}, options);
   return view;
 }
 
@@ -244,6 +260,27 @@ ChangeItem AppearanceItem(const graph::TopoMap& map, const PlaceChange& place, c
   return item;
 }
 
+// A change found along the route: its best view's two route frames, the region outlined.
+ChangeItem RouteItem(const ChangeReport& report, const graph::TopoMap& map, const RouteChange& change,
+                     const ReportOptions& options) {
+  const RouteChange::View& best = change.views[change.best];
+  const RoutePair& pair = report.route.pairs[best.pair];
+  const AppearanceRegion& region = pair.appearance.regions[best.region];
+  const RouteFrame& prior = map.Patrol(report.prior_flight)->route[pair.prior];
+  const RouteFrame& current = map.Patrol(report.current_flight)->route[pair.current];
+  ChangeItem item;
+  item.id = RouteChangeId(prior, current);
+  item.kind = "appearance";
+  item.state = "changed";
+  item.label = "seen in " + std::to_string(change.views.size()) + " views";
+  item.confidence = change.confidence;
+  item.position = current.pose ? std::optional<Eigen::Vector3d>(current.pose->position)
+                               : CameraAt(map, report.current_flight, current.timestamp_ns);
+  item.before = RouteView(report.prior_flight, prior, region.prior_box, options);
+  item.after = RouteView(report.current_flight, current, region.current_box, options);
+  return item;
+}
+
 Status WriteView(const ChangeView& view, const std::string& path) {
   std::vector<unsigned char> jpeg;
   if (!cv::imencode(".jpg", view.image, jpeg, {cv::IMWRITE_JPEG_QUALITY, 85}))
@@ -277,6 +314,10 @@ std::string AppearanceChangeId(int prior_node, int current_node) {
   return "appearance-" + std::to_string(prior_node) + "-" + std::to_string(current_node);
 }
 
+std::string RouteChangeId(const RouteFrame& prior, const RouteFrame& current) {
+  return "appearance-f" + std::to_string(prior.frame_index) + "-" + std::to_string(current.frame_index);
+}
+
 std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::TopoMap& map,
                                     const ReportOptions& options) {
   std::vector<ChangeItem> items;
@@ -287,6 +328,7 @@ std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::Top
   for (const PlaceChange& place : report.places) {
     if (!place.appearance.regions.empty()) items.push_back(AppearanceItem(map, place, options));
   }
+  for (const RouteChange& change : report.route.changes) items.push_back(RouteItem(report, map, change, options));
   // Regions in one 2 m cell share their id (one onboard event each); in the report the later ones get "-2", ...
   std::map<std::string, int> seen;
   for (std::size_t i = 0; i < items.size(); ++i) {

@@ -1,4 +1,5 @@
 // changes.json: format "patrolmap.changes", version 2 (docs/changes.schema.json).
+#include <algorithm>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -40,6 +41,36 @@ json PlaceJson(const PlaceChange& place, const graph::TopoMap& map) {
           {"offset", a.offset},
           {"compared_fraction", a.compared_fraction},
           {"regions", regions}};
+}
+
+// The route comparison: what share of the route was compared, and per change its views (the route frames of
+// each agreeing pair and the region's boxes in them). `ids`: the changes' ids in the report, in order.
+json RouteJson(const ChangeReport& report, const graph::TopoMap& map, const std::vector<std::string>& ids) {
+  if (!report.route.compared) return nullptr;
+  const std::vector<RouteFrame>& prior = map.Patrol(report.prior_flight)->route;
+  const std::vector<RouteFrame>& current = map.Patrol(report.current_flight)->route;
+  json changes = json::array();
+  for (std::size_t i = 0; i < report.route.changes.size(); ++i) {
+    const RouteChange& change = report.route.changes[i];
+    json views = json::array();
+    for (const RouteChange::View& v : change.views) {
+      const RoutePair& pair = report.route.pairs[v.pair];
+      const AppearanceRegion& r = pair.appearance.regions[v.region];
+      views.push_back({{"prior_frame", prior[pair.prior].frame_index},
+                       {"current_frame", current[pair.current].frame_index},
+                       {"prior_box", Box(r.prior_box)},
+                       {"current_box", Box(r.current_box)},
+                       {"score", r.score}});
+    }
+    changes.push_back({{"id", i < ids.size() ? ids[i] : std::string()},
+                       {"confidence", change.confidence},
+                       {"score", change.score},
+                       {"views", views}});
+  }
+  return {{"frames", report.route.current_frames},
+          {"compared_pairs", report.route.pairs.size()},
+          {"compared_share", report.route.ComparedShare()},
+          {"changes", changes}};
 }
 
 json ObjectJson(const ObjectChange& o) {
@@ -131,6 +162,9 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
     counts[ToString(s)] = report.ObjectsIn(s);
   }
   for (const ChangeItem& item : items) changes.push_back(ChangeJson(item, geo, images));
+  std::vector<std::string> route_ids;  // the route's changes are the last items
+  for (std::size_t i = items.size() - std::min(items.size(), report.route.changes.size()); i < items.size(); ++i)
+    route_ids.push_back(items[i].id);
   json geo_json = nullptr;
   if (geo) {
     geo_json = {{"origin_latitude", geo->origin_latitude},
@@ -156,6 +190,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
       {"geo_reference", geo_json},
       {"changes", changes},
       {"places", places},
+      {"route", RouteJson(report, map, route_ids)},
       {"objects", report.objects_compared ? objects : json(nullptr)},
       {"geometry", report.geometry_compared ? GeometryJson(report.geometry, items) : json(nullptr)}};
   return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";

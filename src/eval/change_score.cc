@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <unordered_map>
 
 #include "patrolmap/core/csv.h"
@@ -239,27 +240,37 @@ bool Overlaps(const cv::Rect2d& a, const cv::Rect2d& b, double min_overlap) {
 
 }  // namespace
 
-std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
-                                           TimestampNs time_ns, const CameraPoseSample& pose,
-                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
-  std::vector<cv::Rect2d> boxes;
+std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
+                                          TimestampNs time_ns, const CameraPoseSample& pose,
+                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
+  std::vector<VisibleChange> changes;
   for (const TruthObject& o : here) {
     const TruthObject* there = FindId(other, o.id);
     if (there != nullptr && (there->centre - o.centre).norm() <= kSamePlace) continue;  // unchanged
     if (!SeenNear(o, time_ns, options.visible_within_s)) continue;
     const cv::Rect2d box = ProjectTruthBox(o, pose, camera);
-    if (box.area() >= options.min_area_px) boxes.push_back(box);
+    if (box.area() >= options.min_area_px) changes.push_back({o.id, box});
   }
+  return changes;
+}
+
+std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
+                                           TimestampNs time_ns, const CameraPoseSample& pose,
+                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
+  std::vector<cv::Rect2d> boxes;
+  for (const VisibleChange& c : VisibleChanges(here, other, time_ns, pose, camera, options)) boxes.push_back(c.box);
   return boxes;
 }
 
+bool CentreMapsInside(const Eigen::Matrix3d& to_other, int width, int height, const cv::Rect2d& box) {
+  const Eigen::Vector3d p = to_other * Eigen::Vector3d(box.x + box.width / 2, box.y + box.height / 2, 1.0);
+  if (p.z() <= 0.0) return false;
+  const double u = p.x() / p.z(), v = p.y() / p.z();
+  return u >= 0.0 && v >= 0.0 && u < width && v < height;
+}
+
 void KeepInOverlap(const Eigen::Matrix3d& to_other, int width, int height, std::vector<cv::Rect2d>* boxes) {
-  const auto outside = [&](const cv::Rect2d& box) {
-    const Eigen::Vector3d p = to_other * Eigen::Vector3d(box.x + box.width / 2, box.y + box.height / 2, 1.0);
-    if (p.z() <= 0.0) return true;
-    const double u = p.x() / p.z(), v = p.y() / p.z();
-    return u < 0.0 || v < 0.0 || u >= width || v >= height;
-  };
+  const auto outside = [&](const cv::Rect2d& box) { return !CentreMapsInside(to_other, width, height, box); };
   boxes->erase(std::remove_if(boxes->begin(), boxes->end(), outside), boxes->end());
 }
 
@@ -290,6 +301,42 @@ AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
       }
     }
   }
+  return score;
+}
+
+double RouteScore::Precision() const { return Ratio(changes_on_truth, changes); }
+double RouteScore::Recall() const { return Ratio(found, visible); }
+
+RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
+                      const ChangeScoreOptions& options) {
+  RouteScore score;
+  // Every object change visible in some compared pair, on either side: (side, object id) -> found.
+  std::map<std::pair<bool, int>, bool> visible;
+  for (const RoutePairTruth& t : truth) {
+    for (const bool prior : {true, false}) {
+      for (const VisibleChange& c : prior ? t.prior : t.current) visible.emplace(std::make_pair(prior, c.id), false);
+    }
+  }
+  for (const ReportedRouteChange& change : reported) {
+    ++score.changes;
+    bool on_truth = false;
+    for (std::size_t v = 0; v < change.pairs.size(); ++v) {
+      const int pair = change.pairs[v];
+      if (pair < 0 || pair >= static_cast<int>(truth.size())) continue;
+      for (const bool prior : {true, false}) {
+        const cv::Rect2d& box = prior ? change.boxes[v].prior : change.boxes[v].current;
+        for (const VisibleChange& c : prior ? truth[pair].prior : truth[pair].current) {
+          if (!Overlaps(box, c.box, options.min_overlap)) continue;
+          on_truth = true;
+          visible[{prior, c.id}] = true;
+        }
+      }
+    }
+    score.changes_on_truth += on_truth;
+  }
+  score.visible = static_cast<int>(visible.size());
+  score.found = static_cast<int>(
+      std::count_if(visible.begin(), visible.end(), [](const auto& entry) { return entry.second; }));
   return score;
 }
 

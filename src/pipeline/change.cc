@@ -27,6 +27,9 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   const PatrolRecord* current_record = map.Patrol(current);
 
   auto start = std::chrono::steady_clock::now();
+  const bool along_route = options.route.enabled && prior_record != nullptr && current_record != nullptr &&
+                           !prior_record->route.empty() && !current_record->route.empty();
+  std::vector<change::RouteAnchor> anchors;
   for (const graph::TopoMap::Edge& edge : map.Edges()) {
     if (edge.data.kind != graph::EdgeKind::kLoopClosure) continue;
     int a = edge.a, b = edge.b;
@@ -42,9 +45,16 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     };
     change::PlaceChange place;
     place.prior_node = a, place.current_node = b;
-    place.appearance =
-        change::DetectAppearanceChange(view(a, prior_record), view(b, current_record), options.appearance);
+    anchors.push_back({map.node(a).timestamp_ns, map.node(b).timestamp_ns});
+    if (!along_route) {
+      place.appearance =
+          change::DetectAppearanceChange(view(a, prior_record), view(b, current_record), options.appearance);
+    }
     report->places.push_back(std::move(place));
+  }
+  if (along_route) {
+    report->route =
+        change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route, options.appearance);
   }
   report->seconds_appearance = SecondsSince(start);
   if (prior_record == nullptr || current_record == nullptr) return Status::Ok();

@@ -79,6 +79,22 @@ Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns,
   return event;
 }
 
+// A change found along the route, at the time and camera position of its best view's current frame.
+Event RouteEvent(const change::RouteChange& change, const change::ChangeReport& report, const graph::TopoMap& map) {
+  const change::RoutePair& pair = report.route.pairs[change.views[change.best].pair];
+  const RouteFrame& prior = map.Patrol(report.prior_flight)->route[pair.prior];
+  const RouteFrame& current = map.Patrol(report.current_flight)->route[pair.current];
+  Event event;
+  event.id = change::RouteChangeId(prior, current);
+  event.type = "appearance";
+  event.timestamp_ns = current.timestamp_ns;
+  if (current.pose) event.position = current.pose->position;
+  event.confidence = change.confidence;
+  event.details = {{"prior_frame", prior.frame_index}, {"frame", current.frame_index}, {"views", change.views.size()}};
+  if (current.gps) event.details["gps"] = json::array({current.gps->x(), current.gps->y()});
+  return event;
+}
+
 }  // namespace
 
 bool ChangeEventOptions::IsValid(std::string* error) const {
@@ -205,6 +221,7 @@ Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::Top
         at == node_positions_.end() ? std::nullopt : std::optional<Eigen::Vector3d>(at->second);
     Send(AppearanceEvent(place.prior_node, place.current_node, t, position, place.appearance), true);
   }
+  for (const change::RouteChange& change : report.route.changes) Send(RouteEvent(change, report, map), true);
   const TimestampNs end_ns = last_ns_;
   for (const change::ObjectChange& change : report.objects) {
     if (Reported(change.state)) Send(ObjectEvent(change, end_ns), true);

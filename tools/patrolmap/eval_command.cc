@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "commands.h"
 #include "common.h"
@@ -208,6 +209,80 @@ void ScoreAppearanceOf(const graph::TopoMap& map, const change::ChangeReport& re
                              {"recall", score.Recall()}};
 }
 
+constexpr double kVisibleShare = 0.01;  // a change is visible in a route frame when its box covers 1 % of it
+
+// The object changes visible in a route frame of `record` (whose flight's objects are `here`); false without a
+// pose or picture.
+bool RouteFrameTruth(const PatrolRecord& record, const RouteFrame& frame, const std::vector<eval::TruthObject>& here,
+                     const std::vector<eval::TruthObject>& other, const change::AppearanceOptions& appearance,
+                     eval::ChangeScoreOptions options, std::vector<eval::VisibleChange>* changes, cv::Size* size) {
+  const cv::Mat image = cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
+  const std::optional<CameraPoseSample> pose = frame.pose ? frame.pose : io::PoseAt(record.views, frame.timestamp_ns);
+  if (image.empty() || !pose || !record.camera.valid()) return false;
+  options.min_area_px = kVisibleShare * image.total();
+  const CameraIntrinsics camera = record.camera.Scaled(static_cast<double>(image.cols) / record.camera.width);
+  *changes = eval::VisibleChanges(here, other, frame.timestamp_ns, *pose, camera, options);
+  *size = image.size();
+  return true;
+}
+
+// Keeps the changes whose centre `to_other` maps inside an image of `size`.
+void KeepInside(const Eigen::Matrix3d& to_other, const cv::Size& size, std::vector<eval::VisibleChange>* changes) {
+  changes->erase(std::remove_if(changes->begin(), changes->end(),
+                                [&](const eval::VisibleChange& c) {
+                                  return !eval::CentreMapsInside(to_other, size.width, size.height, c.box);
+                                }),
+                 changes->end());
+}
+
+// Appearance along the route of the recomputed report against the object changes visible in its compared pairs.
+void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
+                  const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
+                  const change::AppearanceOptions& appearance, const eval::ChangeScoreOptions& options,
+                  nlohmann::json* result) {
+  const PatrolRecord* prior = map.Patrol(report.prior_flight);
+  const PatrolRecord* current = map.Patrol(report.current_flight);
+  if (!report.route.compared || prior == nullptr || current == nullptr) return;
+  std::vector<eval::RoutePairTruth> truth(report.route.pairs.size());
+  std::vector<bool> scored(report.route.pairs.size(), false);
+  for (std::size_t i = 0; i < report.route.pairs.size(); ++i) {
+    const change::RoutePair& pair = report.route.pairs[i];
+    cv::Size prior_size, current_size;
+    if (!RouteFrameTruth(*prior, prior->route[pair.prior], before, after, appearance, options, &truth[i].prior,
+                         &prior_size) ||
+        !RouteFrameTruth(*current, current->route[pair.current], after, before, appearance, options,
+                         &truth[i].current, &current_size)) {
+      continue;
+    }
+    Eigen::Matrix3d current_from_prior;
+    cv::cv2eigen(pair.appearance.homography, current_from_prior);
+    KeepInside(current_from_prior, current_size, &truth[i].prior);
+    KeepInside(current_from_prior.inverse(), prior_size, &truth[i].current);
+    scored[i] = true;
+  }
+  std::vector<eval::ReportedRouteChange> reported;
+  for (const change::RouteChange& change : report.route.changes) {
+    eval::ReportedRouteChange r;
+    for (const change::RouteChange::View& v : change.views) {
+      if (!scored[v.pair]) continue;
+      const change::AppearanceRegion& region = report.route.pairs[v.pair].appearance.regions[v.region];
+      r.pairs.push_back(v.pair);
+      r.boxes.push_back({region.prior_box, region.current_box});
+    }
+    reported.push_back(r);
+  }
+  const eval::RouteScore score = eval::ScoreRoute(truth, reported, options);
+  (*result)["route"] = {{"frames", report.route.current_frames},
+                        {"pairs", report.route.pairs.size()},
+                        {"compared_share", report.route.ComparedShare()},
+                        {"changes", score.changes},
+                        {"changes_on_change", score.changes_on_truth},
+                        {"visible", score.visible},
+                        {"found", score.found},
+                        {"precision", score.Precision()},
+                        {"recall", score.Recall()}};
+}
+
 // Changes of RUN (changes.json, and the grids in map.pmap) against the two flights' ground truth.
 Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLog>& logs, nlohmann::json* report) {
   const std::string path = arguments.run + "/changes.json";
@@ -255,6 +330,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     options.min_observations = config.change.geometry.min_observations;
     if (recomputed.geometry_compared) ScoreGeometryOf(map, recomputed, before, after, options, &result);
     ScoreAppearanceOf(map, recomputed, before, after, config.change.appearance, options, &result);
+    ScoreRouteOf(map, recomputed, before, after, config.change.appearance, options, &result);
   }
   (*report)["changes"] = result;
   return Status::Ok();
@@ -300,6 +376,15 @@ void PrintChangeTable(const nlohmann::json& c) {
                 Score(p + r > 0 ? 2 * p * r / (p + r) : 0.0, regions > 0 && changes > 0, 6).c_str());
     std::printf("appearance: %d regions, %d object changes visible in the key frames of %d registered places\n",
                 regions, changes, a["places"].get<int>());
+  }
+  if (c.contains("route")) {
+    const nlohmann::json& r = c["route"];
+    const int changes = r["changes"].get<int>(), visible = r["visible"].get<int>();
+    std::printf("route: %d of %d frames compared (%.0f %%); %d changes, %d on an object change (precision %s), "
+                "%d of %d visible object changes found (recall %s)\n",
+                r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
+                r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
+                r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);

@@ -56,6 +56,20 @@ struct AppearanceChange {
 // key frame. Features that still match show the same things seen from elsewhere (parallax).
 bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions& options);
 
+// The prior key frame registered onto the current one: ratio-test matches (query = current) and the homography
+// fitted to them by RANSAC (empty when it failed).
+struct Registration {
+  std::vector<cv::DMatch> matches;
+  int inliers = 0;
+  cv::Mat current_from_prior;  // image pixels, CV_64F 3x3
+};
+Registration Register(const KeyFrameView& prior, const KeyFrameView& current, const AppearanceOptions& options);
+
+// The changed regions of a registered pair (none when it has fewer than min_inliers inliers).
+AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
+                                   const Registration& registration, const AppearanceOptions& options);
+
+// Register, then CompareRegistered.
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,
                                         const AppearanceOptions& options);
 

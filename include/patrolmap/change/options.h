@@ -13,14 +13,32 @@ struct AppearanceOptions {
   int min_inliers = 12;                 // fewer: the pair is not registered and not compared
   double blur_sigma_px = 1.0;           // Gaussian blur before differencing
   int search_radius_px = 2;             // each pixel takes the best match within this shift (parallax)
-  double min_difference = 30.0;         // after global gain/offset compensation [grey levels], and ...
-  double min_structure_change = 0.5;    // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
+  double min_difference = 20.0;         // after global gain/offset compensation [grey levels], and ...
+  double min_structure_change = 0.4;    // 1 - SSIM's contrast-structure term (gain and offset free) must exceed this
   double structure_sigma_px = 1.5;      // Gaussian window of that term
-  double min_area_fraction = 0.01;      // regions smaller than this share of the compared area are dropped
+  int closing_px = 4;                   // changed pixels this close join one region (morphological closing)
+  double min_area_fraction = 0.002;     // regions smaller than this share of the compared area are dropped, ...
+  double min_side_fraction = 0.04;      // ... and so are regions thinner than this share of the image's shorter
+                                        // side (seams at depth edges and the image border)
   double min_unmatched_share = 0.5;     // ... and so are regions with features of which fewer than this share lost
                                         // their match between the key frames (parallax, not change)
   int parallax_search_px = 8;           // ... and regions whose content the registered prior image shows, up to
-  double max_shifted_similarity = 0.7;  // this far off, with a normalised cross-correlation above this
+  double max_shifted_similarity = 0.6;  // this far off, with a normalised cross-correlation above this
+  // After the homography, register the pair locally by dense optical flow (DIS), so parallax off the
+  // homography's plane does not differ; flows longer than max_flow_px are not followed.
+  bool dense_flow = false;
+  double max_flow_px = 12.0;
+};
+
+// Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
+// prior patrol's, and voting over consecutive aligned pairs.
+struct RouteCompareOptions {
+  bool enabled = true;           // false: only the key frames of the places both patrols saw are compared
+  double search_window_s = 4.0;  // a frame's partner is searched this far either side of its predicted time [s]
+  int max_features = 800;        // SIFT features found per route frame
+  int max_candidates = 6;        // prior frames registered per current frame: those most alike in a thumbnail
+  int min_votes = 2;             // consecutive aligned pairs that must agree on a region for it to be reported
+  double min_overlap = 0.3;      // agreeing regions overlap by this share of the smaller box
 };
 
 // Object map of one patrol (paper 000, with the 2D fallback of paper 001).
@@ -112,6 +130,7 @@ struct ChangeOptions {
   EvidenceGridOptions grid;
   GeometryDiffOptions geometry;
   RouteFrameOptions route_frames;
+  RouteCompareOptions route;
   // False with a message naming the first invalid option.
   bool IsValid(std::string* error) const;
 };

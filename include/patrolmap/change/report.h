@@ -20,6 +20,7 @@
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/geo_reference.h"
 #include "patrolmap/change/object_diff.h"
+#include "patrolmap/change/route_compare.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/graph/topo_map.h"
 
@@ -32,7 +33,8 @@ struct PlaceChange {
 
 struct ChangeReport {
   std::string prior_flight, current_flight;
-  std::vector<PlaceChange> places;  // every place both patrols saw
+  std::vector<PlaceChange> places;  // every place both patrols saw (their key frames compared when the route is not)
+  RouteComparison route;            // appearance along the route, when both patrols kept route frames
   bool objects_compared = false;    // both patrols had detections and poses
   std::vector<ObjectChange> objects;
   bool geometry_compared = false;  // both patrols had depth and poses
@@ -44,11 +46,14 @@ struct ChangeReport {
 };
 
 // Stable ids: "object-p<prior id>-c<current id>" (-1 where the object is not in that patrol),
-// "geometry-<x>_<y>_<z>" (the 2 m cell of the region's centroid), "appearance-<prior node>-<current node>".
+// "geometry-<x>_<y>_<z>" (the 2 m cell of the region's centroid), "appearance-<prior node>-<current node>"
+// (key frames of a place).
 // In a report, a later change with the same id (two regions in one cell) gets "-2", "-3", ... appended.
 std::string ObjectChangeId(const ObjectChange& change);
 std::string GeometryChangeId(const Eigen::Vector3d& centroid);
 std::string AppearanceChangeId(int prior_node, int current_node);
+// A change along the route: "appearance-f<prior frame index>-<current frame index>" of its best view's frames.
+std::string RouteChangeId(const RouteFrame& prior, const RouteFrame& current);
 
 // What one patrol saw of a change: the kept frame (PatrolRecord::route) that showed it best, cropped around
 // it with the change outlined.

@@ -108,7 +108,18 @@ std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here,
                                            TimestampNs time_ns, const CameraPoseSample& pose,
                                            const CameraIntrinsics& camera, const ChangeScoreOptions& options);
 
-// Keeps the boxes whose centre `to_other` (a homography) maps inside a width x height image.
+struct VisibleChange {
+  int id = 0;  // the object's
+  cv::Rect2d box;
+};
+// VisibleChangeBoxes with the objects' ids.
+std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
+                                          TimestampNs time_ns, const CameraPoseSample& pose,
+                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options);
+
+// Whether `to_other` (a homography) maps the box's centre inside a width x height image.
+bool CentreMapsInside(const Eigen::Matrix3d& to_other, int width, int height, const cv::Rect2d& box);
+// Keeps the boxes whose centre `to_other` maps inside a width x height image.
 void KeepInOverlap(const Eigen::Matrix3d& to_other, int width, int height, std::vector<cv::Rect2d>* boxes);
 
 struct PlaceTruth {
@@ -129,5 +140,27 @@ struct AppearanceScore {
 AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
                                 const std::vector<std::vector<RegionBoxes>>& regions,
                                 const ChangeScoreOptions& options);
+
+// Appearance along the route (change::RouteComparison). Per compared pair of route frames, the object changes
+// visible in each frame (as for key frames, within the pair's overlap). A reported change lies on a change
+// when one of its views' boxes overlaps a visible change's box in that view's pair; an object change (per
+// side: its prior or current position) is found when some reported change lies on it in some pair.
+// Precision = changes on a change / changes; recall = object changes found / object changes visible in any
+// compared pair.
+struct RoutePairTruth {
+  std::vector<VisibleChange> prior, current;
+};
+struct ReportedRouteChange {
+  std::vector<int> pairs;            // per view: the compared pair (index into the truth)
+  std::vector<RegionBoxes> boxes;    // ... and its boxes in the pair's two frames
+};
+struct RouteScore {
+  int changes = 0, changes_on_truth = 0;
+  int visible = 0, found = 0;
+  double Precision() const;
+  double Recall() const;
+};
+RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
+                      const ChangeScoreOptions& options);
 
 }  // namespace patrolmap::eval

@@ -83,10 +83,14 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.appearance.min_difference", &change.appearance.min_difference);
   visitor->Field("change.appearance.min_structure_change", &change.appearance.min_structure_change);
   visitor->Field("change.appearance.structure_sigma_px", &change.appearance.structure_sigma_px);
+  visitor->Field("change.appearance.closing_px", &change.appearance.closing_px);
   visitor->Field("change.appearance.min_area_fraction", &change.appearance.min_area_fraction);
+  visitor->Field("change.appearance.min_side_fraction", &change.appearance.min_side_fraction);
   visitor->Field("change.appearance.min_unmatched_share", &change.appearance.min_unmatched_share);
   visitor->Field("change.appearance.parallax_search_px", &change.appearance.parallax_search_px);
   visitor->Field("change.appearance.max_shifted_similarity", &change.appearance.max_shifted_similarity);
+  visitor->Field("change.appearance.dense_flow", &change.appearance.dense_flow);
+  visitor->Field("change.appearance.max_flow_px", &change.appearance.max_flow_px);
   visitor->Field("change.object_map.centroid_gate_m", &change.object_map.centroid_gate_m);
   visitor->Field("change.object_map.pair_distance_m", &change.object_map.pair_distance_m);
   visitor->Field("change.object_map.min_pair_fraction", &change.object_map.min_pair_fraction);
@@ -130,6 +134,12 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route_frames.max_width", &change.route_frames.max_width);
   visitor->Field("change.route_frames.jpeg_quality", &change.route_frames.jpeg_quality);
   visitor->Field("change.route_frames.memory_mb", &change.route_frames.memory_mb);
+  visitor->Field("change.route.enabled", &change.route.enabled);
+  visitor->Field("change.route.search_window_s", &change.route.search_window_s);
+  visitor->Field("change.route.max_features", &change.route.max_features);
+  visitor->Field("change.route.max_candidates", &change.route.max_candidates);
+  visitor->Field("change.route.min_votes", &change.route.min_votes);
+  visitor->Field("change.route.min_overlap", &change.route.min_overlap);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);

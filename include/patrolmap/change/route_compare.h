@@ -1,0 +1,67 @@
+// Appearance change along the whole route (issue 15): every frame a patrol kept along its route
+// (PatrolRecord::route) is aligned to the frame of the prior patrol's route that shows the same place, and
+// every aligned pair is compared (DetectAppearanceChange). A region is reported when consecutive aligned
+// pairs agree on it.
+//
+// Alignment. Loop closures between the two flights are anchors: each ties a prior time to a current time. A
+// current frame's partner is searched among the prior frames within `search_window_s` of the times its
+// nearest anchors predict (the same time offset) and of the time the previous aligned frame's partner
+// predicts; without anchors, among all prior frames. The candidate whose features register onto the frame
+// with the most homography inliers (at least the appearance stage's min_inliers) is its partner.
+//
+// Voting. A region of one aligned pair agrees with one of the next pair (the next current frame) when its box,
+// carried into that frame by the homography between the two current frames, overlaps it by `min_overlap` of
+// the smaller box. Chains of agreeing regions over at least `min_votes` pairs are the changes; a lone region is
+// a fluke of one view (a reflection, an alignment error, a passer-by) and is dropped.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/patrol_data.h"
+
+namespace patrolmap::change {
+
+struct RouteAnchor {
+  TimestampNs prior_ns = 0, current_ns = 0;  // the same place on the two flights
+};
+
+// One current route frame and the prior route frame aligned to it, compared.
+struct RoutePair {
+  int prior = -1, current = -1;  // indices into the two routes
+  AppearanceChange appearance;
+};
+
+// One region seen in consecutive aligned pairs.
+struct RouteChange {
+  struct View {
+    int pair = -1, region = -1;  // RouteComparison::pairs[pair].appearance.regions[region]
+  };
+  std::vector<View> views;  // in time order, one per agreeing pair
+  int best = 0;             // index into views: the largest region
+  double score = 0.0;       // mean structure change over the views
+  double confidence = 0.0;  // in [0, 1]: the score, weighed by how many views agreed
+};
+
+struct RouteComparison {
+  bool compared = false;         // both patrols kept frames along their routes
+  int current_frames = 0;        // frames the current patrol kept
+  std::vector<RoutePair> pairs;  // the aligned pairs, in the current route's order
+  std::vector<RouteChange> changes;
+  // The share of the current route that was aligned and compared.
+  double ComparedShare() const;
+};
+
+// The route frame decoded (grey), with its SIFT features; feature_scale 1.
+KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features);
+
+RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
+                              const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
+                              const AppearanceOptions& appearance);
+
+}  // namespace patrolmap::change

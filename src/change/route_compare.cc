@@ -1,0 +1,240 @@
+#include "patrolmap/change/route_compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <set>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace patrolmap::change {
+namespace {
+
+const cv::Size kSignatureSize(32, 20);  // the thumbnail that ranks a frame's candidate partners
+
+// A frame as a small thumbnail with zero mean and unit norm: the dot product of two is their normalised
+// correlation, free of exposure.
+cv::Mat Signature(const cv::Mat& grey) {
+  cv::Mat small, floats;
+  if (grey.empty()) return cv::Mat::zeros(kSignatureSize, CV_32F);
+  cv::resize(grey, small, kSignatureSize, 0, 0, cv::INTER_AREA);
+  small.convertTo(floats, CV_32F);
+  floats -= cv::mean(floats)[0];
+  const double norm = cv::norm(floats);
+  if (norm > 0.0) floats /= norm;
+  return floats;
+}
+
+double Seconds(TimestampNs ns) { return static_cast<double>(ns) * 1e-9; }
+
+// The prior times a current frame's partner is expected at: the same time offset as the two anchors nearest in
+// time, and as the previous aligned pair.
+std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors,
+                                   const RoutePair* previous, const std::vector<RouteFrame>& prior,
+                                   const std::vector<RouteFrame>& current) {
+  std::vector<std::pair<double, double>> by_distance;  // (|time apart|, predicted prior time)
+  for (const RouteAnchor& a : anchors) {
+    by_distance.emplace_back(std::abs(Seconds(a.current_ns) - current_s),
+                             Seconds(a.prior_ns) + current_s - Seconds(a.current_ns));
+  }
+  std::sort(by_distance.begin(), by_distance.end());
+  std::vector<double> times;
+  for (std::size_t i = 0; i < by_distance.size() && i < 2; ++i) times.push_back(by_distance[i].second);
+  if (previous != nullptr) {
+    times.push_back(Seconds(prior[previous->prior].timestamp_ns) + current_s -
+                    Seconds(current[previous->current].timestamp_ns));
+  }
+  return times;
+}
+
+// The prior frames within the window of a predicted time (all of them without a prediction), the
+// `max_candidates` most alike first.
+std::vector<int> Candidates(const std::vector<double>& predicted, const std::vector<RouteFrame>& prior,
+                            const std::vector<cv::Mat>& prior_signatures, const cv::Mat& signature,
+                            const RouteCompareOptions& options) {
+  std::vector<std::pair<double, int>> ranked;
+  for (std::size_t p = 0; p < prior.size(); ++p) {
+    const double t = Seconds(prior[p].timestamp_ns);
+    const bool near = predicted.empty() || std::any_of(predicted.begin(), predicted.end(), [&](double centre) {
+                        return std::abs(t - centre) <= options.search_window_s;
+                      });
+    if (near) ranked.emplace_back(-signature.dot(prior_signatures[p]), static_cast<int>(p));
+  }
+  const std::size_t keep = std::min(ranked.size(), static_cast<std::size_t>(options.max_candidates));
+  std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end());
+  std::vector<int> candidates;
+  for (std::size_t i = 0; i < keep; ++i) candidates.push_back(ranked[i].second);
+  return candidates;
+}
+
+// Overlap of two boxes as a share of the smaller one.
+double OverlapOfSmaller(const cv::Rect2d& a, const cv::Rect2d& b) {
+  const double smaller = std::min(a.area(), b.area());
+  return smaller > 0.0 ? (a & b).area() / smaller : 0.0;
+}
+
+// Keeps the regions of `change` that a comparison of the same current frame with a second prior frame also
+// found (a region overlapping by `min_overlap`): what differs only from one viewpoint is parallax.
+void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, AppearanceChange* change) {
+  const auto alone = [&](const AppearanceRegion& r) {
+    return std::none_of(second.regions.begin(), second.regions.end(), [&](const AppearanceRegion& s) {
+      return OverlapOfSmaller(r.current_box, s.current_box) >= min_overlap;
+    });
+  };
+  change->regions.erase(std::remove_if(change->regions.begin(), change->regions.end(), alone),
+                        change->regions.end());
+}
+
+// Aligns the current frame `c` to its best-registered candidate and compares the pair; false when no
+// candidate registers. With a second registered candidate, a region must be found against both.
+bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<KeyFrameView>& prior_views,
+                const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
+                const AppearanceOptions& appearance, RoutePair* pair) {
+  std::vector<std::pair<Registration, int>> registered;  // best first
+  for (const int p : candidates) {
+    Registration r = Register(prior_views[p], current_views[c], appearance);
+    if (r.inliers >= appearance.min_inliers && !r.current_from_prior.empty()) registered.emplace_back(std::move(r), p);
+  }
+  if (registered.empty()) return false;
+  std::stable_sort(registered.begin(), registered.end(),
+                   [](const auto& a, const auto& b) { return a.first.inliers > b.first.inliers; });
+  pair->prior = registered[0].second;
+  pair->current = c;
+  pair->appearance = CompareRegistered(prior_views[pair->prior], current_views[c], registered[0].first, appearance);
+  if (!pair->appearance.registered) return false;
+  if (registered.size() > 1 && !pair->appearance.regions.empty()) {
+    const AppearanceChange second =
+        CompareRegistered(prior_views[registered[1].second], current_views[c], registered[1].first, appearance);
+    if (second.registered) KeepSeenFromBoth(second, options.min_overlap, &pair->appearance);
+  }
+  return true;
+}
+
+cv::Rect2d MapBox(const cv::Rect& box, const cv::Mat& homography) {
+  const std::vector<cv::Point2f> corners = {
+      cv::Point2f(box.x, box.y), cv::Point2f(box.x + box.width, box.y),
+      cv::Point2f(box.x + box.width, box.y + box.height), cv::Point2f(box.x, box.y + box.height)};
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(corners, mapped, homography);
+  return cv::boundingRect(mapped);
+}
+
+int Find(std::vector<int>* parent, int i) {
+  while ((*parent)[i] != i) i = (*parent)[i] = (*parent)[(*parent)[i]];
+  return i;
+}
+
+// Links the regions of consecutive aligned pairs that show the same thing: the earlier box carried into the
+// later current frame overlaps the later box.
+void LinkConsecutive(const RouteComparison& comparison, const std::vector<KeyFrameView>& current_views,
+                     const std::vector<int>& first_node, const RouteCompareOptions& options,
+                     const AppearanceOptions& appearance, std::vector<int>* parent) {
+  for (std::size_t i = 0; i + 1 < comparison.pairs.size(); ++i) {
+    const RoutePair &a = comparison.pairs[i], &b = comparison.pairs[i + 1];
+    if (a.appearance.regions.empty() || b.appearance.regions.empty() || b.current != a.current + 1) continue;
+    const Registration step = Register(current_views[a.current], current_views[b.current], appearance);
+    if (step.inliers < appearance.min_inliers || step.current_from_prior.empty()) continue;
+    for (std::size_t ra = 0; ra < a.appearance.regions.size(); ++ra) {
+      const cv::Rect2d carried = MapBox(a.appearance.regions[ra].current_box, step.current_from_prior);
+      for (std::size_t rb = 0; rb < b.appearance.regions.size(); ++rb) {
+        if (OverlapOfSmaller(carried, b.appearance.regions[rb].current_box) < options.min_overlap) continue;
+        (*parent)[Find(parent, first_node[i] + static_cast<int>(ra))] =
+            Find(parent, first_node[i + 1] + static_cast<int>(rb));
+      }
+    }
+  }
+}
+
+// The chains of linked regions over at least min_votes pairs, as changes.
+std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vector<KeyFrameView>& current_views,
+                              const RouteCompareOptions& options, const AppearanceOptions& appearance) {
+  std::vector<int> first_node;  // per pair: the node of its first region
+  int nodes = 0;
+  for (const RoutePair& pair : comparison.pairs) {
+    first_node.push_back(nodes);
+    nodes += static_cast<int>(pair.appearance.regions.size());
+  }
+  std::vector<int> parent(nodes);
+  std::iota(parent.begin(), parent.end(), 0);
+  LinkConsecutive(comparison, current_views, first_node, options, appearance, &parent);
+  std::map<int, RouteChange> chains;  // by root, so the changes come in route order
+  for (std::size_t i = 0; i < comparison.pairs.size(); ++i) {
+    for (std::size_t r = 0; r < comparison.pairs[i].appearance.regions.size(); ++r) {
+      const int root = Find(&parent, first_node[i] + static_cast<int>(r));
+      chains[root].views.push_back({static_cast<int>(i), static_cast<int>(r)});
+    }
+  }
+  std::vector<RouteChange> changes;
+  for (auto& [root, change] : chains) {
+    std::vector<int> pairs;
+    for (const RouteChange::View& v : change.views) pairs.push_back(v.pair);
+    const int votes = static_cast<int>(std::set<int>(pairs.begin(), pairs.end()).size());
+    if (votes < options.min_votes) continue;
+    int largest = 0;
+    double score = 0.0;
+    for (std::size_t k = 0; k < change.views.size(); ++k) {
+      const auto region = [&](std::size_t j) -> const AppearanceRegion& {
+        return comparison.pairs[change.views[j].pair].appearance.regions[change.views[j].region];
+      };
+      score += region(k).score;
+      if (region(k).area_px > region(largest).area_px) largest = static_cast<int>(k);
+    }
+    change.best = largest;
+    change.score = score / change.views.size();
+    change.confidence = std::clamp(change.score, 0.0, 1.0) * votes / (votes + 1.0);
+    changes.push_back(std::move(change));
+  }
+  std::sort(changes.begin(), changes.end(), [](const RouteChange& a, const RouteChange& b) {
+    return a.views.front().pair < b.views.front().pair;
+  });
+  return changes;
+}
+
+}  // namespace
+
+double RouteComparison::ComparedShare() const {
+  return current_frames > 0 ? static_cast<double>(pairs.size()) / current_frames : 0.0;
+}
+
+KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features) {
+  KeyFrameView view;
+  if (!frame.jpeg.empty()) view.image = cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
+  if (view.image.empty()) return view;
+  cv::SIFT::create(max_features)->detectAndCompute(view.image, cv::noArray(), view.keypoints, view.descriptors);
+  return view;
+}
+
+RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
+                              const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
+                              const AppearanceOptions& appearance) {
+  RouteComparison comparison;
+  comparison.current_frames = static_cast<int>(current.size());
+  if (prior.empty() || current.empty()) return comparison;
+  comparison.compared = true;
+  std::vector<KeyFrameView> prior_views, current_views;
+  std::vector<cv::Mat> prior_signatures;
+  for (const RouteFrame& f : prior) {
+    prior_views.push_back(RouteFrameView(f, options.max_features));
+    prior_signatures.push_back(Signature(prior_views.back().image));
+  }
+  for (const RouteFrame& f : current) current_views.push_back(RouteFrameView(f, options.max_features));
+  for (std::size_t c = 0; c < current.size(); ++c) {
+    const RoutePair* previous = comparison.pairs.empty() ? nullptr : &comparison.pairs.back();
+    const std::vector<double> predicted =
+        PredictedTimes(Seconds(current[c].timestamp_ns), anchors, previous, prior, current);
+    const std::vector<int> candidates =
+        Candidates(predicted, prior, prior_signatures, Signature(current_views[c].image), options);
+    RoutePair pair;
+    if (AlignFrame(static_cast<int>(c), candidates, prior_views, current_views, options, appearance, &pair)) {
+      comparison.pairs.push_back(std::move(pair));
+    }
+  }
+  comparison.changes = Vote(comparison, current_views, options, appearance);
+  return comparison;
+}
+
+}  // namespace patrolmap::change

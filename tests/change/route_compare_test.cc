@@ -1,0 +1,140 @@
+// Appearance along the route (route_compare.h): route frames aligned and compared, regions voted over
+// consecutive pairs; and real same-scene pairs (Debian's opencv-doc) that must give no region.
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/route_compare.h"
+
+namespace patrolmap::change {
+namespace {
+
+constexpr int kFrameWidth = 376, kFrameHeight = 240, kStepPx = 40, kFrames = 14;
+
+// A long textured facade: the camera flies along it.
+cv::Mat Facade(int seed) {
+  cv::Mat facade(kFrameHeight, kFrameWidth + kStepPx * (kFrames + 2), CV_8UC1, cv::Scalar(110));
+  cv::RNG rng(seed);
+  for (int i = 0; i < 700; ++i) {
+    const cv::Point a(rng.uniform(0, facade.cols), rng.uniform(0, facade.rows));
+    cv::rectangle(facade, a, a + cv::Point(rng.uniform(4, 30), rng.uniform(4, 30)), cv::Scalar(rng.uniform(0, 255)),
+                  cv::FILLED);
+  }
+  cv::GaussianBlur(facade, facade, cv::Size(3, 3), 0.7);
+  return facade;
+}
+
+// Frames every kStepPx along the facade (first at `offset_px`), one a second, as JPEG route frames.
+std::vector<RouteFrame> Route(const cv::Mat& facade, int offset_px, double gain, double bias) {
+  std::vector<RouteFrame> route;
+  for (int i = 0; i < kFrames; ++i) {
+    cv::Mat frame;
+    facade(cv::Rect(offset_px + i * kStepPx, 0, kFrameWidth, kFrameHeight)).convertTo(frame, CV_8U, gain, bias);
+    RouteFrame f;
+    f.timestamp_ns = SecondsToNs(1.0 + i);
+    f.frame_index = 30 * i;
+    cv::imencode(".jpg", frame, f.jpeg, {cv::IMWRITE_JPEG_QUALITY, 90});
+    route.push_back(std::move(f));
+  }
+  return route;
+}
+
+// Whether some view of the change outlines the object at facade columns [x0, x1) in its current frame.
+bool OnObject(const RouteComparison& comparison, const RouteChange& change, int offset_px, int x0, int x1,
+              const cv::Rect& rows) {
+  for (const RouteChange::View& v : change.views) {
+    const RoutePair& pair = comparison.pairs[v.pair];
+    const cv::Rect object(x0 - offset_px - pair.current * kStepPx, rows.y, x1 - x0, rows.height);
+    const cv::Rect& box = pair.appearance.regions[v.region].current_box;
+    if ((box & object).area() < 0.5 * std::min(box.area(), object.area())) return false;
+  }
+  return true;
+}
+
+TEST(RouteCompare, EveryFrameIsAlignedAndALightingChangeGivesNoChange) {
+  const cv::Mat facade = Facade(3);
+  const std::vector<RouteFrame> prior = Route(facade, 0, 1.0, 0.0);
+  const std::vector<RouteFrame> current = Route(facade, 12, 0.7, 25.0);  // 12 px on, darker
+  const RouteComparison comparison =
+      CompareRoutes(prior, current, {{SecondsToNs(3.0), SecondsToNs(3.0)}}, RouteCompareOptions{},
+                    AppearanceOptions{});
+  ASSERT_TRUE(comparison.compared);
+  EXPECT_EQ(comparison.current_frames, kFrames);
+  EXPECT_EQ(static_cast<int>(comparison.pairs.size()), kFrames);
+  for (const RoutePair& pair : comparison.pairs) EXPECT_EQ(pair.prior, pair.current);  // 12 px beats 28 px
+  EXPECT_TRUE(comparison.changes.empty());
+}
+
+TEST(RouteCompare, AnObjectSeenFromSeveralFramesIsOneChangeWithTheirVotes) {
+  const cv::Mat facade = Facade(4);
+  cv::Mat changed = facade.clone();
+  const cv::Rect object(300, 90, 60, 70);  // facade pixels: in frames 0-7 of the current route
+  changed(object).setTo(35);
+  cv::rectangle(changed, object, cv::Scalar(230), 3);
+  const std::vector<RouteFrame> prior = Route(facade, 0, 1.0, 0.0);
+  const std::vector<RouteFrame> current = Route(changed, 8, 1.0, 0.0);
+  const RouteComparison comparison = CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{});
+  EXPECT_EQ(static_cast<int>(comparison.pairs.size()), kFrames);  // without anchors, by thumbnails alone
+  ASSERT_EQ(comparison.changes.size(), 1u);
+  const RouteChange& change = comparison.changes[0];
+  EXPECT_GE(static_cast<int>(change.views.size()), 4);
+  EXPECT_TRUE(OnObject(comparison, change, 8, object.x, object.br().x, object));
+  EXPECT_GT(change.confidence, 0.0);
+  EXPECT_LE(change.confidence, 1.0);
+}
+
+TEST(RouteCompare, ARegionInOneFrameOnlyIsNotReported) {
+  const cv::Mat facade = Facade(5);
+  std::vector<RouteFrame> current = Route(facade, 0, 1.0, 0.0);
+  cv::Mat frame = cv::imdecode(current[6].jpeg, cv::IMREAD_GRAYSCALE);
+  frame(cv::Rect(150, 80, 60, 60)).setTo(20);  // a passer-by in one frame
+  cv::imencode(".jpg", frame, current[6].jpeg);
+  RouteCompareOptions options;
+  const RouteComparison voted = CompareRoutes(Route(facade, 0, 1.0, 0.0), current, {}, options, AppearanceOptions{});
+  EXPECT_TRUE(voted.changes.empty());
+  options.min_votes = 1;
+  const RouteComparison single = CompareRoutes(Route(facade, 0, 1.0, 0.0), current, {}, options, AppearanceOptions{});
+  EXPECT_EQ(single.changes.size(), 1u);
+}
+
+TEST(RouteCompare, WithoutFramesNothingIsCompared) {
+  const RouteComparison comparison =
+      CompareRoutes({}, Route(Facade(6), 0, 1.0, 0.0), {}, RouteCompareOptions{}, AppearanceOptions{});
+  EXPECT_FALSE(comparison.compared);
+  EXPECT_EQ(comparison.ComparedShare(), 0.0);
+}
+
+// Real pairs of one unchanged scene (Debian's opencv-doc): an exposure change (leuven), a strong viewpoint change
+// of a plane (graf) and an aerial view from elsewhere (aero). At the route frames' width, none may give a region.
+class RealUnchangedPair : public testing::TestWithParam<std::pair<const char*, const char*>> {};
+
+TEST_P(RealUnchangedPair, GivesNoRegion) {
+  const std::string data = "/usr/share/doc/opencv-doc/examples/data/";
+  if (!std::filesystem::exists(data + GetParam().first)) GTEST_SKIP() << "opencv-doc not installed";
+  const auto view = [&](const char* name) {
+    cv::Mat image = cv::imread(data + name, cv::IMREAD_GRAYSCALE);
+    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
+               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
+    RouteFrame frame;
+    cv::imencode(".jpg", image, frame.jpeg);
+    return RouteFrameView(frame, RouteCompareOptions{}.max_features);
+  };
+  const AppearanceChange change = DetectAppearanceChange(view(GetParam().first), view(GetParam().second),
+                                                         AppearanceOptions{});
+  ASSERT_TRUE(change.registered) << change.matches << " matches, " << change.inliers << " inliers";
+  EXPECT_TRUE(change.regions.empty()) << change.regions.size() << " regions, the first at "
+                                      << change.regions[0].current_box;
+}
+
+INSTANTIATE_TEST_SUITE_P(OpencvDoc, RealUnchangedPair,
+                         testing::Values(std::make_pair("leuvenA.jpg", "leuvenB.jpg"),
+                                         std::make_pair("graf1.png", "graf3.png"),
+                                         std::make_pair("aero1.jpg", "aero3.jpg")));
+
+}  // namespace
+}  // namespace patrolmap::change
