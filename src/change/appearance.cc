@@ -109,7 +109,8 @@ void FollowFlow(const cv::Mat& current, double gain, double offset, double max_f
     cv::Vec2f* m = map.ptr<cv::Vec2f>(y);
     for (int x = 0; x < flow.cols; ++x) {
       const bool kept = f[x].dot(f[x]) <= max_squared;
-      m[x] = cv::Vec2f(static_cast<float>(x) + (kept ? f[x][0] : 0.0f), static_cast<float>(y) + (kept ? f[x][1] : 0.0f));
+      m[x] =
+          cv::Vec2f(static_cast<float>(x) + (kept ? f[x][0] : 0.0f), static_cast<float>(y) + (kept ? f[x][1] : 0.0f));
     }
   }
   cv::Mat resampled;

@@ -144,7 +144,8 @@ const MapObject* FindObject(const PatrolRecord* record, int id) {
 cv::Mat OutlinedFrame(const cv::Mat& frame, int reference_width, const std::vector<cv::Rect>& boxes,
                       const ReportOptions& options) {
   double scale = 1.0;
-  cv::Mat image = Fit(frame, std::max(options.crop_size_px, std::min(2 * frame.cols, 2 * options.crop_size_px)), &scale);
+  cv::Mat image =
+      Fit(frame, std::max(options.crop_size_px, std::min(2 * frame.cols, 2 * options.crop_size_px)), &scale);
   const double to_image = static_cast<double>(image.cols) / reference_width;
   for (const cv::Rect& b : boxes) {
     cv::rectangle(image, cv::Rect2d(b.x * to_image, b.y * to_image, b.width * to_image, b.height * to_image), kOutline,

@@ -33,9 +33,8 @@ double Seconds(TimestampNs ns) { return static_cast<double>(ns) * 1e-9; }
 
 // The prior times a current frame's partner is expected at: the same time offset as the two anchors nearest in
 // time, and as the previous aligned pair.
-std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors,
-                                   const RoutePair* previous, const std::vector<RouteFrame>& prior,
-                                   const std::vector<RouteFrame>& current) {
+std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors, const RoutePair* previous,
+                                   const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current) {
   std::vector<std::pair<double, double>> by_distance;  // (|time apart|, predicted prior time)
   for (const RouteAnchor& a : anchors) {
     by_distance.emplace_back(std::abs(Seconds(a.current_ns) - current_s),
@@ -77,6 +76,27 @@ double OverlapOfSmaller(const cv::Rect2d& a, const cv::Rect2d& b) {
   return smaller > 0.0 ? (a & b).area() / smaller : 0.0;
 }
 
+constexpr double kNearlyMostInliers = 0.8;
+
+// The share of a `size` image that the prior image (of `prior_size`) covers through the homography.
+double Coverage(const cv::Mat& current_from_prior, const cv::Size& prior_size, const cv::Size& size) {
+  const std::vector<cv::Point2f> corners = {
+      {0.0f, 0.0f},
+      {static_cast<float>(prior_size.width), 0.0f},
+      {static_cast<float>(prior_size.width), static_cast<float>(prior_size.height)},
+      {0.0f, static_cast<float>(prior_size.height)}};
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(corners, mapped, current_from_prior);
+  const std::vector<cv::Point2f> image = {{0.0f, 0.0f},
+                                          {static_cast<float>(size.width), 0.0f},
+                                          {static_cast<float>(size.width), static_cast<float>(size.height)},
+                                          {0.0f, static_cast<float>(size.height)}};
+  std::vector<cv::Point2f> overlap;
+  if (!cv::isContourConvex(mapped)) return 0.0;
+  const float area = cv::intersectConvexConvex(mapped, image, overlap);
+  return size.area() > 0 ? area / size.area() : 0.0;
+}
+
 // Keeps the regions of `change` that a comparison of the same current frame with a second prior frame also
 // found (a region overlapping by `min_overlap`): what differs only from one viewpoint is parallax.
 void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, AppearanceChange* change) {
@@ -85,8 +105,7 @@ void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, Appear
       return OverlapOfSmaller(r.current_box, s.current_box) >= min_overlap;
     });
   };
-  change->regions.erase(std::remove_if(change->regions.begin(), change->regions.end(), alone),
-                        change->regions.end());
+  change->regions.erase(std::remove_if(change->regions.begin(), change->regions.end(), alone), change->regions.end());
 }
 
 // Aligns the current frame `c` to its best-registered candidate and compares the pair; false when no
@@ -100,8 +119,19 @@ bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<Key
     if (r.inliers >= appearance.min_inliers && !r.current_from_prior.empty()) registered.emplace_back(std::move(r), p);
   }
   if (registered.empty()) return false;
+  // Candidates with nearly the most inliers are alike in registration; the one covering most of the frame
+  // is the nearest viewpoint (least parallax).
+  int most = 0;
+  for (const auto& r : registered) most = std::max(most, r.first.inliers);
+  const cv::Size size = current_views[c].image.size();
+  const auto rank = [&](const std::pair<Registration, int>& r) {
+    const bool near_most = r.first.inliers >= kNearlyMostInliers * most;
+    return std::make_pair(near_most,
+                          near_most ? Coverage(r.first.current_from_prior, prior_views[r.second].image.size(), size)
+                                    : static_cast<double>(r.first.inliers));
+  };
   std::stable_sort(registered.begin(), registered.end(),
-                   [](const auto& a, const auto& b) { return a.first.inliers > b.first.inliers; });
+                   [&](const auto& a, const auto& b) { return rank(a) > rank(b); });
   pair->prior = registered[0].second;
   pair->current = c;
   pair->appearance = CompareRegistered(prior_views[pair->prior], current_views[c], registered[0].first, appearance);
@@ -115,9 +145,9 @@ bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<Key
 }
 
 cv::Rect2d MapBox(const cv::Rect& box, const cv::Mat& homography) {
-  const std::vector<cv::Point2f> corners = {
-      cv::Point2f(box.x, box.y), cv::Point2f(box.x + box.width, box.y),
-      cv::Point2f(box.x + box.width, box.y + box.height), cv::Point2f(box.x, box.y + box.height)};
+  const std::vector<cv::Point2f> corners = {cv::Point2f(box.x, box.y), cv::Point2f(box.x + box.width, box.y),
+                                            cv::Point2f(box.x + box.width, box.y + box.height),
+                                            cv::Point2f(box.x, box.y + box.height)};
   std::vector<cv::Point2f> mapped;
   cv::perspectiveTransform(corners, mapped, homography);
   return cv::boundingRect(mapped);
@@ -188,9 +218,8 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
     change.confidence = std::clamp(change.score, 0.0, 1.0) * votes / (votes + 1.0);
     changes.push_back(std::move(change));
   }
-  std::sort(changes.begin(), changes.end(), [](const RouteChange& a, const RouteChange& b) {
-    return a.views.front().pair < b.views.front().pair;
-  });
+  std::sort(changes.begin(), changes.end(),
+            [](const RouteChange& a, const RouteChange& b) { return a.views.front().pair < b.views.front().pair; });
   return changes;
 }
 

@@ -250,8 +250,8 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
     cv::Size prior_size, current_size;
     if (!RouteFrameTruth(*prior, prior->route[pair.prior], before, after, appearance, options, &truth[i].prior,
                          &prior_size) ||
-        !RouteFrameTruth(*current, current->route[pair.current], after, before, appearance, options,
-                         &truth[i].current, &current_size)) {
+        !RouteFrameTruth(*current, current->route[pair.current], after, before, appearance, options, &truth[i].current,
+                         &current_size)) {
       continue;
     }
     Eigen::Matrix3d current_from_prior;
@@ -380,11 +380,12 @@ void PrintChangeTable(const nlohmann::json& c) {
   if (c.contains("route")) {
     const nlohmann::json& r = c["route"];
     const int changes = r["changes"].get<int>(), visible = r["visible"].get<int>();
-    std::printf("route: %d of %d frames compared (%.0f %%); %d changes, %d on an object change (precision %s), "
-                "%d of %d visible object changes found (recall %s)\n",
-                r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
-                r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
-                r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
+    std::printf(
+        "route: %d of %d frames compared (%.0f %%); %d changes, %d on an object change (precision %s), "
+        "%d of %d visible object changes found (recall %s)\n",
+        r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
+        r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
+        r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);

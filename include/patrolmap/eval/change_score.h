@@ -151,8 +151,8 @@ struct RoutePairTruth {
   std::vector<VisibleChange> prior, current;
 };
 struct ReportedRouteChange {
-  std::vector<int> pairs;            // per view: the compared pair (index into the truth)
-  std::vector<RegionBoxes> boxes;    // ... and its boxes in the pair's two frames
+  std::vector<int> pairs;          // per view: the compared pair (index into the truth)
+  std::vector<RegionBoxes> boxes;  // ... and its boxes in the pair's two frames
 };
 struct RouteScore {
   int changes = 0, changes_on_truth = 0;
