@@ -214,8 +214,8 @@ constexpr double kVisibleShare = 0.01;  // a change is visible in a route frame 
 // The object changes visible in a route frame of `record` (whose flight's objects are `here`); false without a
 // pose or picture.
 bool RouteFrameTruth(const PatrolRecord& record, const RouteFrame& frame, const std::vector<eval::TruthObject>& here,
-                     const std::vector<eval::TruthObject>& other, const change::AppearanceOptions& appearance,
-                     eval::ChangeScoreOptions options, std::vector<eval::VisibleChange>* changes, cv::Size* size) {
+                     const std::vector<eval::TruthObject>& other, eval::ChangeScoreOptions options,
+                     std::vector<eval::VisibleChange>* changes, cv::Size* size) {
   const cv::Mat image = cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
   const std::optional<CameraPoseSample> pose = frame.pose ? frame.pose : io::PoseAt(record.views, frame.timestamp_ns);
   if (image.empty() || !pose || !record.camera.valid()) return false;
@@ -238,8 +238,7 @@ void KeepInside(const Eigen::Matrix3d& to_other, const cv::Size& size, std::vect
 // Appearance along the route of the recomputed report against the object changes visible in its compared pairs.
 void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
                   const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
-                  const change::AppearanceOptions& appearance, const eval::ChangeScoreOptions& options,
-                  nlohmann::json* result) {
+                  const eval::ChangeScoreOptions& options, nlohmann::json* result) {
   const PatrolRecord* prior = map.Patrol(report.prior_flight);
   const PatrolRecord* current = map.Patrol(report.current_flight);
   if (!report.route.compared || prior == nullptr || current == nullptr) return;
@@ -248,9 +247,8 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
   for (std::size_t i = 0; i < report.route.pairs.size(); ++i) {
     const change::RoutePair& pair = report.route.pairs[i];
     cv::Size prior_size, current_size;
-    if (!RouteFrameTruth(*prior, prior->route[pair.prior], before, after, appearance, options, &truth[i].prior,
-                         &prior_size) ||
-        !RouteFrameTruth(*current, current->route[pair.current], after, before, appearance, options, &truth[i].current,
+    if (!RouteFrameTruth(*prior, prior->route[pair.prior], before, after, options, &truth[i].prior, &prior_size) ||
+        !RouteFrameTruth(*current, current->route[pair.current], after, before, options, &truth[i].current,
                          &current_size)) {
       continue;
     }
@@ -330,7 +328,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     options.min_observations = config.change.geometry.min_observations;
     if (recomputed.geometry_compared) ScoreGeometryOf(map, recomputed, before, after, options, &result);
     ScoreAppearanceOf(map, recomputed, before, after, config.change.appearance, options, &result);
-    ScoreRouteOf(map, recomputed, before, after, config.change.appearance, options, &result);
+    ScoreRouteOf(map, recomputed, before, after, options, &result);
   }
   (*report)["changes"] = result;
   return Status::Ok();
