@@ -71,7 +71,7 @@ cv::Mat ContrastStructure(const cv::Mat& a, const cv::Mat& b, double sigma) {
   cv::Mat va = cv::max(aa - ma.mul(ma), 0.0), vb = cv::max(bb - mb.mul(mb), 0.0), cov = ab - ma.mul(mb);
   cv::Mat denominator;
   cv::sqrt((va + kC2 / 2).mul(vb + kC2 / 2), denominator);
-  return (cov + kC2 / 2) / denominator;
+  return (cv::abs(cov) + kC2 / 2) / denominator;
 }
 
 // Per pixel, the best of `measure(a, b shifted)` over shifts of b within the radius (parallax), where

@@ -31,6 +31,14 @@ cv::Mat Signature(const cv::Mat& grey) {
 
 double Seconds(TimestampNs ns) { return static_cast<double>(ns) * 1e-9; }
 
+// Per frame: whether it repeats the frame before (a key frame kept at an interval frame's time): it is neither
+// compared nor a vote of its own.
+std::vector<bool> Repeats(const std::vector<RouteFrame>& route) {
+  std::vector<bool> repeats(route.size(), false);
+  for (std::size_t i = 1; i < route.size(); ++i) repeats[i] = route[i].timestamp_ns == route[i - 1].timestamp_ns;
+  return repeats;
+}
+
 // The prior times a current frame's partner is expected at: the same time offset as the two anchors nearest in
 // time, and as the previous aligned pair.
 std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors, const RoutePair* previous,
@@ -61,7 +69,8 @@ std::vector<int> Candidates(const std::vector<double>& predicted, const std::vec
     const bool near = predicted.empty() || std::any_of(predicted.begin(), predicted.end(), [&](double centre) {
                         return std::abs(t - centre) <= options.search_window_s;
                       });
-    if (near) ranked.emplace_back(-signature.dot(prior_signatures[p]), static_cast<int>(p));
+    if (near && !prior_signatures[p].empty())
+      ranked.emplace_back(-signature.dot(prior_signatures[p]), static_cast<int>(p));
   }
   const std::size_t keep = std::min(ranked.size(), static_cast<std::size_t>(options.max_candidates));
   std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end());
@@ -161,11 +170,12 @@ int Find(std::vector<int>* parent, int i) {
 // Links the regions of consecutive aligned pairs that show the same thing: the earlier box carried into the
 // later current frame overlaps the later box.
 void LinkConsecutive(const RouteComparison& comparison, const std::vector<KeyFrameView>& current_views,
-                     const std::vector<int>& first_node, const RouteCompareOptions& options,
-                     const AppearanceOptions& appearance, std::vector<int>* parent) {
+                     const std::vector<int>& next, const std::vector<int>& first_node,
+                     const RouteCompareOptions& options, const AppearanceOptions& appearance,
+                     std::vector<int>* parent) {
   for (std::size_t i = 0; i + 1 < comparison.pairs.size(); ++i) {
     const RoutePair &a = comparison.pairs[i], &b = comparison.pairs[i + 1];
-    if (a.appearance.regions.empty() || b.appearance.regions.empty() || b.current != a.current + 1) continue;
+    if (a.appearance.regions.empty() || b.appearance.regions.empty() || b.current != next[a.current]) continue;
     const Registration step = Register(current_views[a.current], current_views[b.current], appearance);
     if (step.inliers < appearance.min_inliers || step.current_from_prior.empty()) continue;
     for (std::size_t ra = 0; ra < a.appearance.regions.size(); ++ra) {
@@ -181,7 +191,8 @@ void LinkConsecutive(const RouteComparison& comparison, const std::vector<KeyFra
 
 // The chains of linked regions over at least min_votes pairs, as changes.
 std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vector<KeyFrameView>& current_views,
-                              const RouteCompareOptions& options, const AppearanceOptions& appearance) {
+                              const std::vector<int>& next, const RouteCompareOptions& options,
+                              const AppearanceOptions& appearance) {
   std::vector<int> first_node;  // per pair: the node of its first region
   int nodes = 0;
   for (const RoutePair& pair : comparison.pairs) {
@@ -190,7 +201,7 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
   }
   std::vector<int> parent(nodes);
   std::iota(parent.begin(), parent.end(), 0);
-  LinkConsecutive(comparison, current_views, first_node, options, appearance, &parent);
+  LinkConsecutive(comparison, current_views, next, first_node, options, appearance, &parent);
   std::map<int, RouteChange> chains;  // by root, so the changes come in route order
   for (std::size_t i = 0; i < comparison.pairs.size(); ++i) {
     for (std::size_t r = 0; r < comparison.pairs[i].appearance.regions.size(); ++r) {
@@ -241,17 +252,22 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
                               const AppearanceOptions& appearance) {
   RouteComparison comparison;
-  comparison.current_frames = static_cast<int>(current.size());
+  const std::vector<bool> prior_repeats = Repeats(prior), current_repeats = Repeats(current);
+  comparison.current_frames = static_cast<int>(std::count(current_repeats.begin(), current_repeats.end(), false));
   if (prior.empty() || current.empty()) return comparison;
   comparison.compared = true;
-  std::vector<KeyFrameView> prior_views, current_views;
-  std::vector<cv::Mat> prior_signatures;
-  for (const RouteFrame& f : prior) {
-    prior_views.push_back(RouteFrameView(f, options.max_features));
-    prior_signatures.push_back(Signature(prior_views.back().image));
+  std::vector<KeyFrameView> prior_views(prior.size()), current_views(current.size());
+  std::vector<cv::Mat> prior_signatures(prior.size());
+  for (std::size_t p = 0; p < prior.size(); ++p) {
+    if (prior_repeats[p]) continue;
+    prior_views[p] = RouteFrameView(prior[p], options.max_features);
+    prior_signatures[p] = Signature(prior_views[p].image);
   }
-  for (const RouteFrame& f : current) current_views.push_back(RouteFrameView(f, options.max_features));
   for (std::size_t c = 0; c < current.size(); ++c) {
+    if (!current_repeats[c]) current_views[c] = RouteFrameView(current[c], options.max_features);
+  }
+  for (std::size_t c = 0; c < current.size(); ++c) {
+    if (current_repeats[c]) continue;
     const RoutePair* previous = comparison.pairs.empty() ? nullptr : &comparison.pairs.back();
     const std::vector<double> predicted =
         PredictedTimes(Seconds(current[c].timestamp_ns), anchors, previous, prior, current);
@@ -262,7 +278,10 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
       comparison.pairs.push_back(std::move(pair));
     }
   }
-  comparison.changes = Vote(comparison, current_views, options, appearance);
+  std::vector<int> next(current.size(), -1);  // per frame: the next frame that is no repeat
+  for (int c = static_cast<int>(current.size()) - 2; c >= 0; --c)
+    next[c] = current_repeats[c + 1] ? next[c + 1] : c + 1;
+  comparison.changes = Vote(comparison, current_views, next, options, appearance);
   return comparison;
 }
 

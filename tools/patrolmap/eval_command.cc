@@ -209,7 +209,7 @@ void ScoreAppearanceOf(const graph::TopoMap& map, const change::ChangeReport& re
                              {"recall", score.Recall()}};
 }
 
-constexpr double kVisibleShare = 0.01;  // a change is visible in a route frame when its box covers 1 % of it
+constexpr double kVisibleShare = 0.002;  // a change is visible in a route frame when its box covers 0.2 % of it
 
 // The object changes visible in a route frame of `record` (whose flight's objects are `here`); false without a
 // pose or picture.
