@@ -1,14 +1,17 @@
 // Change-stage speed on rendered village views at 376x240 (the processing
 // size of a 752x480 camera): object association per detection (paper 000
 // needed 15 ms per object), evidence-grid integration per depth frame, the
-// grid comparison of two patrols, and the appearance comparison of one place.
+// grid comparison of two patrols, the appearance comparison of one place, and appearance along the route
+// (features per route frame, registration per candidate, comparison per pair, a whole route).
 #include <benchmark/benchmark.h>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/object_map.h"
+#include "patrolmap/change/route_compare.h"
 #include "patrolmap/sim/objects.h"
 #include "patrolmap/sim/renderer.h"
 #include "patrolmap/sim/village.h"
@@ -138,6 +141,74 @@ void BM_AppearanceChangePerPlace(benchmark::State& state) {
   state.counters["regions"] = static_cast<double>(change.regions.size());
 }
 BENCHMARK(BM_AppearanceChangePerPlace)->Unit(benchmark::kMillisecond);
+
+// Appearance along the route (route_compare.h): a route frame at 376x240 as the map keeps it (JPEG).
+RouteFrame RouteFrameAt(double x, const std::vector<sim::WorldObject>& objects, const sim::Lighting& lighting,
+                        double seconds) {
+  RouteFrame frame;
+  frame.timestamp_ns = SecondsToNs(seconds);
+  cv::imencode(".jpg", Render(x, objects, lighting).image, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  return frame;
+}
+
+// Decoding one route frame and finding its SIFT features: done once per frame of either route.
+void BM_RouteFrameFeatures(benchmark::State& state) {
+  const RouteFrame frame = RouteFrameAt(20.0, sim::PlaceObjects(30, 1), {}, 0.0);
+  change::KeyFrameView view;
+  for (auto _ : state) view = change::RouteFrameView(frame, change::RouteCompareOptions{}.max_features);
+  state.counters["features"] = static_cast<double>(view.keypoints.size());
+}
+BENCHMARK(BM_RouteFrameFeatures)->Unit(benchmark::kMillisecond);
+
+// Registering one candidate prior frame onto a current frame: max_candidates of them per current frame.
+void BM_RouteCandidateRegistration(benchmark::State& state) {
+  const std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
+  const change::RouteCompareOptions options;
+  const change::KeyFrameView prior = change::RouteFrameView(RouteFrameAt(20.0, objects, {}, 0.0), options.max_features);
+  const change::KeyFrameView current =
+      change::RouteFrameView(RouteFrameAt(20.4, objects, sim::DrawLighting(1, 2), 0.0), options.max_features);
+  change::Registration registration;
+  for (auto _ : state) registration = change::Register(prior, current, change::AppearanceOptions{});
+  state.counters["inliers"] = registration.inliers;
+}
+BENCHMARK(BM_RouteCandidateRegistration)->Unit(benchmark::kMillisecond);
+
+// Comparing one registered pair of route frames (an object removed): once per compared frame, twice where the
+// first comparison found a region.
+void BM_RouteComparedPair(benchmark::State& state) {
+  std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
+  const std::size_t removed = SouthObject(objects);
+  const double x = objects[removed].centre.x();
+  const change::RouteCompareOptions options;
+  const change::KeyFrameView prior = change::RouteFrameView(RouteFrameAt(x, objects, {}, 0.0), options.max_features);
+  objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(removed));
+  const change::KeyFrameView current =
+      change::RouteFrameView(RouteFrameAt(x + 0.3, objects, sim::DrawLighting(1, 2), 0.0), options.max_features);
+  const change::Registration registration = change::Register(prior, current, change::AppearanceOptions{});
+  change::AppearanceChange change;
+  for (auto _ : state) change = change::CompareRegistered(prior, current, registration, change::AppearanceOptions{});
+  state.counters["regions"] = static_cast<double>(change.regions.size());
+}
+BENCHMARK(BM_RouteComparedPair)->Unit(benchmark::kMillisecond);
+
+// A whole route of 20 frames 1.3 m apart (a 20 s flight at the simulator's speed), aligned with one anchor,
+// compared and voted; per frame = time / 20.
+void BM_RouteOfTwentyFrames(benchmark::State& state) {
+  std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
+  const double x0 = objects[SouthObject(objects)].centre.x() - 13.0;
+  std::vector<RouteFrame> prior, current;
+  for (int i = 0; i < 20; ++i) prior.push_back(RouteFrameAt(x0 + 1.3 * i, objects, {}, i));
+  objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(SouthObject(objects)));
+  for (int i = 0; i < 20; ++i) current.push_back(RouteFrameAt(x0 + 0.4 + 1.3 * i, objects, sim::DrawLighting(1, 2), i));
+  change::RouteComparison comparison;
+  for (auto _ : state) {
+    comparison =
+        change::CompareRoutes(prior, current, {{0, 0}}, change::RouteCompareOptions{}, change::AppearanceOptions{});
+  }
+  state.counters["pairs"] = static_cast<double>(comparison.pairs.size());
+  state.counters["changes"] = static_cast<double>(comparison.changes.size());
+}
+BENCHMARK(BM_RouteOfTwentyFrames)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -176,6 +176,8 @@ check "lighting only: no object changed" \
   "all(r['objects'][s]['false_positives'] == 0 for s in ('new', 'removed', 'moved'))" "$json"
 check "lighting only: no geometry region" "r['geometry']['regions'] == 0" "$json"
 check "lighting only: no appearance region" "r['places_changed'] == 0" "$json"
+check "lighting only: the route compared, no appearance change along it" \
+  "r['route']['compared_share'] >= 0.8 and r['route']['changes'] == 0" "$json"
 
 # An unreadable depth image is named, left out, and the patrol goes on (the grid integrates the first frame).
 corrupted="$work/lighting/flight_2/depth0/data/$(ls "$work/lighting/flight_2/depth0/data" | sort -n | sed -n 1p)"

@@ -58,36 +58,54 @@ void FitLighting(const cv::Mat& prior, const cv::Mat& current, const cv::Mat& ma
   }
 }
 
-// The contrast-structure term of SSIM over a Gaussian window: 1 where the two images have the same local
-// pattern whatever their local gain and offset, near 0 or below where they differ.
-cv::Mat ContrastStructure(const cv::Mat& a, const cv::Mat& b, double sigma) {
-  constexpr double kC2 = (0.03 * 255) * (0.03 * 255);  // SSIM's stabiliser: flat pairs count as alike
-  cv::Mat ma, mb, aa, bb, ab;
-  cv::GaussianBlur(a, ma, cv::Size(), sigma);
-  cv::GaussianBlur(b, mb, cv::Size(), sigma);
-  cv::GaussianBlur(a.mul(a), aa, cv::Size(), sigma);
-  cv::GaussianBlur(b.mul(b), bb, cv::Size(), sigma);
-  cv::GaussianBlur(a.mul(b), ab, cv::Size(), sigma);
-  cv::Mat va = cv::max(aa - ma.mul(ma), 0.0), vb = cv::max(bb - mb.mul(mb), 0.0), cov = ab - ma.mul(mb);
-  cv::Mat denominator;
-  cv::sqrt((va + kC2 / 2).mul(vb + kC2 / 2), denominator);
-  return (cv::abs(cov) + kC2 / 2) / denominator;
+constexpr double kC2 = (0.03 * 255) * (0.03 * 255);  // SSIM's stabiliser: flat pairs count as alike
+
+// Local mean and variance over a Gaussian window.
+void Moments(const cv::Mat& image, double sigma, cv::Mat* mean, cv::Mat* variance) {
+  cv::Mat squares;
+  cv::GaussianBlur(image, *mean, cv::Size(), sigma);
+  cv::GaussianBlur(image.mul(image), squares, cv::Size(), sigma);
+  *variance = cv::max(squares - mean->mul(*mean), 0.0);
 }
 
-// Per pixel, the best of `measure(a, b shifted)` over shifts of b within the radius (parallax), where
-// `larger_is_better` says whether to keep the largest or the smallest value.
-template <typename Measure>
-cv::Mat BestOverShifts(const cv::Mat& a, const cv::Mat& b, int radius, bool larger_is_better, Measure measure) {
+void Shift(const cv::Mat& image, int dx, int dy, cv::Mat* shifted) {
+  const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
+  cv::warpAffine(image, *shifted, m, image.size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
+}
+
+// Per pixel, the best contrast-structure term of SSIM (over a Gaussian window) between `a` and `b` shifted by
+// up to `radius` pixels (parallax): 1 where the two have the same local pattern whatever their local gain,
+// offset and an edge's polarity (a face lit the other way), near 0 where they differ. The windows' means and
+// variances of `b` are shifted with it rather than recomputed.
+cv::Mat BestStructure(const cv::Mat& a, const cv::Mat& b, int radius, double sigma) {
+  cv::Mat ma, va, mb, vb;
+  Moments(a, sigma, &ma, &va);
+  Moments(b, sigma, &mb, &vb);
+  va += kC2 / 2;
+  vb += kC2 / 2;
+  cv::Mat best, bs, mbs, vbs, ab, denominator;
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      Shift(b, dx, dy, &bs);
+      Shift(mb, dx, dy, &mbs);
+      Shift(vb, dx, dy, &vbs);
+      cv::GaussianBlur(a.mul(bs), ab, cv::Size(), sigma);
+      cv::sqrt(va.mul(vbs), denominator);
+      const cv::Mat value = (cv::abs(ab - ma.mul(mbs)) + kC2 / 2) / denominator;
+      best = best.empty() ? value : cv::Mat(cv::max(best, value));
+    }
+  }
+  return best;
+}
+
+// Per pixel, the smallest absolute difference between `a` and `b` shifted by up to `radius` pixels (parallax).
+cv::Mat SmallestDifference(const cv::Mat& a, const cv::Mat& b, int radius) {
   cv::Mat best, shifted;
   for (int dy = -radius; dy <= radius; ++dy) {
     for (int dx = -radius; dx <= radius; ++dx) {
-      const cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, dx, 0, 1, dy);
-      cv::warpAffine(b, shifted, m, b.size(), cv::INTER_NEAREST, cv::BORDER_REPLICATE);
-      const cv::Mat value = measure(a, shifted);
-      if (best.empty())
-        best = value.clone();
-      else
-        best = larger_is_better ? cv::max(best, value) : cv::min(best, value);
+      Shift(b, dx, dy, &shifted);
+      const cv::Mat value = cv::abs(a - shifted);
+      best = best.empty() ? value : cv::Mat(cv::min(best, value));
     }
   }
   return best;
@@ -201,11 +219,8 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
   if (options.dense_flow) FollowFlow(current_f, result.gain, result.offset, options.max_flow_px, &warped);
 
   const int r = options.search_radius_px;
-  const cv::Mat global = BestOverShifts(current_f, warped * result.gain + result.offset, r, false,
-                                        [](const cv::Mat& a, const cv::Mat& b) { return cv::Mat(cv::abs(a - b)); });
-  const cv::Mat local = 1.0 - BestOverShifts(current_f, warped, r, true, [&](const cv::Mat& a, const cv::Mat& b) {
-                          return ContrastStructure(a, b, options.structure_sigma_px);
-                        });
+  const cv::Mat global = SmallestDifference(current_f, warped * result.gain + result.offset, r);
+  const cv::Mat local = 1.0 - BestStructure(current_f, warped, r, options.structure_sigma_px);
   cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
   cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), options.closing_px);
   cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());

@@ -1,8 +1,9 @@
 // changes.html: one page for the inspector. A plan of both flights with every change as a numbered marker,
 // beside a table of the changes with their before and after pictures (a click on a marker selects its row and
 // a click on a row its marker), then every object with the reason for its state. Pictures are files in the
-// images folder, loaded as their rows come into view, or embedded when there is no folder. No network at view time. When the page has
-// initialised, <body> carries data-ready="N markers" and data-ready-ms, the milliseconds it took to get there.
+// images folder, loaded as their rows come into view, or embedded when there is no folder. No network at view time.
+// When the page has initialised, <body> carries data-ready="N markers" and data-ready-ms, the milliseconds it took to
+// get there.
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -94,12 +95,12 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   }
   // A file is loaded when its row comes near the view (data-src; the script), so a report of hundreds of
   // changes opens at once: Chromium loads file:// images eagerly even with loading='lazy'.
-  const std::string source =
-      images.empty() ? "src='" + graph::PngDataUri(view.image) + "'"
-                     : "data-src='" + graph::EscapeXml(images + "/" + ViewFileName(item, before)) + "'";
+  const std::string source = images.empty()
+                                 ? "src='" + graph::PngDataUri(view.image) + "'"
+                                 : "data-src='" + graph::EscapeXml(images + "/" + ViewFileName(item, before)) + "'";
   std::ostringstream out;
-  out << "<figure><img loading='lazy' alt='" << word << "' " << source << " width='" << view.image.cols
-      << "' height='" << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
+  out << "<figure><img loading='lazy' alt='" << word << "' " << source << " width='" << view.image.cols << "' height='"
+      << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
       << Number(NsToSeconds(view.timestamp_ns), 1) << " s, frame " << view.frame_index << "</figcaption></figure>";
   return out.str();
 }
@@ -161,6 +162,13 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
   *html << "<p class='summary'>" << Counted(static_cast<long long>(items.size()), "change", "changes") << ". "
         << Counted(static_cast<long long>(report.places.size()), "place", "places") << " seen by both patrols, "
         << report.ChangedPlaces() << " changed in appearance.";
+  if (report.route.compared) {
+    *html << " Along the route: " << report.route.pairs.size() << " of "
+          << Counted(report.route.current_frames, "frame", "frames") << " compared ("
+          << Number(100.0 * report.route.ComparedShare(), 0) << " %), "
+          << Counted(static_cast<long long>(report.route.changes.size()), "appearance change", "appearance changes")
+          << ".";
+  }
   if (report.objects_compared) {
     *html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)
           << " removed, " << report.ObjectsIn(ObjectState::kMoved) << " moved, "
