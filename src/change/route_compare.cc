@@ -4,9 +4,11 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -39,10 +41,10 @@ std::vector<bool> Repeats(const std::vector<RouteFrame>& route) {
   return repeats;
 }
 
-// The prior times a current frame's partner is expected at: the same time offset as the two anchors nearest in
-// time, and as the previous aligned pair.
-std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors, const RoutePair* previous,
-                                   const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current) {
+// The prior times a current frame's partner is expected at: the same time offset (prior - current) as the two
+// anchors nearest in time, and as the previous aligned pair (`previous_offset_s`).
+std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnchor>& anchors,
+                                   std::optional<double> previous_offset_s) {
   std::vector<std::pair<double, double>> by_distance;  // (|time apart|, predicted prior time)
   for (const RouteAnchor& a : anchors) {
     by_distance.emplace_back(std::abs(Seconds(a.current_ns) - current_s),
@@ -51,10 +53,7 @@ std::vector<double> PredictedTimes(double current_s, const std::vector<RouteAnch
   std::sort(by_distance.begin(), by_distance.end());
   std::vector<double> times;
   for (std::size_t i = 0; i < by_distance.size() && i < 2; ++i) times.push_back(by_distance[i].second);
-  if (previous != nullptr) {
-    times.push_back(Seconds(prior[previous->prior].timestamp_ns) + current_s -
-                    Seconds(current[previous->current].timestamp_ns));
-  }
+  if (previous_offset_s) times.push_back(current_s + *previous_offset_s);
   return times;
 }
 
@@ -117,19 +116,24 @@ void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, Appear
   change->regions.erase(std::remove_if(change->regions.begin(), change->regions.end(), alone), change->regions.end());
 }
 
-// Aligns the current frame `c` to its best-registered candidate and compares the pair; false when no
-// candidate registers. With a second registered candidate, a region must be found against both.
+// A current frame's partner and the runner-up, registered.
+struct Alignment {
+  int current = -1;
+  std::vector<std::pair<Registration, int>> registered;  // (registration, prior frame), the partner first
+};
+
+// Registers the candidates onto the current frame `c`; the partner is, of those with nearly the most
+// inliers (alike in registration), the one covering most of the frame: the nearest viewpoint (least
+// parallax). False when no candidate registers.
 bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<KeyFrameView>& prior_views,
-                const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
-                const AppearanceOptions& appearance, RoutePair* pair) {
-  std::vector<std::pair<Registration, int>> registered;  // best first
+                const std::vector<KeyFrameView>& current_views, const AppearanceOptions& appearance,
+                Alignment* alignment) {
+  std::vector<std::pair<Registration, int>>& registered = alignment->registered;
   for (const int p : candidates) {
     Registration r = Register(prior_views[p], current_views[c], appearance);
     if (r.inliers >= appearance.min_inliers && !r.current_from_prior.empty()) registered.emplace_back(std::move(r), p);
   }
   if (registered.empty()) return false;
-  // Candidates with nearly the most inliers are alike in registration; the one covering most of the frame
-  // is the nearest viewpoint (least parallax).
   int most = 0;
   for (const auto& r : registered) most = std::max(most, r.first.inliers);
   const cv::Size size = current_views[c].image.size();
@@ -141,16 +145,27 @@ bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<Key
   };
   std::stable_sort(registered.begin(), registered.end(),
                    [&](const auto& a, const auto& b) { return rank(a) > rank(b); });
-  pair->prior = registered[0].second;
-  pair->current = c;
-  pair->appearance = CompareRegistered(prior_views[pair->prior], current_views[c], registered[0].first, appearance);
-  if (!pair->appearance.registered) return false;
-  if (registered.size() > 1 && !pair->appearance.regions.empty()) {
-    const AppearanceChange second =
-        CompareRegistered(prior_views[registered[1].second], current_views[c], registered[1].first, appearance);
-    if (second.registered) KeepSeenFromBoth(second, options.min_overlap, &pair->appearance);
-  }
+  registered.resize(std::min<std::size_t>(registered.size(), 2));
+  alignment->current = c;
   return true;
+}
+
+// Compares the aligned frame with its partner; a region must be found against the runner-up too.
+RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView>& prior_views,
+                      const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
+                      const AppearanceOptions& appearance) {
+  RoutePair pair;
+  const auto& [registration, prior] = alignment.registered[0];
+  pair.prior = prior;
+  pair.current = alignment.current;
+  pair.appearance = CompareRegistered(prior_views[prior], current_views[pair.current], registration, appearance);
+  if (alignment.registered.size() > 1 && !pair.appearance.regions.empty()) {
+    const auto& [second_registration, second_prior] = alignment.registered[1];
+    const AppearanceChange second =
+        CompareRegistered(prior_views[second_prior], current_views[pair.current], second_registration, appearance);
+    if (second.registered) KeepSeenFromBoth(second, options.min_overlap, &pair.appearance);
+  }
+  return pair;
 }
 
 cv::Rect2d MapBox(const cv::Rect& box, const cv::Mat& homography) {
@@ -258,26 +273,42 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
   comparison.compared = true;
   std::vector<KeyFrameView> prior_views(prior.size()), current_views(current.size());
   std::vector<cv::Mat> prior_signatures(prior.size());
-  for (std::size_t p = 0; p < prior.size(); ++p) {
-    if (prior_repeats[p]) continue;
-    prior_views[p] = RouteFrameView(prior[p], options.max_features);
-    prior_signatures[p] = Signature(prior_views[p].image);
-  }
-  for (std::size_t c = 0; c < current.size(); ++c) {
-    if (!current_repeats[c]) current_views[c] = RouteFrameView(current[c], options.max_features);
-  }
-  for (std::size_t c = 0; c < current.size(); ++c) {
+  // Each frame's features, each pair's comparison on its own: the same whatever the threads.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(prior.size() + current.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const bool is_prior = i < static_cast<int>(prior.size());
+      const std::size_t k = is_prior ? i : i - prior.size();
+      if (is_prior ? prior_repeats[k] : current_repeats[k]) continue;
+      if (is_prior) {
+        prior_views[k] = RouteFrameView(prior[k], options.max_features);
+        prior_signatures[k] = Signature(prior_views[k].image);
+      } else {
+        current_views[k] = RouteFrameView(current[k], options.max_features);
+      }
+    }
+  });
+  std::vector<Alignment> alignments;
+  for (std::size_t c = 0; c < current.size(); ++c) {  // in order: each predicts the next one's partner
     if (current_repeats[c]) continue;
-    const RoutePair* previous = comparison.pairs.empty() ? nullptr : &comparison.pairs.back();
-    const std::vector<double> predicted =
-        PredictedTimes(Seconds(current[c].timestamp_ns), anchors, previous, prior, current);
+    const Alignment* previous = alignments.empty() ? nullptr : &alignments.back();
+    const std::vector<double> predicted = PredictedTimes(
+        Seconds(current[c].timestamp_ns), anchors,
+        previous != nullptr ? std::optional<double>(Seconds(prior[previous->registered[0].second].timestamp_ns) -
+                                                    Seconds(current[previous->current].timestamp_ns))
+                            : std::nullopt);
     const std::vector<int> candidates =
         Candidates(predicted, prior, prior_signatures, Signature(current_views[c].image), options);
-    RoutePair pair;
-    if (AlignFrame(static_cast<int>(c), candidates, prior_views, current_views, options, appearance, &pair)) {
-      comparison.pairs.push_back(std::move(pair));
+    Alignment alignment;
+    if (AlignFrame(static_cast<int>(c), candidates, prior_views, current_views, appearance, &alignment)) {
+      alignments.push_back(std::move(alignment));
     }
   }
+  comparison.pairs.resize(alignments.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(alignments.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      comparison.pairs[i] = ComparePair(alignments[i], prior_views, current_views, options, appearance);
+    }
+  });
   std::vector<int> next(current.size(), -1);  // per frame: the next frame that is no repeat
   for (int c = static_cast<int>(current.size()) - 2; c >= 0; --c)
     next[c] = current_repeats[c + 1] ? next[c + 1] : c + 1;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -104,6 +105,31 @@ TEST(RouteCompare, ARegionInOneFrameOnlyIsNotReported) {
   const RouteComparison single = CompareRoutes(Route(facade, 0, 1.0, 0.0), current, {}, options, AppearanceOptions{});
   ASSERT_FALSE(single.changes.empty());
   for (const RouteChange& change : single.changes) EXPECT_EQ(single.pairs[change.views[0].pair].current, 6);
+}
+
+TEST(RouteCompare, OneThreadOrSeveralGiveTheSameComparison) {
+  const cv::Mat facade = Facade(7);
+  cv::Mat changed = facade.clone();
+  changed(cv::Rect(420, 60, 50, 90)).setTo(40);
+  const std::vector<RouteFrame> prior = Route(facade, 0, 1.0, 0.0), current = Route(changed, 6, 0.9, 10.0);
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const RouteComparison one = CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{});
+  cv::setNumThreads(std::max(2, threads));
+  const RouteComparison several = CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{});
+  cv::setNumThreads(threads);
+  ASSERT_EQ(one.pairs.size(), several.pairs.size());
+  for (std::size_t i = 0; i < one.pairs.size(); ++i) {
+    EXPECT_EQ(one.pairs[i].prior, several.pairs[i].prior);
+    ASSERT_EQ(one.pairs[i].appearance.regions.size(), several.pairs[i].appearance.regions.size());
+    for (std::size_t r = 0; r < one.pairs[i].appearance.regions.size(); ++r) {
+      EXPECT_EQ(one.pairs[i].appearance.regions[r].current_box, several.pairs[i].appearance.regions[r].current_box);
+      EXPECT_EQ(one.pairs[i].appearance.regions[r].score, several.pairs[i].appearance.regions[r].score);
+    }
+  }
+  ASSERT_FALSE(one.changes.empty());
+  ASSERT_EQ(one.changes.size(), several.changes.size());
+  for (std::size_t i = 0; i < one.changes.size(); ++i) EXPECT_EQ(one.changes[i].score, several.changes[i].score);
 }
 
 TEST(RouteCompare, WithoutFramesNothingIsCompared) {
