@@ -19,6 +19,7 @@ constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 5: the patrol's depth source; 6: the frames kept along the route
 constexpr std::uint32_t kVersion = 6;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
+constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
 constexpr int kDescriptorWidth = 128;  // SIFT
 
@@ -480,8 +481,40 @@ std::vector<RouteFrame> ReadRoute(Reader* r) {
   return route;
 }
 
+// The width and height a JPEG's start-of-frame segment states, found by walking its segments; false when the
+// bytes end, or the scan starts, before a start-of-frame segment.
+bool JpegSize(const std::vector<unsigned char>& jpeg, int* width, int* height) {
+  std::size_t i = 2;  // after the start-of-image marker
+  while (i + 4 <= jpeg.size()) {
+    if (jpeg[i] != 0xFF) return false;
+    const unsigned char marker = jpeg[i + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++i;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // segments without a length
+      i += 2;
+      continue;
+    }
+    if (marker == 0xDA || marker == 0xD9) return false;  // the scan or the end before a frame header
+    const std::size_t length = (static_cast<std::size_t>(jpeg[i + 2]) << 8) | jpeg[i + 3];
+    const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (frame) {
+      if (i + 9 > jpeg.size()) return false;
+      *height = (jpeg[i + 5] << 8) | jpeg[i + 6];
+      *width = (jpeg[i + 7] << 8) | jpeg[i + 8];
+      return true;
+    }
+    if (length < 2) return false;
+    i += 2 + length;
+  }
+  return false;
+}
+
 // Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and
-// JPEG bytes (they start with the JPEG start-of-image marker).
+// JPEG bytes: the start-of-image marker, and a frame header stating at most kMaxRouteFrameSide pixels a side
+// (what change.route_frames.max_width allows), so no crafted map makes the report or the route comparison
+// decode a huge image.
 bool ValidRoute(const std::vector<RouteFrame>& route) {
   for (std::size_t i = 0; i < route.size(); ++i) {
     const RouteFrame& f = route[i];
@@ -490,6 +523,11 @@ bool ValidRoute(const std::vector<RouteFrame>& route) {
     if (f.pose && !ValidPose(*f.pose)) return false;
     if (f.gps && !(std::abs(f.gps->x()) <= 90.0 && std::abs(f.gps->y()) <= 180.0)) return false;
     if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8) return false;
+    int width = 0, height = 0;
+    if (!JpegSize(f.jpeg, &width, &height) || width < 1 || height < 1 || width > kMaxRouteFrameSide ||
+        height > kMaxRouteFrameSide) {
+      return false;
+    }
   }
   return true;
 }

@@ -282,14 +282,28 @@ TEST(MapFile, RouteFramesRoundTrip) {
   EXPECT_EQ(cv::imdecode(b[1].jpeg, cv::IMREAD_GRAYSCALE).cols, 32);
 }
 
-// Route frames out of time order, or bytes that are not JPEG, make the map corrupt, named.
+// The offset of a JPEG's baseline start-of-frame segment (0xFFC0).
+std::size_t FrameHeader(const std::vector<unsigned char>& jpeg) {
+  for (std::size_t i = 2; i + 1 < jpeg.size(); ++i) {
+    if (jpeg[i] == 0xFF && jpeg[i + 1] == 0xC0) return i;
+  }
+  return 0;
+}
+
+// Route frames out of time order, bytes that are not JPEG, or a JPEG stating a huge image (which decoding
+// would allocate) make the map corrupt, named.
 TEST(MapFile, DamagedRouteFramesAreNamed) {
   testing::TempDir dir;
-  for (int damage = 0; damage < 2; ++damage) {
+  for (int damage = 0; damage < 4; ++damage) {
     TopoMap map = WithRoute();
     PatrolRecord record = *map.Patrol("b");
+    std::vector<unsigned char>& jpeg = record.route[0].jpeg;
+    const std::size_t header = FrameHeader(jpeg);
+    ASSERT_GT(header, 0u);
     if (damage == 0) record.route[1].timestamp_ns = 1;
-    if (damage == 1) record.route[0].jpeg[0] = 'P';
+    if (damage == 1) jpeg[0] = 'P';
+    if (damage == 2) jpeg[header + 5] = jpeg[header + 6] = jpeg[header + 7] = jpeg[header + 8] = 0xEA;  // 60138 px
+    if (damage == 3) jpeg.resize(header);  // ends before its frame header
     map.SetPatrol(record);
     ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
     TopoMap loaded;
