@@ -32,18 +32,25 @@ check "SIGTERM map loads" grep -qE "1 flight, [1-9][0-9]* nodes?" <<<"$("$bin" i
 frames=$(grep -oE "interrupted: [0-9]+ frames" "$work/stopped.txt" | grep -oE "[0-9]+")
 check "paced: about 9 s of a 30 Hz log" test "${frames:-0}" -ge 210 -a "${frames:-999}" -le 330
 
-# A later patrol compares its key frames with an onboard map's as with patrolmap map's: same places, same
-# registration, same regions (the onboard map keeps the width its key-frame features were found at).
+# A later patrol compares its route and its key frames with an onboard map's as with patrolmap map's: same
+# alignment, same places, same registration, same regions (the onboard map keeps the width its key-frame
+# features were found at, and the same route frames).
 "$bin" -q simulate --route street --walls 3 --speed 5 --flights 2 --resolution 376x240 --seed 3 --out "$work/series"
 "$bin" -q map "$work/series/flight_1" --vocabulary "$vocabulary" --out "$work/offline1"
 "$onboard" -q "$work/series/flight_1" --fast --vocabulary "$vocabulary" --out "$work/onboard1" >/dev/null
+printf 'change:\n  route:\n    enabled: false\n' > "$work/places.yaml"
 for prior in offline1 onboard1; do
   "$bin" -q patrol "$work/series/flight_2" --map "$work/$prior/map.pmap" --vocabulary "$vocabulary" \
     --out "$work/patrol_$prior" >/dev/null
+  "$bin" -q diff "$work/patrol_$prior/map.pmap" -c "$work/places.yaml" --out "$work/places_$prior" >/dev/null
 done
+check "patrol against an onboard map compares the route alike" /usr/bin/python3 -c "
+import json, sys
+a, b = (json.load(open('$work/patrol_' + p + '/changes.json'))['route'] for p in ('offline1', 'onboard1'))
+sys.exit(0 if a == b and a['compared_pairs'] >= 1 else 1)"
 check "patrol against an onboard map compares places alike" /usr/bin/python3 -c "
 import json, sys
-a, b = (json.load(open('$work/patrol_' + p + '/changes.json'))['places'] for p in ('offline1', 'onboard1'))
+a, b = (json.load(open('$work/places_' + p + '/changes.json'))['places'] for p in ('offline1', 'onboard1'))
 sys.exit(0 if a == b and len(a) >= 1 and all(p['registered'] for p in a) else 1)"
 
 # Change detection onboard: on village patrols with detections and depth, the onboard map (objects and grid
