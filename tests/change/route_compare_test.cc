@@ -1,6 +1,7 @@
 // Appearance along the route (route_compare.h): route frames aligned and compared, regions voted over
 // consecutive pairs; and real same-scene pairs (Debian's opencv-doc) that must give no region.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -137,6 +138,55 @@ TEST(RouteCompare, WithoutFramesNothingIsCompared) {
       CompareRoutes({}, Route(Facade(6), 0, 1.0, 0.0), {}, RouteCompareOptions{}, AppearanceOptions{});
   EXPECT_FALSE(comparison.compared);
   EXPECT_EQ(comparison.ComparedShare(), 0.0);
+}
+
+// The shared KITTI excerpt (51 frames at 10 Hz, forward motion along a road), flown twice: unchanged, and
+// with a textured 120x100 object (a facade patch) pasted into frames 20-25 of the second flight.
+const std::string kKittiImages = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/kitti_seq2/image_l";
+constexpr int kKittiFrames = 51;
+
+std::vector<RouteFrame> KittiRoute(const cv::Rect& object, int first, int last) {
+  const cv::Mat patch = Facade(7)(cv::Rect(0, 0, object.width, object.height));
+  std::vector<RouteFrame> route;
+  for (int i = 0; i < kKittiFrames; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof(name), "/%06d.png", i);
+    cv::Mat image = cv::imread(kKittiImages + name, cv::IMREAD_GRAYSCALE);
+    if (i >= first && i <= last) patch.copyTo(image(object));
+    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
+               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
+    RouteFrame f;
+    f.timestamp_ns = SecondsToNs(0.1 * i);
+    f.frame_index = i;
+    cv::imencode(".jpg", image, f.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+    route.push_back(std::move(f));
+  }
+  return route;
+}
+
+TEST(RouteCompare, KittiFlownTwiceGivesNoChangeAndAPastedObjectIsFound) {
+  if (!std::filesystem::exists(kKittiImages)) GTEST_SKIP() << "shared KITTI excerpt not present";
+  const cv::Rect object(560, 150, 120, 100);  // full-size pixels, above the road ahead
+  const std::vector<RouteFrame> prior = KittiRoute(object, 0, -1);
+  const std::vector<RouteAnchor> anchors = {{SecondsToNs(0.0), SecondsToNs(0.0)}, {SecondsToNs(5.0), SecondsToNs(5.0)}};
+  const RouteComparison same = CompareRoutes(prior, prior, anchors, RouteCompareOptions{}, AppearanceOptions{});
+  EXPECT_EQ(static_cast<int>(same.pairs.size()), kKittiFrames);
+  EXPECT_TRUE(same.changes.empty()) << same.changes.size() << " changes";
+
+  const RouteComparison changed =
+      CompareRoutes(prior, KittiRoute(object, 20, 25), anchors, RouteCompareOptions{}, AppearanceOptions{});
+  EXPECT_EQ(static_cast<int>(changed.pairs.size()), kKittiFrames);
+  ASSERT_EQ(changed.changes.size(), 1u);
+  EXPECT_GE(changed.changes[0].views.size(), 4u);
+  const double scale = static_cast<double>(kFrameWidth) / 1241;  // KITTI's width
+  const cv::Rect expected(cv::Point(object.tl()) * scale, cv::Point(object.br()) * scale);
+  for (const RouteChange::View& v : changed.changes[0].views) {
+    const RoutePair& pair = changed.pairs[v.pair];
+    EXPECT_GE(pair.current, 20);
+    EXPECT_LE(pair.current, 25);
+    const cv::Rect& box = pair.appearance.regions[v.region].current_box;
+    EXPECT_GE((box & expected).area(), 0.5 * std::min(box.area(), expected.area())) << box << " vs " << expected;
+  }
 }
 
 // Real pairs of one unchanged scene (Debian's opencv-doc): an exposure change (leuven), a strong viewpoint change
