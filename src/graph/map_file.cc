@@ -17,7 +17,7 @@ namespace {
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
 // 5: the patrol's depth source; 6: the frames kept along the route
-constexpr std::uint32_t kVersion = 6;
+constexpr std::uint32_t kVersion = 7;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
@@ -278,6 +278,7 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     w.Value<std::int64_t>(p.grid.evicted_voxels);
     w.String(p.depth_source);
     WriteRoute(p.route, &w);
+    w.Value<std::uint8_t>(p.timed ? 1 : 0);
   }
 }
 
@@ -550,6 +551,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     if (version >= 4) p.grid.evicted_voxels = r->Value<std::int64_t>();
     if (version >= 5) p.depth_source = r->String();
     if (version >= 6) p.route = ReadRoute(r);
+    if (version >= 7) p.timed = r->Value<std::uint8_t>() != 0;
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);

@@ -78,19 +78,22 @@ graph::TopoMap::VocabularyTag TagOf(const vocab::Vocabulary& vocabulary, const s
   return {vocabulary.Fingerprint(), std::filesystem::path(path).filename().string()};
 }
 
+Status CheckNodeFits(const graph::TopoMap& map, const std::string& path, int id, const vocab::Vocabulary& vocabulary) {
+  const graph::NodeData& node = map.node(id);
+  const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(), [&](vocab::WordId word) {
+    return word < static_cast<vocab::WordId>(vocabulary.word_count());
+  });
+  if (words_fit && (node.descriptors.empty() || node.descriptors.cols == vocabulary.dimension())) return Status::Ok();
+  return Status::DataLoss(path + ": node " + std::to_string(id) +
+                          " was not described with this vocabulary (word ids or descriptor width out of range)");
+}
+
 Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path, const vocab::Vocabulary& vocabulary,
                       place::PlaceRecognizer* recognizer) {
   PATROLMAP_CHECK(recognizer->node_count() == 0);
   for (int i = 0; i < prior.node_count(); ++i) {
+    PATROLMAP_RETURN_IF_ERROR(CheckNodeFits(prior, prior_path, i, vocabulary));
     const graph::NodeData& node = prior.node(i);
-    const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(), [&](vocab::WordId word) {
-      return word < static_cast<vocab::WordId>(vocabulary.word_count());
-    });
-    if (!words_fit || (!node.descriptors.empty() && node.descriptors.cols != vocabulary.dimension())) {
-      return Status::DataLoss(prior_path + ": node " + std::to_string(i) +
-                              " was not described with this vocabulary "
-                              "(word ids or descriptor width out of range)");
-    }
     recognizer->AddDescribedNode(
         {node.flight, node.timestamp_ns, node.frame_index, node.keypoints, node.descriptors, node.bow});
   }

@@ -22,6 +22,7 @@ PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
       next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
   next_stereo_ns_ = next_grid_ns_;
   base_.flight = info.flight_id;
+  base_.timed = info.timed;
   if (info.camera) base_.camera = *info.camera;
   if (!info.has_poses || !info.camera) return;
   base_.has_objects = info.has_detections;
@@ -223,6 +224,7 @@ void PatrolRecorder::Finish(PatrolRecord* record, PatrolRecordStats* stats) {
 PatrolRecord CameraOnlyRecord(const io::LogInfo& info) {
   PatrolRecord record;
   record.flight = info.flight_id;
+  record.timed = info.timed;
   if (info.camera) record.camera = *info.camera;
   return record;
 }

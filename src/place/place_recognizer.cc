@@ -239,19 +239,21 @@ PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
           n.keypoints, n.descriptors,  database_.entry(static_cast<vocab::EntryId>(node))};
 }
 
+std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) const {
+  // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
+  cv::Mat as_float;
+  descriptors.convertTo(as_float, CV_32F, descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
+  std::vector<vocab::WordId> words;
+  vocabulary_->Quantize(as_float, &words);
+  std::vector<std::uint32_t> groups;
+  for (vocab::WordId word : words) groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
+  return groups;
+}
+
 int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
   Node node{std::move(features.flight),    features.timestamp_ns,           features.frame_index,
             std::move(features.keypoints), std::move(features.descriptors), {}};
-  if (options_.direct_index_levels_up > 0) {
-    // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
-    cv::Mat as_float;
-    node.descriptors.convertTo(as_float, CV_32F,
-                               node.descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
-    std::vector<vocab::WordId> words;
-    vocabulary_->Quantize(as_float, &words);
-    for (vocab::WordId word : words)
-      node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
-  }
+  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
   const int id = static_cast<int>(database_.Add(features.bow));
   nodes_.push_back(std::move(node));
   return id;
@@ -262,7 +264,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
     return Status::InvalidArgument("key frame " + std::to_string(key_frame.frame_index) + " has no grey image");
   }
   *result = PlaceResult();
-  auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   Node node{key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, {}, {}, {}};
   DescribeFeatures(key_frame.image, options_, &node.keypoints, &node.descriptors);
   vocab::BowVector bow;
@@ -276,8 +278,27 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   result->features = node.descriptors.rows;
   if (options_.compact_descriptors) node.descriptors = Compact(node.descriptors, options_.root_sift);
   result->seconds_features = Since(start);
+  Recognise(key_frame, std::move(node), bow, result);
+  return Status::Ok();
+}
 
-  start = std::chrono::steady_clock::now();
+void PlaceRecognizer::AddDescribedKeyFrame(NodeFeatures features, bool timed, PlaceResult* result) {
+  *result = PlaceResult();
+  KeyFrame key_frame;
+  key_frame.flight = features.flight;
+  key_frame.timestamp_ns = features.timestamp_ns;
+  key_frame.frame_index = features.frame_index;
+  key_frame.timed = timed;
+  Node node{std::move(features.flight),    features.timestamp_ns,           features.frame_index,
+            std::move(features.keypoints), std::move(features.descriptors), {}};
+  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
+  result->features = node.descriptors.rows;
+  Recognise(key_frame, std::move(node), features.bow, result);
+}
+
+void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow,
+                                PlaceResult* result) {
+  auto start = std::chrono::steady_clock::now();
   std::vector<vocab::QueryResult> candidates;
   database_.Query(
       bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); }, &candidates);
@@ -303,7 +324,6 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   result->node = static_cast<int>(database_.Add(bow));
   nodes_.push_back(std::move(node));
   result->seconds_add = Since(start);
-  return Status::Ok();
 }
 
 }  // namespace patrolmap::place

@@ -221,8 +221,8 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
 TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
   testing::TempDir dir;
   // The evicted-voxel count (8 bytes), the depth source ("stereo": a 4-byte length and 6 characters) and the
-  // route frames (none: a 4-byte count).
-  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 22);
+  // route frames (none: a 4-byte count) and whether the log was timed (1 byte).
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 23);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -233,7 +233,7 @@ TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
 
 TEST(MapFile, VersionFourPatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 14);
+  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 15);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v4.pmap", &map).ok()) << LoadMap(dir / "v4.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -316,11 +316,26 @@ TEST(MapFile, DamagedRouteFramesAreNamed) {
 // A version-5 map (before the route frames) loads without them.
 TEST(MapFile, VersionFivePatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 4);
+  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 5);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v5.pmap", &map).ok()) << LoadMap(dir / "v5.pmap", &map).message();
   EXPECT_EQ(map.Patrol("b")->depth_source, "stereo");
   EXPECT_TRUE(map.Patrol("b")->route.empty());
+}
+
+// A version-6 map (before the timed flag) loads as timed; version 7 keeps an untimed log's flag.
+TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
+  testing::TempDir dir;
+  TopoMap untimed = TwoFlights();
+  PatrolRecord record = *untimed.Patrol("b");
+  record.timed = false;
+  untimed.SetPatrol(record);
+  std::ofstream(dir / "v6.pmap", std::ios::binary) << OlderPatrolSection(untimed, dir / "m.pmap", 6, 1);
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v6.pmap", &map).ok()) << LoadMap(dir / "v6.pmap", &map).message();
+  EXPECT_TRUE(map.Patrol("b")->timed);
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &map).ok());
+  EXPECT_FALSE(map.Patrol("b")->timed);
 }
 
 TEST(MapFile, VersionOneFilesStillLoad) {

@@ -20,5 +20,6 @@ Command AddPatrolCommand(CLI::App* app);
 Command AddInfoCommand(CLI::App* app);
 Command AddExportCommand(CLI::App* app);
 Command AddDiffCommand(CLI::App* app);
+Command AddMergeCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

@@ -66,6 +66,10 @@ int main(int argc, char** argv) {
       patrolmap::tools::AddMapCommand);
   add("patrol", "fly a later patrol against a map: add it, recognise the places seen before, and report what changed",
       patrolmap::tools::AddPatrolCommand);
+  add("merge",
+      "merge maps built apart (a fleet's logs mapped on several machines) into one, with the loop closures "
+      "between them",
+      patrolmap::tools::AddMergeCommand);
   add("info", "summarise a map file, or list a ROS bag's topics", patrolmap::tools::AddInfoCommand);
   add("diff", "report what changed between two flights of a map (a page with pictures and a plan, JSON, GeoJSON, KML)",
       patrolmap::tools::AddDiffCommand);

@@ -11,7 +11,8 @@ namespace patrolmap::tools {
 
 class Progress {
  public:
-  explicit Progress(const char* what) : what_(what), enabled_(::isatty(STDERR_FILENO) != 0) {}
+  explicit Progress(const char* what, const char* unit = "frames")
+      : what_(what), unit_(unit), enabled_(::isatty(STDERR_FILENO) != 0) {}
   ~Progress() {
     if (enabled_ && shown_) std::fprintf(stderr, "\n");
   }
@@ -28,16 +29,17 @@ class Progress {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double rate = seconds > 0.0 ? done / seconds : 0.0;
     if (total > 0) {
-      std::fprintf(stderr, "\r%s: %lld/%lld frames (%.0f/s)   ", what_, static_cast<long long>(done),
-                   static_cast<long long>(total), rate);
+      std::fprintf(stderr, "\r%s: %lld/%lld %s (%.0f/s)   ", what_, static_cast<long long>(done),
+                   static_cast<long long>(total), unit_, rate);
     } else {
-      std::fprintf(stderr, "\r%s: %lld frames (%.0f/s)   ", what_, static_cast<long long>(done), rate);
+      std::fprintf(stderr, "\r%s: %lld %s (%.0f/s)   ", what_, static_cast<long long>(done), unit_, rate);
     }
     shown_ = true;
   }
 
  private:
   const char* what_;
+  const char* unit_;
   bool enabled_;
   bool shown_ = false;
   std::int64_t last_done_ = 0;

@@ -106,6 +106,9 @@ struct PatrolRecord {
   EvidenceGridData grid;     // voxel_size 0 when the log had no depth
   std::string depth_source;  // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
   std::vector<RouteFrame> route;  // in time order; key frames among them (map format 6 on)
+  // Whether the log had timestamps (false: 'recent' nodes are counted in images; map format 7 on, true before),
+  // so a merge recognises its nodes' places as the mapping run did.
+  bool timed = true;
 };
 
 }  // namespace patrolmap

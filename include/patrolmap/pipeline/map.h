@@ -96,6 +96,9 @@ Status CheckVocabulary(const graph::TopoMap& prior, const std::string& prior_pat
 // What a map records of the vocabulary at `path` (TopoMap::set_vocabulary).
 graph::TopoMap::VocabularyTag TagOf(const vocab::Vocabulary& vocabulary, const std::string& path);
 
+// Fails naming the map file and the node when node `id`'s words or descriptors do not fit `vocabulary`.
+Status CheckNodeFits(const graph::TopoMap& map, const std::string& path, int id, const vocab::Vocabulary& vocabulary);
+
 // Puts a prior map's nodes (their stored features and BoW vectors) into an
 // empty recognizer, in order, so a later flight is matched against them. Fails naming the map when a node's
 // words or descriptors do not fit `vocabulary`.

@@ -144,6 +144,12 @@ class PlaceRecognizer {
   // Adds a node described earlier (a prior map's), without querying; returns its id.
   int AddDescribedNode(NodeFeatures features);
 
+  // Recognises a node described earlier (a map's, when maps are merged) as AddKeyFrame recognises a key
+  // frame, from its stored features and BoW vector, then adds it. `timed`: its log had timestamps. With the
+  // stored features of a key frame, the result is AddKeyFrame's (with the direct index, up to the words
+  // re-quantised from 8-bit descriptors).
+  void AddDescribedKeyFrame(NodeFeatures features, bool timed, PlaceResult* result);
+
   // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
   // direct-index node of each feature) matching stays inside equal groups.
   Verification Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
@@ -161,6 +167,9 @@ class PlaceRecognizer {
     std::vector<std::uint32_t> groups;  // direct-index node of each feature (when enabled)
   };
   bool Allowed(const KeyFrame& query, int node) const;
+  // Queries the database for `node`'s place, verifies the candidates, and adds it.
+  void Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow, PlaceResult* result);
+  std::vector<std::uint32_t> Groups(const cv::Mat& descriptors) const;  // direct-index groups of stored features
   bool Plausible(const KeyFrame& query, int node) const;
 
   const vocab::Vocabulary* vocabulary_;
