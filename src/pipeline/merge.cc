@@ -2,7 +2,6 @@
 #include "patrolmap/pipeline/merge.h"
 
 #include <algorithm>
-#include <chrono>
 #include <map>
 
 #include <spdlog/spdlog.h>
@@ -18,8 +17,8 @@ namespace {
 
 // One flight of one input map: its nodes in order and its patrol record.
 struct FlightPart {
-  std::string id;      // in the merged map (renamed on a clash)
-  int map = 0;         // index of the input map
+  std::string id;  // in the merged map (renamed on a clash)
+  int map = 0;     // index of the input map
   std::vector<int> nodes;
   const PatrolRecord* record = nullptr;  // may be null (a map written before patrol records)
 };
@@ -75,8 +74,8 @@ void SortFlights(const std::vector<graph::TopoMap>& maps, std::vector<FlightPart
   });
 }
 
-Status LoadInputs(const MergeRequest& request, const vocab::Vocabulary& vocabulary,
-                  const std::string& vocabulary_path, std::vector<graph::TopoMap>* maps) {
+Status LoadInputs(const MergeRequest& request, const vocab::Vocabulary& vocabulary, const std::string& vocabulary_path,
+                  std::vector<graph::TopoMap>* maps) {
   maps->resize(request.maps.size());
   for (std::size_t i = 0; i < request.maps.size(); ++i) {
     const std::string& path = request.maps[i];
@@ -92,17 +91,13 @@ Status LoadInputs(const MergeRequest& request, const vocab::Vocabulary& vocabula
   return Status::Ok();
 }
 
-double Since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 // Recognises every node again in the merge order and builds the merged map.
 graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector<FlightPart>& parts,
                       const vocab::Vocabulary& vocabulary, const place::PlaceOptions& options,
                       const MergeRequest& request, MergeOutcome* outcome) {
   place::PlaceRecognizer recognizer(&vocabulary, options);
   graph::TopoMap merged;
-  std::vector<int> map_of;  // input map of each merged node
+  std::vector<int> map_of;                                    // input map of each merged node
   std::vector<std::pair<int, place::Verification>> closures;  // (query node, accepted verification)
   std::int64_t total = 0;
   for (const FlightPart& part : parts) total += static_cast<std::int64_t>(part.nodes.size());
@@ -112,9 +107,9 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
       graph::NodeData node = maps[part.map].node(n);
       node.flight = part.id;
       place::PlaceResult result;
-      recognizer.AddDescribedKeyFrame({node.flight, node.timestamp_ns, node.frame_index, node.keypoints,
-                                       node.descriptors, node.bow},
-                                      timed, &result);
+      recognizer.AddDescribedKeyFrame(
+          {node.flight, node.timestamp_ns, node.frame_index, node.keypoints, node.descriptors, node.bow}, timed,
+          &result);
       outcome->seconds_query += result.seconds_query;
       outcome->seconds_verify += result.seconds_verify;
       const int id = merged.AddNode(std::move(node));
@@ -135,7 +130,8 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
   }
   // After every traversal, as a mapping run adds them (BuildTopoMap), so the layout sees the same graph.
   for (const auto& [query, v] : closures) {
-    merged.AddEdge(query, v.node, {graph::EdgeKind::kLoopClosure, v.bow_score, v.matched_fraction, v.inliers, v.log_nfa});
+    merged.AddEdge(query, v.node,
+                   {graph::EdgeKind::kLoopClosure, v.bow_score, v.matched_fraction, v.inliers, v.log_nfa});
   }
   outcome->flights = static_cast<int>(parts.size());
   outcome->nodes = merged.node_count();

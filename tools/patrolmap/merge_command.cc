@@ -18,7 +18,8 @@ int RunMerge(pipeline::MergeRequest request) {
   pipeline::MergeOutcome outcome;
   const Status status = pipeline::RunMerge(request, &outcome);
   if (!status.ok()) return Fail(status);
-  for (const auto& [old_id, new_id] : outcome.renamed) std::printf("renamed %s to %s\n", old_id.c_str(), new_id.c_str());
+  for (const auto& [old_id, new_id] : outcome.renamed)
+    std::printf("renamed %s to %s\n", old_id.c_str(), new_id.c_str());
   const double nodes = std::max(1, outcome.nodes);
   std::printf("%s merged: %s, %s, %s (%d across maps); per node %.2f ms query, %.1f ms verification; outputs in %s\n",
               Counted(static_cast<long long>(request.maps.size()), "map", "maps").c_str(),
@@ -42,7 +43,8 @@ Command AddMergeCommand(CLI::App* app) {
   app->add_flag("--rename-clashes", request->rename_clashes,
                 "a flight id found in several maps is renamed ID-2, ID-3, ... in the later maps (default: an error)");
   app->footer(
-      "Orders the flights by their start (the first frame kept along the route, else the first node), then by id, and recognises every node again from its "
+      "Orders the flights by their start (the first frame kept along the route, else the first node), then by id, and "
+      "recognises every node again from its "
       "stored features against all nodes before it: the result is the map one 'patrolmap map' over all the logs "
       "in that order builds, whatever order or grouping the maps are merged in. Each flight keeps its patrol "
       "record, so 'patrolmap diff' works between any two flights. Writes OUT/map.pmap (last, atomically), "

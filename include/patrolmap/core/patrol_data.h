@@ -103,8 +103,8 @@ struct PatrolRecord {
   std::vector<CameraPoseSample> views;  // camera poses sampled along the flight
   bool has_objects = false;             // the log had detections
   std::vector<MapObject> objects;
-  EvidenceGridData grid;     // voxel_size 0 when the log had no depth
-  std::string depth_source;  // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
+  EvidenceGridData grid;          // voxel_size 0 when the log had no depth
+  std::string depth_source;       // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
   std::vector<RouteFrame> route;  // in time order; key frames among them (map format 6 on)
   // Whether the log had timestamps (false: 'recent' nodes are counted in images; map format 7 on, true before),
   // so a merge recognises its nodes' places as the mapping run did.

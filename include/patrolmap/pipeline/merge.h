@@ -1,9 +1,9 @@
 // Merging maps built apart (issue 17: a fleet's logs mapped on many machines): `patrolmap merge`.
 //
 // The merged map is the map one `patrolmap map` over all their logs would build, with the logs in the merge
-// order: by each flight's start (its first route frame, else its first node), then by flight id (natural order). Each node is recognised
-// again from its stored features and BoW vector (PlaceRecognizer::AddDescribedKeyFrame) against every node
-// before it in that order, so closures within a map and across maps come out as one mapping run finds them,
+// order: by each flight's start (its first route frame, else its first node), then by flight id (natural order). Each
+// node is recognised again from its stored features and BoW vector (PlaceRecognizer::AddDescribedKeyFrame) against
+// every node before it in that order, so closures within a map and across maps come out as one mapping run finds them,
 // and merging is associative: pairwise merges in any order give the same nodes and closures. No log is read.
 #pragma once
 
@@ -28,7 +28,7 @@ struct MergeRequest {
 
 struct MergeOutcome {
   int flights = 0, nodes = 0, loop_closures = 0;
-  int across_maps = 0;                                   // loop closures between nodes of different input maps
+  int across_maps = 0;                                       // loop closures between nodes of different input maps
   std::vector<std::pair<std::string, std::string>> renamed;  // (map file: flight, new id)
   double seconds_query = 0.0, seconds_verify = 0.0;          // summed over nodes
 };
