@@ -144,18 +144,19 @@ bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method) 
 
 bool PlaceOptions::IsValid(std::string* error) const {
   return OptionCheck(error)
-      .InRange("place.max_features", max_features, 8, 100000)
-      .InRange("place.candidates", candidates, 1, 1000)
-      .InRange("place.exclude_recent_s", exclude_recent_s, 0.0, 1e10)
-      .InRange("place.exclude_recent_images", exclude_recent_images, 0, 1000000)
-      .AboveAtMost("place.ratio", ratio, 0.0, 1.0)
-      .InRange("place.min_matched_fraction", min_matched_fraction, 0.0, 1.0)
-      .AboveAtMost("place.inlier_threshold_px", inlier_threshold_px, 0.0, 100.0)
-      .InRange("place.min_inliers", min_inliers, 8, 100000)
-      .InRange("place.max_log_nfa", max_log_nfa, -1000.0, 1000.0)
-      .InRange("place.max_topological_gap", max_topological_gap, 0, 1000000)
-      .InRange("place.direct_index_levels_up", direct_index_levels_up, 0, 32)
-      .ok();
+             .InRange("place.max_features", max_features, 8, 100000)
+             .InRange("place.candidates", candidates, 1, 1000)
+             .InRange("place.exclude_recent_s", exclude_recent_s, 0.0, 1e10)
+             .InRange("place.exclude_recent_images", exclude_recent_images, 0, 1000000)
+             .AboveAtMost("place.ratio", ratio, 0.0, 1.0)
+             .InRange("place.min_matched_fraction", min_matched_fraction, 0.0, 1.0)
+             .AboveAtMost("place.inlier_threshold_px", inlier_threshold_px, 0.0, 100.0)
+             .InRange("place.min_inliers", min_inliers, 8, 100000)
+             .InRange("place.max_log_nfa", max_log_nfa, -1000.0, 1000.0)
+             .InRange("place.max_topological_gap", max_topological_gap, 0, 1000000)
+             .InRange("place.direct_index_levels_up", direct_index_levels_up, 0, 32)
+             .ok() &&
+         query.IsValid(error);
 }
 
 PlaceRecognizer::PlaceRecognizer(const vocab::Vocabulary* vocabulary, const PlaceOptions& options)
@@ -301,7 +302,8 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   auto start = std::chrono::steady_clock::now();
   std::vector<vocab::QueryResult> candidates;
   database_.Query(
-      bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); }, &candidates);
+      bow, options_.candidates, [&](vocab::EntryId entry) { return Allowed(key_frame, entry); }, &candidates,
+      options_.query);
   result->seconds_query = Since(start);
 
   start = std::chrono::steady_clock::now();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <mutex>
 
+#include "patrolmap/core/option_check.h"
 #include "patrolmap/core/status.h"
 
 namespace patrolmap::vocab {
@@ -21,15 +22,55 @@ EntryId Database::Add(const BowVector& bow) {
   return id;
 }
 
+bool QueryOptions::IsValid(std::string* error) const {
+  OptionCheck check(error);
+  check.InRange("place.query_words", max_words, 0, 1000000);
+  check.InRange("place.rescored_entries", rescored, 1, 1000000);
+  return check.ok();
+}
+
+float Database::Common(const BowVector& query, EntryId entry) const {
+  const BowVector& d = entries_[entry];
+  float common = 0.0f;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < query.words.size(); ++i) {
+    while (j < d.words.size() && d.words[j] < query.words[i]) ++j;
+    if (j == d.words.size()) break;
+    if (d.words[j] != query.words[i]) continue;
+    const float q = query.weights[i];
+    common += q + d.weights[j] - std::abs(q - d.weights[j]);
+  }
+  return common;
+}
+
+void Database::ReadWords(const BowVector& bow, int max_words, std::vector<std::uint32_t>* order) const {
+  order->clear();
+  for (std::uint32_t i = 0; i < bow.words.size(); ++i) {
+    if (bow.words[i] < postings_.size()) order->push_back(i);
+  }
+  if (max_words <= 0 || order->size() <= static_cast<std::size_t>(max_words)) return;
+  std::nth_element(order->begin(), order->begin() + max_words, order->end(), [&](std::uint32_t a, std::uint32_t b) {
+    const std::size_t la = postings_[bow.words[a]].size(), lb = postings_[bow.words[b]].size();
+    return la != lb ? la < lb : a < b;
+  });
+  order->resize(max_words);
+  std::sort(order->begin(), order->end());
+}
+
 void Database::Query(const BowVector& bow, int max_results, const std::function<bool(EntryId)>& allowed,
-                     std::vector<QueryResult>* results) const {
+                     std::vector<QueryResult>* results, const QueryOptions& options) const {
   std::shared_lock lock(mutex_);
   results->clear();
-  // For L1-normalised vectors, score = sum over common words of (q + d - |q - d|) / 2.
-  std::vector<float> common(entries_.size(), 0.0f);
-  std::vector<EntryId> touched;
-  for (std::size_t i = 0; i < bow.words.size(); ++i) {
-    if (bow.words[i] >= postings_.size()) continue;
+  // For L1-normalised vectors, score = sum over common words of (q + d - |q - d|) / 2 = sum of min(q, d). The
+  // sums live in a per-thread scratch array that only grows; the entries touched are zeroed again afterwards.
+  thread_local std::vector<float> common;
+  thread_local std::vector<EntryId> touched;
+  thread_local std::vector<std::uint32_t> order;
+  if (common.size() < entries_.size()) common.resize(entries_.size(), 0.0f);
+  touched.clear();
+  ReadWords(bow, options.max_words, &order);
+  const bool two_stage = order.size() < bow.words.size();
+  for (const std::uint32_t i : order) {
     const float q = bow.weights[i];
     for (const Posting& posting : postings_[bow.words[i]]) {
       if (common[posting.entry] == 0.0f) touched.push_back(posting.entry);
@@ -37,12 +78,20 @@ void Database::Query(const BowVector& bow, int max_results, const std::function<
     }
   }
   for (EntryId entry : touched) {
-    if (!allowed || allowed(entry)) results->push_back({entry, std::min(1.0, 0.5 * common[entry])});
+    if (!allowed || allowed(entry)) results->push_back({entry, common[entry]});
+    common[entry] = 0.0f;
   }
   const auto better = [](const QueryResult& a, const QueryResult& b) {
     return a.score != b.score ? a.score > b.score : a.entry < b.entry;
   };
-  const std::size_t keep = std::min<std::size_t>(results->size(), static_cast<std::size_t>(std::max(0, max_results)));
+  if (two_stage) {  // the best partial sums, scored exactly
+    const auto rescored = std::min(results->size(), static_cast<std::size_t>(options.rescored));
+    std::nth_element(results->begin(), results->begin() + rescored, results->end(), better);
+    results->resize(rescored);
+    for (QueryResult& r : *results) r.score = Common(bow, r.entry);
+  }
+  for (QueryResult& r : *results) r.score = std::min(1.0, 0.5 * static_cast<float>(r.score));
+  const std::size_t keep = std::min(results->size(), static_cast<std::size_t>(std::max(0, max_results)));
   std::partial_sort(results->begin(), results->begin() + keep, results->end(), better);
   results->resize(keep);
 }

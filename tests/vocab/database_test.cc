@@ -47,6 +47,54 @@ TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
   EXPECT_EQ(results.size(), 1u);
 }
 
+// The two-stage query (QueryOptions::max_words): with all the query's words it is the exhaustive query; with its
+// rarest words it still finds an entry that shares them, with the exhaustive score bit for bit; and the entries
+// it rescores are the best partial scores only.
+TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
+  constexpr int kWords = 200;
+  std::vector<float> idf(kWords);
+  for (int w = 0; w < kWords; ++w) idf[w] = 0.5f + 0.02f * w;
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<WordId> common(0, 19), rare(20, kWords - 1);
+  Database database(kWords);
+  std::vector<BowVector> entries;
+  for (int e = 0; e < 300; ++e) {
+    std::vector<WordId> words;
+    for (int i = 0; i < 40; ++i) words.push_back(i % 4 == 0 ? rare(rng) : common(rng));
+    BowVector bow;
+    MakeBowVector(words, idf.data(), &bow);
+    database.Add(bow);
+    entries.push_back(bow);
+  }
+  std::vector<QueryResult> exact, two_stage;
+  for (const EntryId target : {7u, 150u, 299u}) {
+    database.Query(entries[target], 3, {}, &exact);
+    QueryOptions all;
+    all.max_words = static_cast<int>(entries[target].words.size());
+    database.Query(entries[target], 3, {}, &two_stage, all);
+    ASSERT_EQ(two_stage.size(), exact.size());
+    for (std::size_t i = 0; i < exact.size(); ++i) {
+      EXPECT_EQ(two_stage[i].entry, exact[i].entry);
+      EXPECT_EQ(two_stage[i].score, exact[i].score);
+    }
+    QueryOptions rarest;
+    rarest.max_words = 5;
+    rarest.rescored = 10;
+    database.Query(entries[target], 3, {}, &two_stage, rarest);
+    ASSERT_FALSE(two_stage.empty());
+    EXPECT_EQ(two_stage[0].entry, target);  // an entry is its own best match
+    EXPECT_EQ(two_stage[0].score, exact[0].score);
+    rarest.rescored = 1;
+    database.Query(entries[target], 3, {}, &two_stage, rarest);
+    EXPECT_EQ(two_stage.size(), 1u);
+  }
+  std::string error;
+  QueryOptions bad;
+  bad.rescored = 0;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("place.rescored_entries"), std::string::npos) << error;
+}
+
 // The L1 score by hand for unequal weights, where only the |q - d| term tells a partial from a full match:
 // q = (3/4, 1/4), d = (1/4, 3/4) over words 0 and 1; score = sum (q + d - |q - d|) / 2 = 1/4 + 1/4.
 TEST(Database, L1ScoreCountsOnlyTheSharedPartOfEachWeight) {

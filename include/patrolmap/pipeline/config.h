@@ -74,6 +74,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);
   visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
+  visitor->Field("place.query_words", &place.query.max_words);
+  visitor->Field("place.rescored_entries", &place.query.rescored);
   auto& change = config->change;
   visitor->Field("change.appearance.ratio", &change.appearance.ratio);
   visitor->Field("change.appearance.inlier_threshold_px", &change.appearance.inlier_threshold_px);

@@ -54,6 +54,9 @@ struct PlaceOptions {
   // Direct index: match only features that share the vocabulary node this many levels above
   // their words (DBoW2's direct index), instead of every feature with every feature. 0 = brute force.
   int direct_index_levels_up = 0;
+  // How much of the inverted index a query reads (vocab::QueryOptions): exhaustive, or two-stage (the lists
+  // of the query's rarest words, then the best entries scored exactly).
+  vocab::QueryOptions query;
 
   bool IsValid(std::string* error) const;
 };

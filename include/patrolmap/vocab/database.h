@@ -19,6 +19,18 @@ struct QueryResult {
   double score = 0.0;  // L1Score with the query, in [0, 1]
 };
 
+// How much of the inverted index a query reads. Exhaustive (the default) scores every entry that shares a word
+// with the query. Two-stage (max_words > 0): only the posting lists of the query's max_words rarest words (the
+// shortest lists: the most discriminative words) are read, and the `rescored` entries with the best partial
+// scores are scored exactly (the exhaustive score, bit for bit). The result equals the exhaustive one whenever
+// its entries are among those (BENCHMARKS.md, "Fleet scale", measures how often and how much faster).
+struct QueryOptions {
+  int max_words = 0;   // 0: exhaustive
+  int rescored = 100;  // entries scored exactly after the first stage
+
+  bool IsValid(std::string* error) const;
+};
+
 class Database {
  public:
   explicit Database(int word_count);
@@ -26,12 +38,11 @@ class Database {
   // Adds a vector; entries are numbered 0, 1, 2, ... in the order added.
   EntryId Add(const BowVector& bow);
 
-  // The best `max_results` entries by L1 score, best first, among those for
-  // which `allowed` is true (all when it is empty); entries sharing no word
-  // with the query are never returned. Safe to call from several threads, also
-  // while another thread adds.
+  // The best `max_results` entries by L1 score, best first (ties: lower id first), among those for which
+  // `allowed` is true (all when it is empty); entries sharing no word with the query are never returned. Safe
+  // to call from several threads, also while another thread adds.
   void Query(const BowVector& bow, int max_results, const std::function<bool(EntryId)>& allowed,
-             std::vector<QueryResult>* results) const;
+             std::vector<QueryResult>* results, const QueryOptions& options = QueryOptions{}) const;
 
   std::size_t size() const;
   BowVector entry(EntryId id) const;
@@ -41,6 +52,11 @@ class Database {
     EntryId entry;
     float weight;
   };
+  // The exact score of `entry`, as the exhaustive pass sums it (in float, in the query's word order).
+  float Common(const BowVector& query, EntryId entry) const;
+  // The query's words whose lists are read (indices into `bow`, ascending): all, or its max_words rarest.
+  void ReadWords(const BowVector& bow, int max_words, std::vector<std::uint32_t>* order) const;
+
   std::vector<std::vector<Posting>> postings_;
   std::vector<BowVector> entries_;
   mutable std::shared_mutex mutex_;
