@@ -154,9 +154,20 @@ Status Vocabulary::Train(const std::vector<cv::Mat>& images, const VocabularyOpt
 
 namespace {
 
+// Eight independent partial sums, so the compiler keeps them in vector registers (a single running float sum
+// is a dependency chain it may not reorder); the tail, when the dimension is not a multiple of 8, runs alone.
 float SquaredDistanceTo8Bit(const float* a, const std::uint8_t* b, int dimension) {
-  float sum = 0.0f;
-  for (int d = 0; d < dimension; ++d) {
+  constexpr int kLanes = 8;
+  float lanes[kLanes] = {};
+  int d = 0;
+  for (; d + kLanes <= dimension; d += kLanes) {
+    for (int l = 0; l < kLanes; ++l) {
+      const float difference = a[d + l] - static_cast<float>(b[d + l]);
+      lanes[l] += difference * difference;
+    }
+  }
+  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
+  for (; d < dimension; ++d) {
     const float difference = a[d] - static_cast<float>(b[d]);
     sum += difference * difference;
   }
