@@ -70,16 +70,34 @@ void Database::Query(const BowVector& bow, int max_results, const std::function<
   touched.clear();
   ReadWords(bow, options.max_words, &order);
   const bool two_stage = order.size() < bow.words.size();
+  std::size_t reads = 0;
+  for (const std::uint32_t i : order) reads += postings_[bow.words[i]].size();
+  // Few reads: remember the entries touched. Many (a large share of the database): add without a branch and
+  // sweep the whole array after. The sums, and so the results, are the same.
+  const bool dense = reads > entries_.size() / 4;
   for (const std::uint32_t i : order) {
     const float q = bow.weights[i];
+    if (dense) {
+      for (const Posting& posting : postings_[bow.words[i]]) {
+        common[posting.entry] += q + posting.weight - std::abs(q - posting.weight);
+      }
+      continue;
+    }
     for (const Posting& posting : postings_[bow.words[i]]) {
       if (common[posting.entry] == 0.0f) touched.push_back(posting.entry);
       common[posting.entry] += q + posting.weight - std::abs(q - posting.weight);
     }
   }
-  for (EntryId entry : touched) {
+  const auto collect = [&](EntryId entry) {
     if (!allowed || allowed(entry)) results->push_back({entry, common[entry]});
     common[entry] = 0.0f;
+  };
+  if (dense) {
+    for (EntryId entry = 0; entry < entries_.size(); ++entry) {
+      if (common[entry] != 0.0f) collect(entry);
+    }
+  } else {
+    for (const EntryId entry : touched) collect(entry);
   }
   const auto better = [](const QueryResult& a, const QueryResult& b) {
     return a.score != b.score ? a.score > b.score : a.entry < b.entry;

@@ -88,6 +88,22 @@ TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
     database.Query(entries[target], 3, {}, &two_stage, rarest);
     EXPECT_EQ(two_stage.size(), 1u);
   }
+  // A query that reads few postings (one rare word: the entries touched are remembered) and one that reads
+  // many (every entry: the array is swept) both rank as the L1 score by brute force.
+  for (const std::vector<WordId>& words : {std::vector<WordId>{150}, std::vector<WordId>{0, 1, 2, 3, 150}}) {
+    BowVector query;
+    MakeBowVector(words, idf.data(), &query);
+    std::vector<QueryResult> brute;
+    for (EntryId e = 0; e < entries.size(); ++e) {
+      const double score = L1Score(query, entries[e]);
+      if (score > 0.0) brute.push_back({e, score});
+    }
+    std::stable_sort(brute.begin(), brute.end(),
+                     [](const QueryResult& a, const QueryResult& b) { return a.score > b.score + 1e-6; });
+    database.Query(query, 1000, {}, &exact);
+    ASSERT_EQ(exact.size(), brute.size()) << words.size() << " words";
+    for (std::size_t i = 0; i < exact.size(); ++i) EXPECT_NEAR(exact[i].score, brute[i].score, 1e-6);
+  }
   std::string error;
   QueryOptions bad;
   bad.rescored = 0;
