@@ -56,6 +56,7 @@ done > "$root/logs.tmp"
 mv "$root/logs.tmp" "$root/logs.txt"
 count=$#
 export PATROLMAP=${PATROLMAP:-$(command -v patrolmap || echo patrolmap)}
+export PATROLMAP_FLEET_DIR=$here
 
 # The tree: level L merges ceil(count(L-1) / FANIN) groups, up to one map.
 levels=() below=$count

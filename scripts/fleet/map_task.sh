@@ -5,6 +5,8 @@
 #   map_task.sh LIST ROOT N [patrolmap map options...]
 # N "array" takes $SLURM_ARRAY_TASK_ID. PATROLMAP names the program (default: patrolmap on PATH).
 set -euo pipefail
+# Slurm runs a copy of this script from its spool folder: fleet.sh says where the scripts are.
+source "${PATROLMAP_FLEET_DIR:-$(dirname "$0")}/publish.sh"
 list=$1 root=$2
 index=$3
 [[ $index == array ]] && index=${SLURM_ARRAY_TASK_ID:?map_task.sh: N is array outside a Slurm array task}
@@ -17,12 +19,5 @@ if [[ -f $out/map.pmap ]]; then
   echo "map $index: $out/map.pmap is complete, skipped ($log)"
   exit 0
 fi
-mkdir -p "$root/maps"
-scratch=$(mktemp -d "$root/maps/.$index.XXXXXX")
-trap 'rm -rf "$scratch"' EXIT
-"$patrolmap" -q map "$log" -o "$scratch" "$@"
-rm -rf "$out"
-chmod 755 "$scratch"
-mv "$scratch" "$out"
-trap - EXIT
+publish "$out" "$patrolmap" -q map "$log" "$@"
 echo "map $index: $log -> $out/map.pmap"

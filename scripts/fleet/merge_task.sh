@@ -5,6 +5,8 @@
 #   merge_task.sh ROOT L FANIN COUNT N [patrolmap merge options...]
 # COUNT is the number of maps on level L-1. N "array" takes $SLURM_ARRAY_TASK_ID.
 set -euo pipefail
+# Slurm runs a copy of this script from its spool folder: fleet.sh says where the scripts are.
+source "${PATROLMAP_FLEET_DIR:-$(dirname "$0")}/publish.sh"
 root=$1 level=$2 fanin=$3 count=$4
 index=$5
 [[ $index == array ]] && index=${SLURM_ARRAY_TASK_ID:?merge_task.sh: N is array outside a Slurm array task}
@@ -23,12 +25,5 @@ for ((i = index * fanin; i < (index + 1) * fanin && i < count; i++)); do
   inputs+=("$below/$i/map.pmap")
 done
 ((${#inputs[@]})) || { echo "merge_task.sh: level $level has no task $index" >&2; exit 1; }
-mkdir -p "$root/merge-$level"
-scratch=$(mktemp -d "$root/merge-$level/.$index.XXXXXX")
-trap 'rm -rf "$scratch"' EXIT
-"$patrolmap" -q merge "${inputs[@]}" -o "$scratch" "$@"
-rm -rf "$out"
-chmod 755 "$scratch"
-mv "$scratch" "$out"
-trap - EXIT
+publish "$out" "$patrolmap" -q merge "${inputs[@]}" "$@"
 echo "merge $level/$index: ${#inputs[@]} maps -> $out/map.pmap"
