@@ -68,7 +68,7 @@ expect "truncated map" 1 "cut.pmap: " -- \
 "$bin" -q vocab build "$source_dir/flight_logs/sample" -k 4 -L 2 --every 30 --out "$work/small.pmvoc" >/dev/null
 expect "another vocabulary" 1 "m1/map.pmap was built with the vocabulary default.pmvoc .* not with .*small.pmvoc" -- \
   "$bin" merge "$work/m1/map.pmap" "$work/m2/map.pmap" --vocabulary "$work/small.pmvoc" -o "$work/vocab"
-expect "output over an input" 1 "map" -- "$bin" merge "$work/m1/map.pmap" "$work/m2/map.pmap" -o "$work/m1"
+expect "output over an input" 1 "m1/map.pmap would replace .*m1/map.pmap \(the map\)" -- "$bin" merge "$work/m1/map.pmap" "$work/m2/map.pmap" -o "$work/m1"
 expect "fleet bad fan-in" 2 "--fan-in 1: must be an integer >= 2" -- bash "$fleet" --fan-in 1 "$work/f" "${logs[@]}"
 expect "fleet missing log" 1 "$work/nothing: no such flight log" -- bash "$fleet" --engine serial "$work/f" "$work/nothing"
 
