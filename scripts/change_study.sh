@@ -4,7 +4,10 @@
 # only the lighting), maps flight 1, adds flights 2 and 3 with `patrol`, and scores every change report with
 # `eval`. Prints one line per patrol and writes OUT/summary.json.
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
-# Environment: ROUTES, SEEDS, OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before.
+# Environment: ROUTES, SEEDS (or SERIES="route:seed ..."), OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before;
+# STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
+# NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
+# scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/change_study}
@@ -17,7 +20,10 @@ mkdir -p "$out"
 # Logs at 376x240 processed at full scale: the same images the default 752x480 log gives the flow and place
 # stages after their 0.5 downscale, at a quarter of the rendering time.
 config="$out/study.yaml"
-printf 'flow:\n  frames:\n    scale: 1.0\n' > "$config"
+printf 'flow:\n  frames:\n    scale: %s\n' "${SCALE:-1.0}" > "$config"
+simulate_extra=()
+[ -n "${STEREO:-}" ] && simulate_extra+=(--stereo "$STEREO")
+printf 'depth:\n  source: %s\n' "${DEPTH:-auto}" >> "$config"
 run_series() {  # name route seed extra-simulate-options...
   local name=$1 route=$2 seed=$3
   shift 3
@@ -25,7 +31,13 @@ run_series() {  # name route seed extra-simulate-options...
   if [ -z "${REUSE_LOGS:-}" ] || [ ! -d "$dir/logs/flight_3" ]; then  # REUSE_LOGS=1: keep logs of an earlier run
     rm -rf "$dir"
     "$pm" simulate --route "$route" --seed "$seed" --flights 3 --objects "$objects" --detections --depth \
-      --resolution 376x240 "$@" --out "$dir/logs" >/dev/null 2>&1
+      --resolution "${RESOLUTION:-376x240}" ${simulate_extra[@]+"${simulate_extra[@]}"} "$@" --out "$dir/logs" \
+      >/dev/null 2>&1
+  fi
+  if [ -n "${NO_DETECTOR:-}" ]; then
+    for flight in "$dir"/logs/flight_*; do
+      [ -d "$flight/objects0" ] && mv "$flight/objects0" "$flight/objects0.hidden"
+    done
   fi
   "$pm" map "$dir/logs/flight_1" --out "$dir/run_1" -c "$config" >/dev/null 2>&1
   for n in 2 3; do
@@ -38,11 +50,17 @@ run_series() {  # name route seed extra-simulate-options...
       >> "$out/lines.jsonl"
   done
 }
-for route in $routes; do
-  for seed in $seeds; do
-    run_series "$route-$seed" "$route" "$seed"
+if [ -n "${SERIES:-}" ]; then  # SERIES="l-shape:41 inner-loop:42": these route-seed pairs instead of ROUTES x SEEDS
+  for pair in $SERIES; do
+    run_series "${pair%%:*}-${pair##*:}" "${pair%%:*}" "${pair##*:}"
   done
-done
+else
+  for route in $routes; do
+    for seed in $seeds; do
+      run_series "$route-$seed" "$route" "$seed"
+    done
+  done
+fi
 run_series "lighting-only" inner-loop 1 --remove-fraction 0 --move-fraction 0 --added 0
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys

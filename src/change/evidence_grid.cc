@@ -357,20 +357,25 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
   });
   std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
   MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
+  std::vector<std::size_t> members;         // the changed voxels of the reported regions
   for (Region& region : regions) {
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
     const Eigen::Vector3d extent = region.data.box_max - region.data.box_min + Eigen::Vector3d::Constant(size);
     if (std::max(extent.x(), extent.y()) < options.min_region_width_m - 1e-9) continue;
     region.data.score = region.score_sum / region.data.voxels;
     change->regions.push_back(region.data);
-    for (std::size_t member : region.members) change->changed_voxels.push_back(changed[member]);
+    members.insert(members.end(), region.members.begin(), region.members.end());
   }
   std::stable_sort(change->regions.begin(), change->regions.end(),
                    [](const GeometryRegion& x, const GeometryRegion& y) { return x.voxels > y.voxels; });
-  std::sort(change->changed_voxels.begin(), change->changed_voxels.end(),
-            [](const Eigen::Vector3i& x, const Eigen::Vector3i& y) {
-              return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3);
-            });
+  std::sort(members.begin(), members.end(), [&changed](std::size_t x, std::size_t y) {
+    return std::lexicographical_compare(changed[x].data(), changed[x].data() + 3, changed[y].data(),
+                                        changed[y].data() + 3);
+  });
+  for (std::size_t member : members) {
+    change->changed_voxels.push_back(changed[member]);
+    change->changed_deltas.push_back(static_cast<float>(deltas[member]));
+  }
 }
 
 }  // namespace

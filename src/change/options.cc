@@ -77,6 +77,19 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
       .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0);
 }
 
+void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
+  check->InRange("change.geometry_objects.cluster_gap_voxels", g.cluster_gap_voxels, 1, 10)
+      .InRange("change.geometry_objects.min_voxels", g.min_voxels, 1, 100000000)
+      .AboveAtMost("change.geometry_objects.max_size_m", g.max_size_m, 0.0, 10000.0)
+      .InRange("change.geometry_objects.max_move_m", g.max_move_m, 0.0, 10000.0)
+      .InRange("change.geometry_objects.max_top_difference_m", g.max_top_difference_m, 0.0, 1000.0)
+      .InRange("change.geometry_objects.min_shape_overlap", g.min_shape_overlap, 0.0, 1.0)
+      .AboveAtMost("change.geometry_objects.shape_tolerance_m", g.shape_tolerance_m, 0.0, 100.0)
+      .InRange("change.geometry_objects.physical_weight", g.physical_weight, 0.0, 1000.0)
+      .InRange("change.geometry_objects.shape_weight", g.shape_weight, 0.0, 1000.0)
+      .InRange("change.geometry_objects.detection_margin_m", g.detection_margin_m, 0.0, 100.0);
+}
+
 void CheckRouteFrames(const RouteFrameOptions& r, OptionCheck* check) {
   check->InRange("change.route_frames.interval_s", r.interval_s, 0.0, 3600.0)
       .InRange("change.route_frames.max_width", r.max_width, 16, 8192)
@@ -101,6 +114,7 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckObjects(objects, &check);
   CheckGrid(grid, &check);
   CheckGeometry(geometry, &check);
+  CheckGeometryObjects(geometry_objects, &check);
   CheckRouteFrames(route_frames, &check);
   CheckRoute(route, &check);
   return check.ok();

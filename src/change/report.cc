@@ -198,6 +198,17 @@ bool Reported(ObjectState state) {
   return state == ObjectState::kNew || state == ObjectState::kRemoved || state == ObjectState::kMoved;
 }
 
+// A class-agnostic object's pictures: the extent of its changed voxels where it was and where it is (each side's
+// extent for the patrol that lacks it), from any time of each patrol.
+void AddClassAgnosticViews(const ChangeReport& report, const graph::TopoMap& map, const ObjectChange& o,
+                           const ReportOptions& options, ChangeItem* item) {
+  const Eigen::Vector3d half = Eigen::Vector3d::Constant(report.geometry.voxel_size / 2.0);
+  const Eigen::AlignedBox3d& then = o.box_before.isEmpty() ? o.box_after : o.box_before;
+  const Eigen::AlignedBox3d& now = o.box_after.isEmpty() ? o.box_before : o.box_after;
+  item->before = ViewOfBox(map, report.prior_flight, then.min() - half, then.max() + half, TimeWindow(), options);
+  item->after = ViewOfBox(map, report.current_flight, now.min() - half, now.max() + half, TimeWindow(), options);
+}
+
 ChangeItem ObjectItem(const ChangeReport& report, const graph::TopoMap& map, const ObjectChange& o,
                       const ReportOptions& options) {
   ChangeItem item;
@@ -208,6 +219,10 @@ ChangeItem ObjectItem(const ChangeReport& report, const graph::TopoMap& map, con
   item.confidence = o.confidence;
   item.position = o.after ? o.after : o.before;
   if (o.state == ObjectState::kMoved) item.from = o.before;
+  if (o.class_agnostic) {
+    AddClassAgnosticViews(report, map, o, options, &item);
+    return item;
+  }
   const MapObject* prior = FindObject(map.Patrol(report.prior_flight), o.prior_id);
   const MapObject* current = FindObject(map.Patrol(report.current_flight), o.current_id);
   // New: where it is now, then and now; removed: where it was; moved: each where it was seen. A patrol
@@ -301,15 +316,26 @@ int ChangeReport::ObjectsIn(ObjectState state) const {
       std::count_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; }));
 }
 
+namespace {
+
+// "<x>_<y>_<z>": the 2 m cell of a position.
+std::string CellName(const Eigen::Vector3d& position) {
+  const Eigen::Vector3d cell = (position / kRegionCellM).array().floor();
+  return std::to_string(static_cast<long long>(cell.x())) + "_" + std::to_string(static_cast<long long>(cell.y())) +
+         "_" + std::to_string(static_cast<long long>(cell.z()));
+}
+
+}  // namespace
+
 std::string ObjectChangeId(const ObjectChange& change) {
+  if (change.class_agnostic) {
+    const std::optional<Eigen::Vector3d>& where = change.after ? change.after : change.before;
+    return "object-g" + CellName(where.value_or(Eigen::Vector3d::Zero()));
+  }
   return "object-p" + std::to_string(change.prior_id) + "-c" + std::to_string(change.current_id);
 }
 
-std::string GeometryChangeId(const Eigen::Vector3d& centroid) {
-  const Eigen::Vector3d cell = (centroid / kRegionCellM).array().floor();
-  return "geometry-" + std::to_string(static_cast<long long>(cell.x())) + "_" +
-         std::to_string(static_cast<long long>(cell.y())) + "_" + std::to_string(static_cast<long long>(cell.z()));
-}
+std::string GeometryChangeId(const Eigen::Vector3d& centroid) { return "geometry-" + CellName(centroid); }
 
 std::string AppearanceChangeId(int prior_node, int current_node) {
   return "appearance-" + std::to_string(prior_node) + "-" + std::to_string(current_node);

@@ -121,7 +121,25 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
 }
 
 // Why an object has its state, in an inspector's words.
+// Why a class-agnostic object (a cluster of changed voxels) has its state.
+std::string GeometryReason(const ObjectChange& o) {
+  const auto voxels = [](const Eigen::AlignedBox3d& box) {
+    return Number(box.sizes().x(), 1) + " x " + Number(box.sizes().y(), 1) + " m";
+  };
+  switch (o.state) {
+    case ObjectState::kNew: return "space free before is occupied now, over " + voxels(o.box_after) + " (no detector)";
+    case ObjectState::kRemoved:
+      return "space occupied before is seen free now, over " + voxels(o.box_before) + " (no detector)";
+    case ObjectState::kMoved:
+      return "space freed and space filled alike in shape, " + Number((*o.after - *o.before).head<2>().norm(), 1) +
+             " m apart, turned " + Number(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) +
+             "&#176; (no detector)";
+    default: return "";
+  }
+}
+
 std::string Reason(const ObjectChange& o) {
+  if (o.class_agnostic) return GeometryReason(o);
   switch (o.state) {
     case ObjectState::kPersistent: return "seen in both patrols at the same place";
     case ObjectState::kNew: return "not in the prior patrol's map there";

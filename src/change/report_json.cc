@@ -77,6 +77,7 @@ json ObjectJson(const ObjectChange& o) {
   json object = {{"id", ObjectChangeId(o)},
                  {"state", ToString(o.state)},
                  {"label", o.label},
+                 {"source", o.class_agnostic ? "geometry" : "detections"},
                  {"confidence", o.confidence},
                  {"prior_id", o.prior_id},
                  {"current_id", o.current_id},

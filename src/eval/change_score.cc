@@ -64,7 +64,7 @@ std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, co
 // Distance between a reported and a true change of the same state; infinity when they cannot match.
 double ChangeDistance(const ReportedObject& r, const TruthChange& t) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  if (r.label != t.label) return kInfinity;
+  if (!r.class_agnostic && r.label != t.label) return kInfinity;
   double distance = 0.0;
   if (t.before) {
     if (!r.before) return kInfinity;

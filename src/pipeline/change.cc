@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "patrolmap/change/geometry_objects.h"
+
 namespace patrolmap::pipeline {
 namespace {
 
@@ -70,6 +72,14 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
       change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
   report->geometry.depth_prior = prior_record->depth_source;
   report->geometry.depth_current = current_record->depth_source;
+  if (report->geometry_compared && options.geometry_objects.enabled) {
+    // Objects no detector named: clusters of changed space (paper 003); detected objects take precedence.
+    for (change::ObjectChange& found : change::GeometryObjects(report->geometry, prior_record->objects,
+                                                               current_record->objects, options.geometry_objects)) {
+      report->objects.push_back(std::move(found));
+    }
+    report->objects_compared = true;
+  }
   report->seconds_geometry = SecondsSince(start);
   return Status::Ok();
 }

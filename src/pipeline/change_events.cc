@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "patrolmap/change/appearance.h"
+#include "patrolmap/change/geometry_objects.h"
 #include "patrolmap/change/object_diff.h"
 #include "patrolmap/core/option_check.h"
 
@@ -52,7 +53,7 @@ Event ObjectEvent(const change::ObjectChange& change, TimestampNs timestamp_ns) 
   event.timestamp_ns = timestamp_ns;
   event.position = change.after ? change.after : change.before;
   event.confidence = change.confidence;
-  event.details = {{"label", change.label}};
+  event.details = {{"label", change.label}, {"source", change.class_agnostic ? "geometry" : "detections"}};
   return event;
 }
 
@@ -200,6 +201,11 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
       change::DiffGrids(prior_record_->grid, *grid, config_.change.geometry, &geometry)) {
     for (const change::GeometryRegion& region : geometry.regions) {
       candidates.push_back(GeometryEvent(region, timestamp_ns));
+    }
+    // Objects no detector named: clusters of the changed space (as the report finds them).
+    for (const change::ObjectChange& change :
+         change::GeometryObjects(geometry, prior_record_->objects, now.objects, config_.change.geometry_objects)) {
+      candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }
   // A change is sent once two checks in a row found it: a region or object state of a grid or map still

@@ -130,6 +130,7 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
   try {
     for (const nlohmann::json& o : objects) {
       eval::ReportedObject r{o.at("state").get<std::string>(), o.at("label").get<std::string>(), {}, {}};
+      r.class_agnostic = o.value("source", "detections") == "geometry";
       for (const char* key : {"before", "after"}) {
         if (o.at(key).is_null()) continue;
         const Eigen::Vector3d p(o[key][0].get<double>(), o[key][1].get<double>(), o[key][2].get<double>());

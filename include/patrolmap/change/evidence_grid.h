@@ -95,7 +95,8 @@ struct GeometryChange {
   // Voxels each patrol's grid dropped at its memory budget (change.grid.memory_mb): nothing is compared there.
   long long evicted_prior = 0, evicted_current = 0;
   std::string depth_prior, depth_current;       // where each grid's depth came from (PatrolRecord::depth_source)
-  std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions
+  std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions, sorted
+  std::vector<float> changed_deltas;            // ... and each one's occupancy now minus before (> 0: appeared)
   std::vector<GeometryRegion> regions;          // largest first
 };
 

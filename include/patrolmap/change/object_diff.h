@@ -23,6 +23,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/patrol_data.h"
@@ -45,6 +46,10 @@ struct ObjectChange {
   // moved: after ~ rotation * (before-point - before) + after, from the SVD registration.
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   double weighted_distance = 0.0;  // moved: paper 003's delta
+  // From changed geometry (GeometryObjects), not from a detector: no object ids, label "object", and the
+  // extent of the changed voxels where it was and where it is (empty boxes where it is not).
+  bool class_agnostic = false;
+  Eigen::AlignedBox3d box_before, box_after;
 };
 
 // The appearance terms between two objects, each in [0, 1] and present when both have it: texture (half

@@ -12,7 +12,8 @@
 // one flight is optional: reported persistent (or new, when the patrol never
 // saw it before) it is no error, unreported no miss.
 // A reported object is a hit when a true object of the same state and label
-// lies within `distance_m` (moved: both its positions). Per state: precision,
+// lies within `distance_m` (moved: both its positions); a class-agnostic one
+// (from changed geometry) matches any label. Per state: precision,
 // recall and F1, one-to-one matching nearest first.
 //
 // Geometry (per voxel, as paper 003 scores per point), only over voxels both
@@ -65,6 +66,7 @@ struct ReportedObject {
   std::string state;  // persistent, new, removed, moved, unobserved
   std::string label;
   std::optional<Eigen::Vector3d> before, after;
+  bool class_agnostic = false;  // from changed geometry, not a detector: matches a true object of any label
 };
 
 struct Counts {

@@ -132,6 +132,17 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
   visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
+  visitor->Field("change.geometry_objects.enabled", &change.geometry_objects.enabled);
+  visitor->Field("change.geometry_objects.cluster_gap_voxels", &change.geometry_objects.cluster_gap_voxels);
+  visitor->Field("change.geometry_objects.min_voxels", &change.geometry_objects.min_voxels);
+  visitor->Field("change.geometry_objects.max_size_m", &change.geometry_objects.max_size_m);
+  visitor->Field("change.geometry_objects.max_move_m", &change.geometry_objects.max_move_m);
+  visitor->Field("change.geometry_objects.max_top_difference_m", &change.geometry_objects.max_top_difference_m);
+  visitor->Field("change.geometry_objects.min_shape_overlap", &change.geometry_objects.min_shape_overlap);
+  visitor->Field("change.geometry_objects.shape_tolerance_m", &change.geometry_objects.shape_tolerance_m);
+  visitor->Field("change.geometry_objects.physical_weight", &change.geometry_objects.physical_weight);
+  visitor->Field("change.geometry_objects.shape_weight", &change.geometry_objects.shape_weight);
+  visitor->Field("change.geometry_objects.detection_margin_m", &change.geometry_objects.detection_margin_m);
   visitor->Field("change.route_frames.interval_s", &change.route_frames.interval_s);
   visitor->Field("change.route_frames.max_width", &change.route_frames.max_width);
   visitor->Field("change.route_frames.jpeg_quality", &change.route_frames.jpeg_quality);

@@ -1,0 +1,202 @@
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "patrolmap/change/evidence_grid.h"
+#include "patrolmap/change/geometry_objects.h"
+
+namespace patrolmap::change {
+namespace {
+
+constexpr double kVoxel = 0.2;
+
+// The surface voxels of a box of nx x ny x nz voxels whose lowest corner voxel is `corner`; with `l_shape` the
+// top half of the box keeps only its first half along x (an object that is not symmetric).
+std::vector<Eigen::Vector3i> BoxSurface(const Eigen::Vector3i& corner, int nx, int ny, int nz, bool l_shape = false) {
+  std::vector<Eigen::Vector3i> voxels;
+  for (int z = 0; z < nz; ++z) {
+    const int width = l_shape && z >= nz / 2 ? nx / 2 : nx;
+    for (int y = 0; y < ny; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const bool surface = x == 0 || y == 0 || z == 0 || x == width - 1 || y == ny - 1 || z == nz - 1;
+        if (surface) voxels.push_back(corner + Eigen::Vector3i(x, y, z));
+      }
+    }
+  }
+  return voxels;
+}
+
+// The voxels turned by 90 degrees about the vertical through voxel `pivot`.
+std::vector<Eigen::Vector3i> Turned(const std::vector<Eigen::Vector3i>& voxels, const Eigen::Vector3i& pivot) {
+  std::vector<Eigen::Vector3i> turned;
+  for (const Eigen::Vector3i& v : voxels) {
+    const Eigen::Vector3i d = v - pivot;
+    turned.push_back(pivot + Eigen::Vector3i(-d.y(), d.x(), d.z()));
+  }
+  return turned;
+}
+
+// A geometry change holding `appeared` (occupancy +0.9) and `vanished` (-0.9) voxels, sorted as DiffGrids sorts.
+GeometryChange ChangeOf(const std::vector<Eigen::Vector3i>& appeared, const std::vector<Eigen::Vector3i>& vanished) {
+  std::map<std::tuple<int, int, int>, float> sorted;
+  for (const Eigen::Vector3i& v : appeared) sorted[{v.x(), v.y(), v.z()}] = 0.9f;
+  for (const Eigen::Vector3i& v : vanished) sorted[{v.x(), v.y(), v.z()}] = -0.9f;
+  GeometryChange change;
+  change.voxel_size = kVoxel;
+  for (const auto& [key, delta] : sorted) {
+    change.changed_voxels.emplace_back(std::get<0>(key), std::get<1>(key), std::get<2>(key));
+    change.changed_deltas.push_back(delta);
+  }
+  return change;
+}
+
+int Count(const std::vector<ObjectChange>& objects, ObjectState state) {
+  return static_cast<int>(
+      std::count_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; }));
+}
+
+const ObjectChange* First(const std::vector<ObjectChange>& objects, ObjectState state) {
+  const auto it =
+      std::find_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; });
+  return it == objects.end() ? nullptr : &*it;
+}
+
+TEST(GeometryObjects, ChangedVoxelsClusterBySignAndGap) {
+  std::vector<Eigen::Vector3i> appeared = BoxSurface({0, 0, 0}, 3, 3, 3);
+  const std::vector<Eigen::Vector3i> second = BoxSurface({4, 0, 0}, 3, 3, 3);  // one free voxel between
+  appeared.insert(appeared.end(), second.begin(), second.end());
+  const std::vector<Eigen::Vector3i> vanished = BoxSurface({0, 3, 0}, 3, 3, 3);  // touching the first block
+  const GeometryChange change = ChangeOf(appeared, vanished);
+
+  const std::vector<VoxelCluster> apart = ClusterChangedVoxels(change, true, 1);
+  ASSERT_EQ(apart.size(), 2u);
+  EXPECT_EQ(apart[0].points.size(), 26u);  // a 3x3x3 box's surface
+  EXPECT_EQ(apart[1].points.size(), 26u);
+  EXPECT_NEAR(apart[0].box.min().x(), 0.0, 1e-6);
+  EXPECT_NEAR(apart[0].box.max().x(), 2 * kVoxel, 1e-6);
+  EXPECT_NEAR(apart[0].mean_change, 0.9, 1e-6);
+  ASSERT_EQ(ClusterChangedVoxels(change, true, 2).size(), 1u);  // the one-voxel gap bridged
+  const std::vector<VoxelCluster> gone = ClusterChangedVoxels(change, false, 1);
+  ASSERT_EQ(gone.size(), 1u);  // touching an appeared block, yet a cluster of its own
+  EXPECT_NEAR(gone[0].Centroid().y(), 4 * kVoxel, 1e-6);
+}
+
+TEST(GeometryObjects, AnObjectTurnedAndMovedIsOneMoveWithItsRotation) {
+  const std::vector<Eigen::Vector3i> before = BoxSurface({0, 0, 0}, 8, 4, 5, true);
+  const std::vector<Eigen::Vector3i> after = Turned(BoxSurface({20, 0, 0}, 8, 4, 5, true), {20, 0, 0});
+  const std::vector<ObjectChange> objects = GeometryObjects(ChangeOf(after, before), {}, {}, GeometryObjectOptions());
+  ASSERT_EQ(objects.size(), 1u);
+  const ObjectChange& moved = objects[0];
+  EXPECT_EQ(moved.state, ObjectState::kMoved);
+  EXPECT_TRUE(moved.class_agnostic);
+  EXPECT_EQ(moved.label, kClassAgnosticLabel);
+  ASSERT_TRUE(moved.before && moved.after);
+  // 4 m along x, and the box's centroid turned about the pivot: the registration follows the turn.
+  EXPECT_GT((*moved.after - *moved.before).head<2>().norm(), 3.0);
+  const double yaw = std::atan2(moved.rotation(1, 0), moved.rotation(0, 0)) * 180.0 / M_PI;
+  EXPECT_NEAR(std::abs(yaw), 90.0, 10.0) << yaw;
+  EXPECT_NEAR(moved.box_before.max().z(), 4 * kVoxel, 1e-6);
+  EXPECT_FALSE(moved.box_after.isEmpty());
+  EXPECT_GT(moved.confidence, 0.5);
+}
+
+TEST(GeometryObjects, OtherShapesTopsAndFarMovesAreRemovedAndNew) {
+  const std::vector<Eigen::Vector3i> before = BoxSurface({0, 0, 0}, 6, 4, 5);
+  GeometryObjectOptions options;
+  // Taller by 3 voxels: the tops differ by 0.6 m.
+  std::vector<ObjectChange> objects =
+      GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 6, 4, 8), before), {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  // As tall but three times as long: the shapes do not overlap enough.
+  objects = GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 18, 4, 5), before), {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  // The same shape 10 m away: beyond max_move_m (8 m) ...
+  objects = GeometryObjects(ChangeOf(BoxSurface({50, 0, 0}, 6, 4, 5), before), {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  // ... and within it when it is raised to 12 m.
+  options.max_move_m = 12.0;
+  objects = GeometryObjects(ChangeOf(BoxSurface({50, 0, 0}, 6, 4, 5), before), {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 1);
+  const ObjectChange* moved = First(objects, ObjectState::kMoved);
+  ASSERT_NE(moved, nullptr);
+  EXPECT_NEAR((*moved->after - *moved->before).x(), 10.0, 1e-6);
+  EXPECT_NEAR(moved->weighted_distance, options.physical_weight * 10.0 / 12.0, 1e-6);  // the shapes overlap fully
+}
+
+TEST(GeometryObjects, SpecksAndStructureAreNoObjects) {
+  GeometryObjectOptions options;
+  const std::vector<Eigen::Vector3i> speck = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // 3 voxels
+  const std::vector<Eigen::Vector3i> wall = BoxSurface({10, 0, 0}, 70, 1, 10);   // 14 m long
+  std::vector<Eigen::Vector3i> appeared = speck;
+  appeared.insert(appeared.end(), wall.begin(), wall.end());
+  EXPECT_TRUE(GeometryObjects(ChangeOf(appeared, {}), {}, {}, options).empty());
+  options.max_size_m = 20.0;
+  EXPECT_EQ(Count(GeometryObjects(ChangeOf(appeared, {}), {}, {}, options), ObjectState::kNew), 1);
+  options.enabled = false;
+  EXPECT_TRUE(GeometryObjects(ChangeOf(appeared, {}), {}, {}, options).empty());
+}
+
+TEST(GeometryObjects, ADetectedObjectLeavesItsClusterToTheDetector) {
+  const std::vector<Eigen::Vector3i> removed = BoxSurface({0, 0, 0}, 5, 5, 5);
+  const std::vector<Eigen::Vector3i> added = BoxSurface({0, 45, 0}, 5, 5, 5);  // 9 m off: not a move
+  const GeometryChange change = ChangeOf(added, removed);
+  MapObject detected;
+  detected.centroid = Eigen::Vector3d(0.4, 9.4, 0.4);  // inside the added box
+  std::vector<ObjectChange> objects = GeometryObjects(change, {}, {detected}, GeometryObjectOptions());
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].state, ObjectState::kRemoved);
+  // The same object in the prior patrol's map says nothing about the current cluster.
+  objects = GeometryObjects(change, {detected}, {}, GeometryObjectOptions());
+  EXPECT_EQ(objects.size(), 2u);
+  // Just outside the box, within the margin.
+  detected.centroid = Eigen::Vector3d(0.4, 8.7, 0.4);
+  EXPECT_EQ(GeometryObjects(change, {}, {detected}, GeometryObjectOptions()).size(), 1u);
+}
+
+// From two evidence grids: a crate put down (its surface occupied now, free before) and another taken away.
+TEST(GeometryObjects, DiffGridsSignsEachChangedVoxel) {
+  EvidenceGridData before, after;
+  before.voxel_size = after.voxel_size = kVoxel;
+  const std::vector<Eigen::Vector3i> put = BoxSurface({0, 0, 0}, 5, 5, 5);
+  const std::vector<Eigen::Vector3i> taken = BoxSurface({0, 60, 0}, 5, 5, 5);
+  std::map<std::tuple<int, int, int>, std::pair<VoxelEvidence, VoxelEvidence>> voxels;
+  const auto add = [&voxels](const Eigen::Vector3i& v, bool occupied_before, bool occupied_after) {
+    const auto evidence = [&v](bool occupied) {
+      return VoxelEvidence{v.x(), v.y(), v.z(), static_cast<std::uint16_t>(occupied ? 8 : 0),
+                           static_cast<std::uint16_t>(occupied ? 0 : 8)};
+    };
+    voxels[{v.x(), v.y(), v.z()}] = {evidence(occupied_before), evidence(occupied_after)};
+  };
+  for (const Eigen::Vector3i& v : put) add(v, false, true);
+  for (const Eigen::Vector3i& v : taken) add(v, true, false);
+  for (const auto& [key, pair] : voxels) {
+    before.voxels.push_back(pair.first);
+    after.voxels.push_back(pair.second);
+  }
+  GeometryDiffOptions diff;
+  diff.surface_tolerance_voxels = 0;
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(before, after, diff, &change));
+  ASSERT_EQ(change.changed_voxels.size(), put.size() + taken.size());
+  ASSERT_EQ(change.changed_deltas.size(), change.changed_voxels.size());
+  for (std::size_t i = 0; i < change.changed_voxels.size(); ++i) {
+    EXPECT_EQ(change.changed_deltas[i] > 0.0f, change.changed_voxels[i].y() < 30) << i;
+  }
+  const std::vector<ObjectChange> objects = GeometryObjects(change, {}, {}, GeometryObjectOptions());
+  ASSERT_EQ(objects.size(), 2u);
+  const ObjectChange* removed = First(objects, ObjectState::kRemoved);
+  const ObjectChange* added = First(objects, ObjectState::kNew);
+  ASSERT_TRUE(removed != nullptr && added != nullptr);
+  EXPECT_NEAR(removed->before->y(), 12.4, 1e-6);
+  EXPECT_NEAR(added->after->x(), 0.4, 1e-6);
+  EXPECT_NEAR(added->confidence, 1.0, 1e-6);
+}
+
+}  // namespace
+}  // namespace patrolmap::change
