@@ -4,11 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
+#include <utility>
 
 #include "patrolmap/change/object_map.h"
 
 namespace patrolmap::change {
 namespace {
+
+constexpr double kGroundSearchDepthM = 3.0;  // the ground is looked for this far below a cluster's lowest voxel
 
 std::uint64_t VoxelKey(const Eigen::Vector3i& v) {
   const auto part = [](int value) { return static_cast<std::uint64_t>(value + (1 << 20)) & 0x1fffff; };
@@ -27,9 +30,7 @@ VoxelCluster GrowCluster(const GeometryChange& change, const std::unordered_map<
     const std::size_t member = open.back();
     open.pop_back();
     const Eigen::Vector3i& index = change.changed_voxels[member];
-    const Eigen::Vector3d centre = index.cast<double>() * change.voxel_size;
-    cluster.points.push_back(centre.cast<float>());
-    cluster.box.extend(centre);
+    cluster.Add(index, change.voxel_size);
     change_sum += std::abs(change.changed_deltas[member]);
     for (int dz = -gap; dz <= gap; ++dz) {
       for (int dy = -gap; dy <= gap; ++dy) {
@@ -61,10 +62,105 @@ bool HoldsDetection(const VoxelCluster& cluster, const std::vector<MapObject>& d
                      [&grown](const MapObject& object) { return grown.contains(object.centroid); });
 }
 
-std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appeared,
+// A voxel on a surface for the growth: two returns at least, and this share of the rays that reached it (uncertain
+// stereo depth spreads a surface's returns over the voxels before and behind it).
+bool IsSurface(const VoxelEvidence& voxel, double min_occupancy) {
+  return voxel.hits >= 2 && voxel.hits >= min_occupancy * (voxel.hits + voxel.passes);
+}
+
+// The ground's voxel level around `seed` in the patrol's grid: the median, over the columns of the ring around the
+// seed's footprint `search_m` wide, of each column's lowest occupied voxel from 3 m below the seed's foot up to it
+// that holds a return. The seed's foot less one when no column has one.
+int GroundLevel(const VoxelCluster& seed, const VoxelLookup& grid, double voxel, double search_m) {
+  const int reach = static_cast<int>(std::ceil(search_m / voxel));
+  const Eigen::Vector3i low = VoxelIndex(seed.box.min(), voxel), high = VoxelIndex(seed.box.max(), voxel);
+  const int below = static_cast<int>(std::ceil(kGroundSearchDepthM / voxel));
+  std::vector<int> lowest;
+  VoxelEvidence evidence;
+  for (int y = low.y() - reach; y <= high.y() + reach; ++y) {
+    for (int x = low.x() - reach; x <= high.x() + reach; ++x) {
+      if (x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y()) continue;  // under the object
+      for (int z = low.z() - below; z <= low.z(); ++z) {
+        // Any return: the ground seen at a grazing angle has more rays passing its voxel than ending in it.
+        if (grid(Eigen::Vector3i(x, y, z), &evidence) && evidence.hits > 0) {
+          lowest.push_back(z);
+          break;
+        }
+      }
+    }
+  }
+  if (lowest.empty()) return low.z() - 1;
+  std::nth_element(lowest.begin(), lowest.begin() + lowest.size() / 2, lowest.end());
+  return lowest[lowest.size() / 2];
+}
+
+// The whole object a seed of changed voxels belongs to, as its patrol's grid holds it (paper 003 projects the
+// changed voxels back into the mission's map and segments the object there): the occupied voxels above the
+// ground connected to the seed. The seed itself when that grows past max_size_m (a wall, a kerb).
+VoxelCluster CompleteObject(const VoxelCluster& seed, const VoxelLookup& grid, double voxel,
+                            const GeometryObjectOptions& options) {
+  const int ground = GroundLevel(seed, grid, voxel, options.ground_search_m);
+  const std::size_t max_voxels = static_cast<std::size_t>(std::pow(options.max_size_m / voxel + 1.0, 2.0) * 4.0);
+  VoxelCluster object;
+  std::unordered_map<std::uint64_t, bool> seen;
+  std::vector<Eigen::Vector3i> open = seed.voxels;
+  for (const Eigen::Vector3i& v : open) seen.emplace(VoxelKey(v), true);
+  VoxelEvidence evidence;
+  while (!open.empty()) {
+    const Eigen::Vector3i index = open.back();
+    open.pop_back();
+    object.Add(index, voxel);
+    const Eigen::Vector3d extent = object.box.sizes();
+    if (std::max(extent.x(), extent.y()) > options.max_size_m || object.voxels.size() > max_voxels) return seed;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Eigen::Vector3i next = index + Eigen::Vector3i(dx, dy, dz);
+          if (next.z() <= ground + options.ground_clearance_voxels || !seen.emplace(VoxelKey(next), true).second) {
+            continue;
+          }
+          if (grid(next, &evidence) && IsSurface(evidence, options.min_surface_occupancy)) open.push_back(next);
+        }
+      }
+    }
+  }
+  object.mean_change = seed.mean_change;
+  return object;
+}
+
+// Objects whose voxels meet are one (two seeds of one object completed alike); the first keeps the rest.
+std::vector<VoxelCluster> MergeSharing(std::vector<VoxelCluster> objects, double voxel) {
+  std::unordered_map<std::uint64_t, std::size_t> owner;
+  std::vector<VoxelCluster> merged;
+  for (VoxelCluster& object : objects) {
+    std::size_t into = merged.size();
+    for (const Eigen::Vector3i& v : object.voxels) {
+      const auto it = owner.find(VoxelKey(v));
+      if (it != owner.end()) into = std::min(into, it->second);
+    }
+    if (into == merged.size()) merged.emplace_back();
+    VoxelCluster& target = merged[into];
+    const double weight = static_cast<double>(target.voxels.size());
+    for (const Eigen::Vector3i& v : object.voxels) {
+      if (owner.emplace(VoxelKey(v), into).second) target.Add(v, voxel);
+    }
+    target.mean_change =
+        (target.mean_change * weight + object.mean_change * static_cast<double>(object.voxels.size())) /
+        (weight + static_cast<double>(object.voxels.size()));
+  }
+  return merged;
+}
+
+std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appeared, const VoxelLookup& grid,
                                          const std::vector<MapObject>& detected, const GeometryObjectOptions& options) {
-  std::vector<VoxelCluster> clusters;
+  std::vector<VoxelCluster> seeds;
   for (VoxelCluster& cluster : ClusterChangedVoxels(change, appeared, options.cluster_gap_voxels)) {
+    if (!IsObjectSized(cluster, options)) continue;
+    seeds.push_back(grid && options.complete_objects ? CompleteObject(cluster, grid, change.voxel_size, options)
+                                                     : std::move(cluster));
+  }
+  std::vector<VoxelCluster> clusters;
+  for (VoxelCluster& cluster : MergeSharing(std::move(seeds), change.voxel_size)) {
     if (IsObjectSized(cluster, options) && !HoldsDetection(cluster, detected, options.detection_margin_m)) {
       clusters.push_back(std::move(cluster));
     }
@@ -145,12 +241,12 @@ ObjectChange ClassAgnostic(ObjectState state, const VoxelCluster* before, const 
   double confidence = 0.0;
   int sides = 0;
   if (before != nullptr) {
-    change.before = before->Centroid();
+    change.before = before->Position();
     change.box_before = before->box;
     confidence += before->mean_change, ++sides;
   }
   if (after != nullptr) {
-    change.after = after->Centroid();
+    change.after = after->Position();
     change.box_after = after->box;
     confidence += after->mean_change, ++sides;
   }
@@ -164,6 +260,30 @@ Eigen::Vector3d VoxelCluster::Centroid() const {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3f& p : points) sum += p.cast<double>();
   return points.empty() ? sum : Eigen::Vector3d(sum / static_cast<double>(points.size()));
+}
+
+void VoxelCluster::Add(const Eigen::Vector3i& index, double voxel_size) {
+  const Eigen::Vector3d centre = index.cast<double>() * voxel_size;
+  voxels.push_back(index);
+  points.push_back(centre.cast<float>());
+  box.extend(centre);
+}
+
+VoxelLookup LookupIn(const EvidenceGridData& grid) {
+  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    const VoxelEvidence* found = FindVoxel(grid, index);
+    if (found != nullptr) *voxel = *found;
+    return found != nullptr;
+  };
+}
+
+VoxelLookup LookupIn(const EvidenceGrid& grid) {
+  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) { return grid.Lookup(index, voxel); };
+}
+
+Eigen::Vector3d VoxelCluster::Position() const {
+  if (points.empty()) return Eigen::Vector3d::Zero();
+  return box.center();
 }
 
 std::vector<VoxelCluster> ClusterChangedVoxels(const GeometryChange& change, bool appeared, int gap_voxels) {
@@ -180,13 +300,14 @@ std::vector<VoxelCluster> ClusterChangedVoxels(const GeometryChange& change, boo
   return clusters;
 }
 
-std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const std::vector<MapObject>& prior_detected,
+std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const VoxelLookup& prior_grid,
+                                          const VoxelLookup& current_grid, const std::vector<MapObject>& prior_detected,
                                           const std::vector<MapObject>& current_detected,
                                           const GeometryObjectOptions& options) {
   std::vector<ObjectChange> objects;
   if (!options.enabled) return objects;
-  const std::vector<VoxelCluster> vanished = ObjectClusters(change, false, prior_detected, options);
-  const std::vector<VoxelCluster> appeared = ObjectClusters(change, true, current_detected, options);
+  const std::vector<VoxelCluster> vanished = ObjectClusters(change, false, prior_grid, prior_detected, options);
+  const std::vector<VoxelCluster> appeared = ObjectClusters(change, true, current_grid, current_detected, options);
   std::vector<bool> vanished_moved(vanished.size()), appeared_moved(appeared.size());
   for (const MoveCandidate& move : PairMoves(vanished, appeared, options)) {
     ObjectChange moved = ClassAgnostic(ObjectState::kMoved, &vanished[move.vanished], &appeared[move.appeared]);

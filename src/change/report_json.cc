@@ -85,6 +85,13 @@ json ObjectJson(const ObjectChange& o) {
                  {"expected_detections", o.expected_detections},
                  {"before", o.before ? Vector(*o.before) : json(nullptr)},
                  {"after", o.after ? Vector(*o.after) : json(nullptr)}};
+  const auto box = [](const Eigen::AlignedBox3d& b) {
+    return b.isEmpty() ? json(nullptr) : json({{"min", Vector(b.min())}, {"max", Vector(b.max())}});
+  };
+  if (o.class_agnostic) {
+    object["box_before"] = box(o.box_before);
+    object["box_after"] = box(o.box_after);
+  }
   if (o.state == ObjectState::kMoved) {
     object["rotation_yaw_deg"] = YawDegrees(o.rotation);
     object["weighted_distance"] = o.weighted_distance;

@@ -74,8 +74,9 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   report->geometry.depth_current = current_record->depth_source;
   if (report->geometry_compared && options.geometry_objects.enabled) {
     // Objects no detector named: clusters of changed space (paper 003); detected objects take precedence.
-    for (change::ObjectChange& found : change::GeometryObjects(report->geometry, prior_record->objects,
-                                                               current_record->objects, options.geometry_objects)) {
+    for (change::ObjectChange& found : change::GeometryObjects(
+             report->geometry, change::LookupIn(prior_record->grid), change::LookupIn(current_record->grid),
+             prior_record->objects, current_record->objects, options.geometry_objects)) {
       report->objects.push_back(std::move(found));
     }
     report->objects_compared = true;

@@ -204,7 +204,8 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
     }
     // Objects no detector named: clusters of the changed space (as the report finds them).
     for (const change::ObjectChange& change :
-         change::GeometryObjects(geometry, prior_record_->objects, now.objects, config_.change.geometry_objects)) {
+         change::GeometryObjects(geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid),
+                                 prior_record_->objects, now.objects, config_.change.geometry_objects)) {
       candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }

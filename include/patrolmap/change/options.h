@@ -83,18 +83,24 @@ struct ObjectDiffOptions {
 // Class-agnostic objects from changed geometry (paper 003's clustering of changed space; GeometryObjects).
 struct GeometryObjectOptions {
   bool enabled = true;
-  int cluster_gap_voxels = 1;         // changed voxels of one sign at most this many voxels apart (along each
-                                      // axis) form one cluster
-  int min_voxels = 8;                 // smaller clusters are no object
-  double max_size_m = 12.0;           // clusters longer than this horizontally are structure, not an object
-  double max_move_m = 8.0;            // moved: a vanished and an appeared cluster at most this far apart [m]
-  double max_top_difference_m = 0.3;  // ... whose tops differ by at most this [m]
-  double min_shape_overlap = 0.5;     // ... and each of which, moved onto the other by the registration, has at
-  double shape_tolerance_m = 0.3;     // least this share of its voxels within this distance of the other's [m]
-  double physical_weight = 0.6;       // alpha of paper 003's weighted distance (physical, normalised)
-  double shape_weight = 0.4;          // beta (1 - the shape overlap)
-  double detection_margin_m = 0.5;    // a cluster whose box grown by this holds a detected object of its patrol
-                                      // is left to the detector [m]
+  int cluster_gap_voxels = 1;  // changed voxels of one sign at most this many voxels apart (along each
+                               // axis) form one cluster
+  int min_voxels = 8;          // smaller clusters are no object
+  // Each cluster grows into the whole object in its patrol's grid: the occupied voxels above the ground connected to
+  // it (not past max_size_m). The ground is the median lowest occupied voxel of the columns within ground_search_m.
+  bool complete_objects = true;
+  double ground_search_m = 1.0;
+  double min_surface_occupancy = 0.3;  // ... through voxels with two returns and at least this occupancy
+  int ground_clearance_voxels = 1;  // ... and the growth stays this many voxels above it (rough ground, stereo noise)
+  double max_size_m = 12.0;         // clusters longer than this horizontally are structure, not an object
+  double max_move_m = 8.0;          // moved: a vanished and an appeared cluster at most this far apart [m]
+  double max_top_difference_m = 0.15;  // ... whose tops differ by at most this (at 0.2 m voxels: the same top) [m]
+  double min_shape_overlap = 0.5;      // ... and each of which, moved onto the other by the registration, has at
+  double shape_tolerance_m = 0.3;      // least this share of its voxels within this distance of the other's [m]
+  double physical_weight = 0.6;        // alpha of paper 003's weighted distance (physical, normalised)
+  double shape_weight = 0.4;           // beta (1 - the shape overlap)
+  double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol
+                                       // is left to the detector [m]
 };
 
 // Evidence grid of one patrol (paper 004).

@@ -135,6 +135,10 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.enabled", &change.geometry_objects.enabled);
   visitor->Field("change.geometry_objects.cluster_gap_voxels", &change.geometry_objects.cluster_gap_voxels);
   visitor->Field("change.geometry_objects.min_voxels", &change.geometry_objects.min_voxels);
+  visitor->Field("change.geometry_objects.complete_objects", &change.geometry_objects.complete_objects);
+  visitor->Field("change.geometry_objects.ground_search_m", &change.geometry_objects.ground_search_m);
+  visitor->Field("change.geometry_objects.min_surface_occupancy", &change.geometry_objects.min_surface_occupancy);
+  visitor->Field("change.geometry_objects.ground_clearance_voxels", &change.geometry_objects.ground_clearance_voxels);
   visitor->Field("change.geometry_objects.max_size_m", &change.geometry_objects.max_size_m);
   visitor->Field("change.geometry_objects.max_move_m", &change.geometry_objects.max_move_m);
   visitor->Field("change.geometry_objects.max_top_difference_m", &change.geometry_objects.max_top_difference_m);
