@@ -209,6 +209,32 @@ TEST(ChangeScore, ObjectStatesPerStateWithOptionalSightings) {
   EXPECT_EQ(wrong.by_state.at("new").false_positives, 1);
 }
 
+// A class-agnostic object (from changed geometry) matches a true object of any label, and a change the detector
+// saw too rarely to count is optional for it, never for a detected one.
+TEST(ChangeScore, ClassAgnosticObjectsMatchAnyLabelAndWhatTheDetectorMissed) {
+  const std::vector<TruthObject> before = {Truth(1, "barrel", 0, 0, 10), Truth(2, "crate", 10, 0, 0)};
+  const std::vector<TruthObject> after = {Truth(3, "vehicle", 20, 0, 10), Truth(4, "crate", 30, 0, 1)};
+  const auto at = [](double x) { return Eigen::Vector3d(x, 0.2, 0.5); };
+  std::vector<ReportedObject> reported = {{"removed", "object", at(0), {}, true},
+                                          {"removed", "object", at(10), {}, true},
+                                          {"new", "object", {}, at(20), true},
+                                          {"new", "object", {}, at(30), true},
+                                          {"new", "object", {}, at(40), true}};
+  ObjectChangeScore score = ScoreObjectChanges(reported, before, after, ChangeScoreOptions{});
+  EXPECT_EQ(score.by_state.at("removed").true_positives, 1);   // the barrel
+  EXPECT_EQ(score.by_state.at("removed").false_positives, 0);  // the unseen crate: optional
+  EXPECT_EQ(score.by_state.at("new").true_positives, 1);       // the vehicle
+  EXPECT_EQ(score.by_state.at("new").false_positives, 1);      // at 40 m: nothing there; at 30 m optional
+  EXPECT_EQ(score.by_state.at("new").false_negatives, 0);
+  // The same reports from a detector: the label must agree and the unseen changes count against it.
+  for (ReportedObject& r : reported) r.class_agnostic = false;
+  score = ScoreObjectChanges(reported, before, after, ChangeScoreOptions{});
+  EXPECT_EQ(score.by_state.at("removed").true_positives, 0);
+  EXPECT_EQ(score.by_state.at("removed").false_positives, 2);
+  EXPECT_EQ(score.by_state.at("new").false_positives, 3);
+  EXPECT_EQ(score.by_state.at("new").false_negatives, 1);
+}
+
 TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
   // One 1 m crate (centre (1, 1), z 0..1) removed between the flights; 0.2 m voxels.
   const std::vector<TruthObject> before = {Truth(1, "crate", 1.0, 1.0, 10)};

@@ -22,8 +22,32 @@ const TruthObject* FindId(const std::vector<TruthObject>& objects, int id) {
 struct TruthChange {
   std::string state, label;
   std::optional<Eigen::Vector2d> before, after;
-  bool required = true;  // false: reporting it is no error, missing it neither
+  bool required = true;        // false: reporting it is no error, missing it neither
+  bool geometry_only = false;  // the detector saw it too rarely: only a class-agnostic object may report it
 };
+
+// The changes the detector saw too rarely to count, as a class-agnostic object (from depth) may still report
+// them: optional, and only for class-agnostic reports.
+void AddUnseenChanges(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after, int min_detections,
+                      std::vector<TruthChange>* truth) {
+  for (const TruthObject& b : before) {
+    const TruthObject* a = FindId(after, b.id);
+    const bool seen_before = b.detections >= min_detections;
+    const bool seen_after = a != nullptr && a->detections >= min_detections;
+    if (a == nullptr) {
+      if (!seen_before) truth->push_back({"removed", b.label, b.centre, std::nullopt, false, true});
+    } else if ((a->centre - b.centre).norm() > kSamePlace && !(seen_before && seen_after)) {
+      truth->push_back({"moved", b.label, b.centre, a->centre, false, true});
+      if (!seen_before) truth->push_back({"removed", b.label, b.centre, std::nullopt, false, true});
+      if (!seen_after) truth->push_back({"new", a->label, std::nullopt, a->centre, false, true});
+    }
+  }
+  for (const TruthObject& a : after) {
+    if (FindId(before, a.id) == nullptr && a.detections < min_detections) {
+      truth->push_back({"new", a.label, std::nullopt, a.centre, false, true});
+    }
+  }
+}
 
 // The true changes as a patrolling robot can know them: an object that moved counts as moved when the
 // detector reported it often enough in both flights, as removed when only in the earlier one and as new
@@ -64,7 +88,7 @@ std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, co
 // Distance between a reported and a true change of the same state; infinity when they cannot match.
 double ChangeDistance(const ReportedObject& r, const TruthChange& t) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  if (!r.class_agnostic && r.label != t.label) return kInfinity;
+  if (!r.class_agnostic && (r.label != t.label || t.geometry_only)) return kInfinity;
   double distance = 0.0;
   if (t.before) {
     if (!r.before) return kInfinity;
@@ -143,7 +167,8 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
                                      const std::vector<TruthObject>& before, const std::vector<TruthObject>& after,
                                      const ChangeScoreOptions& options) {
   ObjectChangeScore score;
-  const std::vector<TruthChange> truth = TruthChanges(before, after, options.min_detections);
+  std::vector<TruthChange> truth = TruthChanges(before, after, options.min_detections);
+  AddUnseenChanges(before, after, options.min_detections, &truth);
   for (const char* state : {"persistent", "new", "removed", "moved"}) {
     struct Candidate {
       double distance;
