@@ -226,6 +226,12 @@ TEST(ChangeScore, ClassAgnosticObjectsMatchAnyLabelAndWhatTheDetectorMissed) {
   EXPECT_EQ(score.by_state.at("new").true_positives, 1);       // the vehicle
   EXPECT_EQ(score.by_state.at("new").false_positives, 1);      // at 40 m: nothing there; at 30 m optional
   EXPECT_EQ(score.by_state.at("new").false_negatives, 0);
+  // On the object's footprint (1 x 1 m) but 1.2 m from its centre: a hit for a class-agnostic object.
+  reported[2].after = Eigen::Vector3d(20.0, 1.2, 0.5);
+  EXPECT_EQ(ScoreObjectChanges(reported, before, after, ChangeScoreOptions{}).by_state.at("new").true_positives, 1);
+  reported[2].after = Eigen::Vector3d(20.0, 1.6, 0.5);  // 1.1 m off the footprint
+  EXPECT_EQ(ScoreObjectChanges(reported, before, after, ChangeScoreOptions{}).by_state.at("new").true_positives, 0);
+  reported[2].after = at(20);
   // The same reports from a detector: the label must agree and the unseen changes count against it.
   for (ReportedObject& r : reported) r.class_agnostic = false;
   score = ScoreObjectChanges(reported, before, after, ChangeScoreOptions{});

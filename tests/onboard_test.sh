@@ -84,8 +84,7 @@ lines = open(sys.argv[1]).read().splitlines()
 events = [json.loads(line) for line in lines]
 ids = [e["id"] for e in events]
 report = json.load(open(sys.argv[2]))
-wanted = {"object-p%d-c%d" % (o.get("prior_id", -1), o.get("current_id", -1))
-          for o in report["objects"] if o["state"] in ("new", "removed", "moved")}
+wanted = {o["id"] for o in report["objects"] if o["state"] in ("new", "removed", "moved")}
 ok = len(ids) == len(set(ids)) and wanted <= set(ids) and all("time_ns" in e and "confidence" in e for e in events)
 sys.exit(0 if ok else 1)
 PY

@@ -24,7 +24,46 @@ struct TruthChange {
   std::optional<Eigen::Vector2d> before, after;
   bool required = true;        // false: reporting it is no error, missing it neither
   bool geometry_only = false;  // the detector saw it too rarely: only a class-agnostic object may report it
+  const TruthObject *was = nullptr, *is = nullptr;  // the object before and after (for its footprint)
 };
+
+const TruthObject* CentredAt(const std::vector<TruthObject>& objects, const std::optional<Eigen::Vector2d>& centre) {
+  if (!centre) return nullptr;
+  for (const TruthObject& o : objects) {
+    if (o.centre == *centre) return &o;
+  }
+  return nullptr;
+}
+
+// Horizontal distance from `point` to the object's footprint (0 inside it).
+double FootprintDistance(const TruthObject& object, const Eigen::Vector3d& point) {
+  const Eigen::Vector2d d = point.head<2>() - object.centre;
+  const double along = d.x() * std::cos(object.yaw) + d.y() * std::sin(object.yaw);
+  const double across = -d.x() * std::sin(object.yaw) + d.y() * std::cos(object.yaw);
+  return std::hypot(std::max(0.0, std::abs(along) - object.length / 2),
+                    std::max(0.0, std::abs(across) - object.width / 2));
+}
+
+// A class-agnostic object lies on the true object (within `distance_m` of its footprint, where it was and where it
+// is): changed space shows the part of an object that changed, not its centre. A move must also agree in
+// displacement.
+double ClassAgnosticDistance(const ReportedObject& r, const TruthChange& t) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double distance = 0.0;
+  if (t.before) {
+    if (!r.before || t.was == nullptr) return kInfinity;
+    distance = std::max(distance, FootprintDistance(*t.was, *r.before));
+  }
+  if (t.after) {
+    if (!r.after || t.is == nullptr) return kInfinity;
+    distance = std::max(distance, FootprintDistance(*t.is, *r.after));
+  }
+  if (t.before && t.after) {
+    const Eigen::Vector2d reported = (*r.after - *r.before).head<2>(), truth = *t.after - *t.before;
+    distance = std::max(distance, (reported - truth).norm());
+  }
+  return distance;
+}
 
 // The changes the detector saw too rarely to count, as a class-agnostic object (from depth) may still report
 // them: optional, and only for class-agnostic reports.
@@ -88,7 +127,8 @@ std::vector<TruthChange> TruthChanges(const std::vector<TruthObject>& before, co
 // Distance between a reported and a true change of the same state; infinity when they cannot match.
 double ChangeDistance(const ReportedObject& r, const TruthChange& t) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
-  if (!r.class_agnostic && (r.label != t.label || t.geometry_only)) return kInfinity;
+  if (r.class_agnostic) return ClassAgnosticDistance(r, t);
+  if (r.label != t.label || t.geometry_only) return kInfinity;
   double distance = 0.0;
   if (t.before) {
     if (!r.before) return kInfinity;
@@ -169,6 +209,7 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
   ObjectChangeScore score;
   std::vector<TruthChange> truth = TruthChanges(before, after, options.min_detections);
   AddUnseenChanges(before, after, options.min_detections, &truth);
+  for (TruthChange& t : truth) t.was = CentredAt(before, t.before), t.is = CentredAt(after, t.after);
   for (const char* state : {"persistent", "new", "removed", "moved"}) {
     struct Candidate {
       double distance;

@@ -12,10 +12,12 @@
 // one flight is optional: reported persistent (or new, when the patrol never
 // saw it before) it is no error, unreported no miss.
 // A reported object is a hit when a true object of the same state and label
-// lies within `distance_m` (moved: both its positions); a class-agnostic one
-// (from changed geometry) matches any label, and the changes of objects the
-// detector saw too rarely to count are optional for it (depth may see what the
-// detector missed). Per state: precision,
+// lies within `distance_m` (moved: both its positions). A class-agnostic one
+// (from changed geometry) matches any label and is a hit when it lies within
+// `distance_m` of the true object's footprint (moved: where it was, where it is,
+// and in displacement), as changed space shows the part of an object that
+// changed rather than its centre; the changes of objects the detector saw too
+// rarely to count are optional for it (depth may see what the detector missed). Per state: precision,
 // recall and F1, one-to-one matching nearest first.
 //
 // Geometry (per voxel, as paper 003 scores per point), only over voxels both
