@@ -1,8 +1,11 @@
 // Change-stage speed on rendered village views at 376x240 (the processing
 // size of a 752x480 camera): object association per detection (paper 000
 // needed 15 ms per object), evidence-grid integration per depth frame, the
-// grid comparison of two patrols, the appearance comparison of one place, and appearance along the route
-// (features per route frame, registration per candidate, comparison per pair, a whole route).
+// grid comparison of two patrols, the class-agnostic objects from it, the appearance comparison of one place, and
+// appearance along the route (features per route frame, registration per candidate, comparison per pair, a whole
+// route).
+#include <array>
+
 #include <benchmark/benchmark.h>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -10,6 +13,7 @@
 
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/evidence_grid.h"
+#include "patrolmap/change/geometry_objects.h"
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/change/route_compare.h"
 #include "patrolmap/sim/objects.h"
@@ -97,25 +101,47 @@ void BM_EvidenceGridIntegrateFrame(benchmark::State& state) {
 BENCHMARK(BM_EvidenceGridIntegrateFrame)->Unit(benchmark::kMillisecond);
 
 // Two grids along 40 m of street (a depth frame every 0.26 m, as at 5 Hz and 1.3 m/s), one with an object removed.
-void BM_DiffGridsFortyMetres(benchmark::State& state) {
-  std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
-  std::vector<sim::WorldObject> fewer = objects;
-  fewer.erase(fewer.begin() + static_cast<std::ptrdiff_t>(SouthObject(objects)));
-  EvidenceGridData grids[2];
-  for (int g = 0; g < 2; ++g) {
-    change::EvidenceGrid grid(change::EvidenceGridOptions{});
-    for (double x = 0.0; x < 40.0; x += 0.26) {
-      const View view = Render(x, g == 0 ? objects : fewer, {});
-      grid.Integrate(view.depth_m, kCamera, view.sample);
+const std::array<EvidenceGridData, 2>& FortyMetreGrids() {
+  static const std::array<EvidenceGridData, 2> grids = [] {
+    std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
+    std::vector<sim::WorldObject> fewer = objects;
+    fewer.erase(fewer.begin() + static_cast<std::ptrdiff_t>(SouthObject(objects)));
+    std::array<EvidenceGridData, 2> built;
+    for (int g = 0; g < 2; ++g) {
+      change::EvidenceGrid grid(change::EvidenceGridOptions{});
+      for (double x = 0.0; x < 40.0; x += 0.26) {
+        const View view = Render(x, g == 0 ? objects : fewer, {});
+        grid.Integrate(view.depth_m, kCamera, view.sample);
+      }
+      built[g] = grid.ToData();
     }
-    grids[g] = grid.ToData();
-  }
+    return built;
+  }();
+  return grids;
+}
+
+void BM_DiffGridsFortyMetres(benchmark::State& state) {
+  const std::array<EvidenceGridData, 2>& grids = FortyMetreGrids();
   change::GeometryChange change;
   for (auto _ : state) change::DiffGrids(grids[0], grids[1], change::GeometryDiffOptions{}, &change);
   state.counters["voxels"] = static_cast<double>(grids[0].voxels.size());
   state.counters["regions"] = static_cast<double>(change.regions.size());
 }
 BENCHMARK(BM_DiffGridsFortyMetres)->Unit(benchmark::kMillisecond);
+
+// Class-agnostic objects from the changed voxels of those grids: clusters, each completed in its patrol's grid.
+void BM_GeometryObjectsFortyMetres(benchmark::State& state) {
+  const std::array<EvidenceGridData, 2>& grids = FortyMetreGrids();
+  change::GeometryChange change;
+  change::DiffGrids(grids[0], grids[1], change::GeometryDiffOptions{}, &change);
+  const change::VoxelLookup prior = change::LookupIn(grids[0]), current = change::LookupIn(grids[1]);
+  std::vector<change::ObjectChange> objects;
+  for (auto _ : state)
+    objects = change::GeometryObjects(change, prior, current, {}, {}, change::GeometryObjectOptions{});
+  state.counters["changed_voxels"] = static_cast<double>(change.changed_voxels.size());
+  state.counters["objects"] = static_cast<double>(objects.size());
+}
+BENCHMARK(BM_GeometryObjectsFortyMetres)->Unit(benchmark::kMillisecond);
 
 change::KeyFrameView Describe(const cv::Mat& image) {
   change::KeyFrameView view;

@@ -151,6 +151,41 @@ std::vector<VoxelCluster> MergeSharing(std::vector<VoxelCluster> objects, double
   return merged;
 }
 
+// Whether the footprints (horizontal extents of the voxel centres) of two clusters come within `gap` of each other.
+bool FootprintsMeet(const VoxelCluster& a, const VoxelCluster& b, double gap) {
+  for (int axis = 0; axis < 2; ++axis) {
+    if (a.box.max()[axis] + gap < b.box.min()[axis] || b.box.max()[axis] + gap < a.box.min()[axis]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Clusters whose footprints come within `gap` are one object (objects stand on the ground: a side seen apart from the
+// top, or two faces the grid does not connect), the first taking the others' voxels.
+std::vector<VoxelCluster> MergeStacked(std::vector<VoxelCluster> objects, double voxel, double gap) {
+  for (std::size_t a = 0; a < objects.size(); ++a) {
+    for (std::size_t b = a + 1; b < objects.size();) {
+      if (!FootprintsMeet(objects[a], objects[b], gap + 1e-6)) {
+        ++b;
+        continue;
+      }
+      std::unordered_map<std::uint64_t, bool> have;
+      for (const Eigen::Vector3i& v : objects[a].voxels) have.emplace(VoxelKey(v), true);
+      const double weight_a = static_cast<double>(objects[a].voxels.size());
+      const double weight_b = static_cast<double>(objects[b].voxels.size());
+      objects[a].mean_change =
+          (objects[a].mean_change * weight_a + objects[b].mean_change * weight_b) / (weight_a + weight_b);
+      for (const Eigen::Vector3i& v : objects[b].voxels) {
+        if (have.emplace(VoxelKey(v), true).second) objects[a].Add(v, voxel);
+      }
+      objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(b));
+      b = a + 1;  // the grown footprint may now meet a cluster passed over
+    }
+  }
+  return objects;
+}
+
 std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appeared, const VoxelLookup& grid,
                                          const std::vector<MapObject>& detected, const GeometryObjectOptions& options) {
   std::vector<VoxelCluster> seeds;
@@ -160,7 +195,8 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
                                                      : std::move(cluster));
   }
   std::vector<VoxelCluster> clusters;
-  for (VoxelCluster& cluster : MergeSharing(std::move(seeds), change.voxel_size)) {
+  std::vector<VoxelCluster> objects = MergeSharing(std::move(seeds), change.voxel_size);
+  for (VoxelCluster& cluster : MergeStacked(std::move(objects), change.voxel_size, options.footprint_gap_m)) {
     if (IsObjectSized(cluster, options) && !HoldsDetection(cluster, detected, options.detection_margin_m)) {
       clusters.push_back(std::move(cluster));
     }

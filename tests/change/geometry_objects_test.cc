@@ -130,6 +130,22 @@ TEST(GeometryObjects, OtherShapesTopsAndFarMovesAreRemovedAndNew) {
   EXPECT_NEAR(moved->weighted_distance, options.physical_weight * 10.0 / 12.0, 1e-6);  // the shapes overlap fully
 }
 
+// A crate's near side and its top, seen apart (two voxels between them): one object, not two.
+TEST(GeometryObjects, ClustersStackedInOneFootprintAreOneObject) {
+  std::vector<Eigen::Vector3i> appeared;
+  for (int x = 0; x < 6; ++x) {
+    for (int z = 0; z < 4; ++z) appeared.emplace_back(x, 0, z);  // the side, 0.8 m high
+    for (int y = 0; y < 5; ++y) appeared.emplace_back(x, y, 6);  // the top at 1.2 m
+  }
+  appeared.emplace_back(20, 0, 0);  // a speck elsewhere stays apart (and too small)
+  const std::vector<ObjectChange> objects =
+      GeometryObjects(ChangeOf(appeared, {}), {}, {}, {}, {}, GeometryObjectOptions());
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_NEAR(objects[0].box_after.max().z(), 6 * kVoxel, 1e-6);
+  EXPECT_NEAR(objects[0].box_after.min().z(), 0.0, 1e-6);
+  EXPECT_NEAR(objects[0].after->y(), 2 * kVoxel, 1e-6);  // the centre of the footprint the top spans
+}
+
 TEST(GeometryObjects, SpecksAndStructureAreNoObjects) {
   GeometryObjectOptions options;
   const std::vector<Eigen::Vector3i> speck = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // 3 voxels

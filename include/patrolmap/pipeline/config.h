@@ -139,6 +139,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.ground_search_m", &change.geometry_objects.ground_search_m);
   visitor->Field("change.geometry_objects.min_surface_occupancy", &change.geometry_objects.min_surface_occupancy);
   visitor->Field("change.geometry_objects.ground_clearance_voxels", &change.geometry_objects.ground_clearance_voxels);
+  visitor->Field("change.geometry_objects.footprint_gap_m", &change.geometry_objects.footprint_gap_m);
   visitor->Field("change.geometry_objects.max_size_m", &change.geometry_objects.max_size_m);
   visitor->Field("change.geometry_objects.max_move_m", &change.geometry_objects.max_move_m);
   visitor->Field("change.geometry_objects.max_top_difference_m", &change.geometry_objects.max_top_difference_m);
