@@ -86,8 +86,9 @@ TEST(GeometryObjects, ChangedVoxelsClusterBySignAndGap) {
 }
 
 TEST(GeometryObjects, AnObjectTurnedAndMovedIsOneMoveWithItsRotation) {
-  const std::vector<Eigen::Vector3i> before = BoxSurface({0, 0, 0}, 8, 4, 5, true);
-  const std::vector<Eigen::Vector3i> after = Turned(BoxSurface({20, 0, 0}, 8, 4, 5, true), {20, 0, 0});
+  // Long and thin (2.4 x 0.6 m): unturned, the two footprints would cross and barely overlap.
+  const std::vector<Eigen::Vector3i> before = BoxSurface({0, 0, 0}, 12, 3, 5, true);
+  const std::vector<Eigen::Vector3i> after = Turned(BoxSurface({20, 0, 0}, 12, 3, 5, true), {20, 0, 0});
   const std::vector<ObjectChange> objects =
       GeometryObjects(ChangeOf(after, before), {}, {}, {}, {}, GeometryObjectOptions());
   ASSERT_EQ(objects.size(), 1u);
