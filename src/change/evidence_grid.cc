@@ -11,11 +11,6 @@ constexpr int kBits = 21;
 constexpr std::int64_t kOffset = 1 << 20;
 constexpr std::uint64_t kUsed = 1ull << 63;
 
-std::uint64_t PackKey(const Eigen::Vector3i& v) {
-  const auto part = [](int value) { return static_cast<std::uint64_t>(value + kOffset) & ((1ull << kBits) - 1); };
-  return kUsed | part(v.x()) << (2 * kBits) | part(v.y()) << kBits | part(v.z());
-}
-
 Eigen::Vector3i UnpackKey(std::uint64_t key) {
   const auto part = [key](int shift) {
     return static_cast<int>(static_cast<std::int64_t>((key >> shift) & ((1ull << kBits) - 1)) - kOffset);
@@ -106,6 +101,23 @@ bool IsOccupied(const VoxelEvidence* voxel) {
   return voxel != nullptr && voxel->hits >= 2 && voxel->hits > voxel->passes;
 }
 
+std::uint64_t VoxelKey(const Eigen::Vector3i& v) {
+  const auto part = [](int value) { return static_cast<std::uint64_t>(value + kOffset) & ((1ull << kBits) - 1); };
+  return kUsed | part(v.x()) << (2 * kBits) | part(v.y()) << kBits | part(v.z());
+}
+
+VoxelLookup LookupIn(const EvidenceGridData& grid) {
+  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    const VoxelEvidence* found = FindVoxel(grid, index);
+    if (found != nullptr) *voxel = *found;
+    return found != nullptr;
+  };
+}
+
+VoxelLookup LookupIn(const EvidenceGrid& grid) {
+  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) { return grid.Lookup(index, voxel); };
+}
+
 Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size) {
   return (point / voxel_size).array().round().cast<int>();
 }
@@ -163,7 +175,7 @@ const EvidenceGrid::Slot* EvidenceGrid::Probe(std::uint64_t key) const {
 }
 
 bool EvidenceGrid::Lookup(const Eigen::Vector3i& index, VoxelEvidence* voxel) const {
-  const Slot* slot = Probe(PackKey(index));
+  const Slot* slot = Probe(VoxelKey(index));
   if (slot == nullptr) return false;
   *voxel = {index.x(), index.y(), index.z(), slot->hits, slot->passes};
   return true;
@@ -240,7 +252,7 @@ void EvidenceGrid::TraceRay(const Eigen::Vector3d& origin, const Eigen::Vector3d
   const double t_free = length > 0.0 ? 1.0 - hold_back_m / length : 1.0;
   double t_entry = 0.0;
   const auto count = [this](const Eigen::Vector3i& v, bool is_hit) {
-    Slot* slot = Find(PackKey(v));
+    Slot* slot = Find(VoxelKey(v));
     if (slot == nullptr) return void(++dropped_);
     std::uint16_t& counter = is_hit ? slot->hits : slot->passes;
     if (counter < std::numeric_limits<std::uint16_t>::max()) ++counter;
@@ -328,11 +340,7 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
   const double size = before.voxel_size;
   change->voxel_size = size;
   change->evicted_prior = before.evicted_voxels;
-  const auto find_before = [&before](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
-    const VoxelEvidence* found = FindVoxel(before, index);
-    if (found != nullptr) *voxel = *found;
-    return found != nullptr;
-  };
+  const VoxelLookup find_before = LookupIn(before);
   std::vector<Eigen::Vector3i> changed;
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> deltas;
@@ -385,11 +393,7 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
   *change = GeometryChange();
   if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size) return false;
   change->evicted_current = after.evicted_voxels;
-  const auto find_after = [&after](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
-    const VoxelEvidence* found = FindVoxel(after, index);
-    if (found != nullptr) *voxel = *found;
-    return found != nullptr;
-  };
+  const VoxelLookup find_after = LookupIn(after);
   const auto for_each_common = [&](const auto& visit) { ForEachCommonVoxel(before, after, visit); };
   DiffVoxels(before, find_after, for_each_common, options, change);
   return true;
@@ -400,9 +404,7 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGrid& after, const 
   *change = GeometryChange();
   if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size()) return false;
   change->evicted_current = after.evicted_voxels();
-  const auto find_after = [&after](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
-    return after.Lookup(index, voxel);
-  };
+  const VoxelLookup find_after = LookupIn(after);
   // The prior's voxels in their (sorted) order, each looked up in the live grid: the merge's order.
   const auto for_each_common = [&](const auto& visit) {
     VoxelEvidence current;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "patrolmap/change/object_map.h"
@@ -12,11 +13,6 @@ namespace patrolmap::change {
 namespace {
 
 constexpr double kGroundSearchDepthM = 3.0;  // the ground is looked for this far below a cluster's lowest voxel
-
-std::uint64_t VoxelKey(const Eigen::Vector3i& v) {
-  const auto part = [](int value) { return static_cast<std::uint64_t>(value + (1 << 20)) & 0x1fffff; };
-  return part(v.x()) << 42 | part(v.y()) << 21 | part(v.z());
-}
 
 // The connected component of voxel `seed` among `voxels` (indices into change.changed_voxels), neighbours at most
 // `gap` voxels apart along each axis; marks its members in `taken`.
@@ -102,9 +98,9 @@ VoxelCluster CompleteObject(const VoxelCluster& seed, const VoxelLookup& grid, d
   const int ground = GroundLevel(seed, grid, voxel, options.ground_search_m);
   const std::size_t max_voxels = static_cast<std::size_t>(std::pow(options.max_size_m / voxel + 1.0, 2.0) * 4.0);
   VoxelCluster object;
-  std::unordered_map<std::uint64_t, bool> seen;
+  std::unordered_set<std::uint64_t> seen;
   std::vector<Eigen::Vector3i> open = seed.voxels;
-  for (const Eigen::Vector3i& v : open) seen.emplace(VoxelKey(v), true);
+  for (const Eigen::Vector3i& v : open) seen.insert(VoxelKey(v));
   VoxelEvidence evidence;
   while (!open.empty()) {
     const Eigen::Vector3i index = open.back();
@@ -116,7 +112,7 @@ VoxelCluster CompleteObject(const VoxelCluster& seed, const VoxelLookup& grid, d
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const Eigen::Vector3i next = index + Eigen::Vector3i(dx, dy, dz);
-          if (next.z() <= ground + options.ground_clearance_voxels || !seen.emplace(VoxelKey(next), true).second) {
+          if (next.z() <= ground + options.ground_clearance_voxels || !seen.insert(VoxelKey(next)).second) {
             continue;
           }
           if (grid(next, &evidence) && IsSurface(evidence, options.min_surface_occupancy)) open.push_back(next);
@@ -128,9 +124,21 @@ VoxelCluster CompleteObject(const VoxelCluster& seed, const VoxelLookup& grid, d
   return object;
 }
 
+// Adds the voxels of `from` not in `keys` to `into` (and to `keys`); the mean change weighed by the voxels each
+// brought.
+void Absorb(const VoxelCluster& from, double voxel, std::unordered_set<std::uint64_t>* keys, VoxelCluster* into) {
+  const double weight_into = static_cast<double>(into->voxels.size());
+  const double weight_from = static_cast<double>(from.voxels.size());
+  into->mean_change = (into->mean_change * weight_into + from.mean_change * weight_from) / (weight_into + weight_from);
+  for (const Eigen::Vector3i& v : from.voxels) {
+    if (keys->insert(VoxelKey(v)).second) into->Add(v, voxel);
+  }
+}
+
 // Objects whose voxels meet are one (two seeds of one object completed alike); the first keeps the rest.
 std::vector<VoxelCluster> MergeSharing(std::vector<VoxelCluster> objects, double voxel) {
-  std::unordered_map<std::uint64_t, std::size_t> owner;
+  std::unordered_map<std::uint64_t, std::size_t> owner;  // voxel key -> the merged object that has it
+  std::unordered_set<std::uint64_t> claimed;             // the voxels of every merged object
   std::vector<VoxelCluster> merged;
   for (VoxelCluster& object : objects) {
     std::size_t into = merged.size();
@@ -139,14 +147,8 @@ std::vector<VoxelCluster> MergeSharing(std::vector<VoxelCluster> objects, double
       if (it != owner.end()) into = std::min(into, it->second);
     }
     if (into == merged.size()) merged.emplace_back();
-    VoxelCluster& target = merged[into];
-    const double weight = static_cast<double>(target.voxels.size());
-    for (const Eigen::Vector3i& v : object.voxels) {
-      if (owner.emplace(VoxelKey(v), into).second) target.Add(v, voxel);
-    }
-    target.mean_change =
-        (target.mean_change * weight + object.mean_change * static_cast<double>(object.voxels.size())) /
-        (weight + static_cast<double>(object.voxels.size()));
+    Absorb(object, voxel, &claimed, &merged[into]);
+    for (const Eigen::Vector3i& v : object.voxels) owner.emplace(VoxelKey(v), into);
   }
   return merged;
 }
@@ -170,15 +172,9 @@ std::vector<VoxelCluster> MergeStacked(std::vector<VoxelCluster> objects, double
         ++b;
         continue;
       }
-      std::unordered_map<std::uint64_t, bool> have;
-      for (const Eigen::Vector3i& v : objects[a].voxels) have.emplace(VoxelKey(v), true);
-      const double weight_a = static_cast<double>(objects[a].voxels.size());
-      const double weight_b = static_cast<double>(objects[b].voxels.size());
-      objects[a].mean_change =
-          (objects[a].mean_change * weight_a + objects[b].mean_change * weight_b) / (weight_a + weight_b);
-      for (const Eigen::Vector3i& v : objects[b].voxels) {
-        if (have.emplace(VoxelKey(v), true).second) objects[a].Add(v, voxel);
-      }
+      std::unordered_set<std::uint64_t> keys;
+      for (const Eigen::Vector3i& v : objects[a].voxels) keys.insert(VoxelKey(v));
+      Absorb(objects[b], voxel, &keys, &objects[a]);
       objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(b));
       b = a + 1;  // the grown footprint may now meet a cluster passed over
     }
@@ -303,18 +299,6 @@ void VoxelCluster::Add(const Eigen::Vector3i& index, double voxel_size) {
   voxels.push_back(index);
   points.push_back(centre.cast<float>());
   box.extend(centre);
-}
-
-VoxelLookup LookupIn(const EvidenceGridData& grid) {
-  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
-    const VoxelEvidence* found = FindVoxel(grid, index);
-    if (found != nullptr) *voxel = *found;
-    return found != nullptr;
-  };
-}
-
-VoxelLookup LookupIn(const EvidenceGrid& grid) {
-  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) { return grid.Lookup(index, voxel); };
 }
 
 Eigen::Vector3d VoxelCluster::Position() const {

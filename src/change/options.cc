@@ -80,7 +80,7 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
 void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
   check->InRange("change.geometry_objects.cluster_gap_voxels", g.cluster_gap_voxels, 1, 10)
       .InRange("change.geometry_objects.min_voxels", g.min_voxels, 1, 100000000)
-      .InRange("change.geometry_objects.ground_search_m", g.ground_search_m, 0.0, 100.0)
+      .InRange("change.geometry_objects.ground_search_m", g.ground_search_m, 0.0, 5.0)
       .InRange("change.geometry_objects.footprint_gap_m", g.footprint_gap_m, 0.0, 100.0)
       .InRange("change.geometry_objects.min_surface_occupancy", g.min_surface_occupancy, 0.0, 1.0)
       .InRange("change.geometry_objects.ground_clearance_voxels", g.ground_clearance_voxels, 0, 100)

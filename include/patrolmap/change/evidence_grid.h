@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -73,12 +74,19 @@ class EvidenceGrid {
 
 // Voxel key helpers (index = round(coordinate / voxel_size)).
 Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size);
+// A voxel index packed into one never-zero number (21 bits an axis, indices within +-2^20): the grid's hash key.
+std::uint64_t VoxelKey(const Eigen::Vector3i& index);
 
 // A voxel counts as occupied when most rays ended in it and at least two did (false for nullptr).
 bool IsOccupied(const VoxelEvidence* voxel);
 
 // The counts of voxel `index`, or nullptr (binary search in the sorted data).
 const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector3i& index);
+
+// Reads one patrol's evidence grid: true and the voxel at `index` when the grid holds it.
+using VoxelLookup = std::function<bool(const Eigen::Vector3i& index, VoxelEvidence* voxel)>;
+VoxelLookup LookupIn(const EvidenceGridData& grid);  // the grid must outlive the lookup
+VoxelLookup LookupIn(const EvidenceGrid& grid);      // a grid still being built (onboard), read in place
 
 struct GeometryRegion {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();

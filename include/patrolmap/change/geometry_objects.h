@@ -14,7 +14,6 @@
 // to the detected objects' states.
 #pragma once
 
-#include <functional>
 #include <vector>
 
 #include "patrolmap/change/evidence_grid.h"
@@ -44,11 +43,6 @@ struct VoxelCluster {
 // The clusters of the changed voxels that appeared (`appeared` true) or vanished, in the order of their first
 // voxel in change.changed_voxels.
 std::vector<VoxelCluster> ClusterChangedVoxels(const GeometryChange& change, bool appeared, int gap_voxels);
-
-// Reads one patrol's evidence grid: true and the voxel at `index` when the grid holds it.
-using VoxelLookup = std::function<bool(const Eigen::Vector3i& index, VoxelEvidence* voxel)>;
-VoxelLookup LookupIn(const EvidenceGridData& grid);  // the grid must outlive the lookup
-VoxelLookup LookupIn(const EvidenceGrid& grid);      // a grid still being built (onboard), read in place
 
 // The objects that appeared, vanished or moved between the two patrols' grids (see above). With a patrol's grid
 // (`prior_grid`, `current_grid`; may be empty), each cluster is completed there into the whole object it belongs to.
