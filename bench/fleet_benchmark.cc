@@ -1,6 +1,9 @@
 // Fleet scale (issue 17): place queries of the pruned inverted index against the exhaustive one on the
 // simulator's places, and merging maps.
 //
+// BM_LoadLargeMap and BM_MergeTwoMaps build synthetic maps (PATROLMAP_BENCH_LARGE_NODES nodes for the load,
+// 1,000,000 when unset is too large for a small machine: the default is 100,000).
+//
 // BM_SimulatedPlaceQuery needs maps of simulated patrol series: PATROLMAP_BENCH_MAPS=a.pmap:b.pmap:... (for
 // example the run_3 maps of scripts/change_study.sh; skipped without). Their nodes form one database, padded
 // with `distractors` vectors drawn from the shipped vocabulary's word frequencies; each verified loop closure
@@ -8,15 +11,22 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <memory>
 #include <random>
 #include <sstream>
 #include <string>
 
+#include <sys/resource.h>
+
+#include <filesystem>
+
 #include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
 
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/graph/topo_map.h"
+#include "patrolmap/pipeline/merge.h"
 #include "patrolmap/vocab/database.h"
 #include "patrolmap/vocab/vocabulary.h"
 
@@ -62,17 +72,17 @@ const Places* LoadPlaces() {
   return places.get();
 }
 
-void BM_SimulatedPlaceQuery(benchmark::State& state) {
-  const Places* places = LoadPlaces();
-  if (places == nullptr || places->queries.empty()) {
-    state.SkipWithError("set PATROLMAP_BENCH_MAPS to maps of simulated patrols");
-    return;
-  }
+// The places' nodes, then `distractors` vectors of 300 words drawn as often as the shipped vocabulary's
+// training images held them; built once per count (Google Benchmark calls a benchmark several times).
+const vocab::Database& PlacesWithDistractors(const Places& places, int distractors) {
+  static std::map<int, std::unique_ptr<vocab::Database>> cache;
+  std::unique_ptr<vocab::Database>& database = cache[distractors];
+  if (database) return *database;
   vocab::Vocabulary vocabulary;
   if (!vocab::Vocabulary::Load(std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc", &vocabulary).ok())
     std::abort();
-  vocab::Database database(vocabulary.word_count());
-  for (const vocab::BowVector& bow : places->nodes) database.Add(bow);
+  database = std::make_unique<vocab::Database>(vocabulary.word_count());
+  for (const vocab::BowVector& bow : places.nodes) database->Add(bow);
   const auto& idf = vocabulary.idf();
   std::vector<double> frequency(vocabulary.word_count());
   for (std::size_t w = 0; w < frequency.size(); ++w) frequency[w] = idf[w] > 0 ? std::exp(-idf[w]) : 0.0;
@@ -80,14 +90,26 @@ void BM_SimulatedPlaceQuery(benchmark::State& state) {
   std::mt19937 rng(5);
   std::vector<vocab::WordId> words(300);
   vocab::BowVector bow;
-  for (int i = 0; i < state.range(0); ++i) {
+  for (int i = 0; i < distractors; ++i) {
     for (auto& w : words) w = draw(rng);
     vocab::MakeBowVector(words, idf.data(), &bow);
-    database.Add(bow);
+    database->Add(bow);
   }
+  return *database;
+}
+
+void BM_SimulatedPlaceQuery(benchmark::State& state) {
+  const Places* places = LoadPlaces();
+  if (places == nullptr || places->queries.empty()) {
+    state.SkipWithError("set PATROLMAP_BENCH_MAPS to maps of simulated patrols");
+    return;
+  }
+  const vocab::Database& database = PlacesWithDistractors(*places, static_cast<int>(state.range(0)));
   vocab::QueryOptions options;
   options.max_words = static_cast<int>(state.range(1));
   options.rescored = static_cast<int>(state.range(2));
+  vocab::QueryOptions exhaustive;
+  exhaustive.max_words = 0;
   std::vector<vocab::QueryResult> results, exact;
   const auto other_flight = [&](const PlaceQuery& q) {
     return [&](vocab::EntryId e) { return e >= places->nodes.size() || places->flights[e] != q.flight; };
@@ -100,7 +122,7 @@ void BM_SimulatedPlaceQuery(benchmark::State& state) {
   }
   int found = 0, found_exact = 0, same = 0;
   for (const PlaceQuery& q : places->queries) {
-    database.Query(q.bow, 3, other_flight(q), &exact);
+    database.Query(q.bow, 3, other_flight(q), &exact, exhaustive);
     database.Query(q.bow, 3, other_flight(q), &results, options);
     const auto has = [](const std::vector<vocab::QueryResult>& r, vocab::EntryId e) {
       return std::any_of(r.begin(), r.end(), [&](const vocab::QueryResult& x) { return x.entry == e; });
@@ -118,8 +140,127 @@ void BM_SimulatedPlaceQuery(benchmark::State& state) {
 }
 BENCHMARK(BM_SimulatedPlaceQuery)
     ->ArgNames({"distractors", "words", "rescored"})
-    ->ArgsProduct({{0, 100000}, {0, 16, 32, 64}, {100, 300}})
+    ->ArgsProduct({{0, 100000, 1000000}, {0, 16, 32, 64}, {100}})
     ->Unit(benchmark::kMillisecond);
+
+// Synthetic key frames for the map benchmarks: `features` keypoints spread over a 752x480 frame, random 8-bit
+// descriptors, and words drawn as often as the shipped vocabulary's training images held them.
+class SyntheticFrames {
+ public:
+  SyntheticFrames() {
+    if (!vocab::Vocabulary::Load(VocabularyPath(), &vocabulary_).ok()) std::abort();
+    const auto& idf = vocabulary_.idf();
+    std::vector<double> frequency(vocabulary_.word_count());
+    for (std::size_t w = 0; w < frequency.size(); ++w) frequency[w] = idf[w] > 0 ? std::exp(-idf[w]) : 0.0;
+    draw_ = std::discrete_distribution<vocab::WordId>(frequency.begin(), frequency.end());
+  }
+
+  static std::string VocabularyPath() { return std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc"; }
+
+  // A new key frame of `flight` at second `second`; with `seen` (the frame made just before this one), that
+  // frame again: half its features kept and moved 6 px to the right, half new.
+  graph::NodeData Frame(const std::string& flight, int second, int features, const graph::NodeData* seen) {
+    graph::NodeData node;
+    node.flight = flight;
+    node.timestamp_ns = SecondsToNs(second);
+    node.frame_index = second;
+    node.descriptors = cv::Mat(features, 128, CV_8UC1);
+    rng_.fill(node.descriptors, cv::RNG::UNIFORM, 0, 64);
+    words_.resize(features);
+    for (int f = 0; f < features; ++f) {
+      node.keypoints.emplace_back(rng_.uniform(0.0f, 752.0f), rng_.uniform(0.0f, 480.0f), 4.0f);
+      words_[f] = draw_(engine_);
+      if (seen != nullptr && f % 2 == 0 && f < seen->descriptors.rows) {
+        node.keypoints[f].pt = seen->keypoints[f].pt + cv::Point2f(6.0f, 0.0f);
+        seen->descriptors.row(f).copyTo(node.descriptors.row(f));
+        words_[f] = seen_words_[f];
+      }
+    }
+    vocab::MakeBowVector(words_, vocabulary_.idf().data(), &node.bow);
+    seen_words_ = words_;
+    return node;
+  }
+
+  // Flight "a" of `nodes` key frames one second apart, each linked to the one before, into `first`; with
+  // `second`, flight "b", later, that sees each of a's frames again (made right after it).
+  void Flights(int nodes, int features, graph::TopoMap* first, graph::TopoMap* second) {
+    for (graph::TopoMap* map : {first, second}) {
+      if (map != nullptr) map->set_vocabulary({vocabulary_.Fingerprint(), "default.pmvoc"});
+    }
+    for (int i = 0; i < nodes; ++i) {
+      const int a = first->AddNode(Frame("a", i, features, nullptr));
+      if (i > 0) first->AddEdge(a - 1, a, graph::EdgeData{});
+      if (second == nullptr) continue;
+      const int b = second->AddNode(Frame("b", 100000 + i, features, &first->node(a)));
+      if (i > 0) second->AddEdge(b - 1, b, graph::EdgeData{});
+    }
+  }
+
+ private:
+  vocab::Vocabulary vocabulary_;
+  std::discrete_distribution<vocab::WordId> draw_;
+  std::mt19937 engine_{17};
+  cv::RNG rng_{17};
+  std::vector<vocab::WordId> words_, seen_words_;
+};
+
+double PeakMegabytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+// Loading a map of PATROLMAP_BENCH_LARGE_NODES (default 100,000) nodes of 64 features each, without
+// thumbnails: the size of a simulated 376x240 key frame's features.
+void BM_LoadLargeMap(benchmark::State& state) {
+  const char* env = std::getenv("PATROLMAP_BENCH_LARGE_NODES");
+  const int nodes = env != nullptr ? std::atoi(env) : 100000;
+  const std::string path = (std::filesystem::temp_directory_path() / "patrolmap_bench_large.pmap").string();
+  {
+    graph::TopoMap map;
+    SyntheticFrames().Flights(nodes, 64, &map, nullptr);
+    if (!graph::SaveMap(map, path).ok()) std::abort();
+  }
+  graph::TopoMap loaded;
+  for (auto _ : state) {
+    loaded = graph::TopoMap();
+    if (!graph::LoadMap(path, &loaded).ok()) state.SkipWithError("load failed");
+  }
+  state.counters["nodes"] = loaded.node_count();
+  state.counters["file_MB"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
+  state.counters["peak_MB"] = PeakMegabytes();
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_LoadLargeMap)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// `patrolmap merge` of two one-flight maps of `nodes` nodes (150 features) where the second flight revisits the
+// first: every node of the second map should close a loop to its twin in the first.
+void BM_MergeTwoMaps(benchmark::State& state) {
+  const auto nodes = static_cast<int>(state.range(0));
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "patrolmap_bench_merge";
+  std::filesystem::create_directories(folder);
+  pipeline::MergeRequest request;
+  request.maps = {(folder / "a.pmap").string(), (folder / "b.pmap").string()};
+  request.out = (folder / "merged").string();
+  request.vocabulary_path = SyntheticFrames::VocabularyPath();
+  {
+    graph::TopoMap a, b;
+    SyntheticFrames().Flights(nodes, 150, &a, &b);
+    if (!graph::SaveMap(a, request.maps[0]).ok() || !graph::SaveMap(b, request.maps[1]).ok()) std::abort();
+  }
+  pipeline::MergeOutcome outcome;
+  for (auto _ : state) {
+    std::filesystem::remove_all(request.out);
+    if (!pipeline::RunMerge(request, &outcome).ok()) state.SkipWithError("merge failed");
+  }
+  state.counters["nodes"] = outcome.nodes;
+  state.counters["closures"] = outcome.loop_closures;
+  state.counters["query_s"] = outcome.seconds_query;
+  state.counters["verify_s"] = outcome.seconds_verify;
+  state.counters["peak_MB"] = PeakMegabytes();
+  std::filesystem::remove_all(folder);
+}
+BENCHMARK(BM_MergeTwoMaps)->Arg(1000)->Arg(50000)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 

@@ -9,7 +9,9 @@
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
+#include "patrolmap/place/place_recognizer.h"
 #include "patrolmap/vocab/database.h"
 #include "patrolmap/vocab/vocabulary.h"
 
@@ -63,6 +65,40 @@ void BM_Transform1000Descriptors(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_Transform1000Descriptors)->Unit(benchmark::kMillisecond);
+
+// Quantising real RootSIFT features (the defaults: the 800 strongest of each image) in the shipped vocabulary,
+// as place recognition does for each key frame. The images are opencv-doc's (skipped without it).
+void BM_QuantizeRealFeatures(benchmark::State& state) {
+  vocab::Vocabulary vocabulary;
+  if (!vocab::Vocabulary::Load(std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc", &vocabulary).ok())
+    std::abort();
+  const std::string folder = "/usr/share/doc/opencv-doc/examples/data/";
+  std::vector<cv::Mat> frames;
+  for (const char* name : {"aero1.jpg", "graf1.png", "leuvenA.jpg", "building.jpg"}) {
+    const cv::Mat image = cv::imread(folder + name, cv::IMREAD_GRAYSCALE);
+    if (image.empty()) continue;
+    std::vector<cv::KeyPoint> keypoints;
+    frames.emplace_back();
+    place::DescribeFeatures(image, place::PlaceOptions{}, &keypoints, &frames.back());
+  }
+  if (frames.empty()) {
+    state.SkipWithError("opencv-doc's example images are not installed");
+    return;
+  }
+  std::vector<vocab::WordId> words;
+  std::int64_t descriptors = 0;
+  for (auto _ : state) {
+    for (const cv::Mat& frame : frames) {
+      vocabulary.Quantize(frame, &words);
+      descriptors += frame.rows;
+    }
+    benchmark::DoNotOptimize(words.data());
+  }
+  state.counters["per_1000"] = benchmark::Counter(static_cast<double>(descriptors) / 1000.0,
+                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["frames"] = static_cast<double>(frames.size());
+}
+BENCHMARK(BM_QuantizeRealFeatures)->Unit(benchmark::kMillisecond);
 
 // Databases of random 400-word vectors over a 10k-word vocabulary (k=10, L=4).
 void BM_DatabaseQuery(benchmark::State& state) {
@@ -139,6 +175,8 @@ void BM_RealisticQuery(benchmark::State& state) {
   vocab::QueryOptions options;
   options.max_words = static_cast<int>(state.range(1));
   options.rescored = static_cast<int>(state.range(2));
+  vocab::QueryOptions exhaustive;
+  exhaustive.max_words = 0;
   std::vector<vocab::QueryResult> results, exact;
   std::size_t q = 0;
   for (auto _ : state) {
@@ -148,7 +186,7 @@ void BM_RealisticQuery(benchmark::State& state) {
   int found = 0, wanted = 0, source = 0;
   const int step = std::max(1, static_cast<int>(state.range(0)) / 100);
   for (std::size_t i = 0; i < data.queries.size(); ++i) {
-    data.database->Query(data.queries[i], 3, {}, &exact);
+    data.database->Query(data.queries[i], 3, {}, &exact, exhaustive);
     data.database->Query(data.queries[i], 3, {}, &results, options);
     for (const vocab::QueryResult& e : exact) {
       ++wanted;

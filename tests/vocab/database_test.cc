@@ -47,8 +47,36 @@ TEST(Database, QueryRanksByScoreAndHonoursExclusions) {
   EXPECT_EQ(results.size(), 1u);
 }
 
-// The two-stage query (QueryOptions::max_words): with all the query's words it is the exhaustive query; with its
-// rarest words it still finds an entry that shares them, with the exhaustive score bit for bit; and the entries
+// The two-stage query reads first the words that buy the most query weight per posting read: a word the query
+// holds twenty times beats a rarer word it holds once. And `allowed` is applied before the entries to rescore
+// are chosen, so excluded entries never take their places.
+TEST(Database, TwoStageQueryReadsTheWordsWithMostWeightPerPosting) {
+  const std::vector<float> idf(4, 1.0f);
+  Database database(4);
+  BowVector bow;
+  for (int e = 0; e < 50; ++e) {
+    MakeBowVector(e < 2 ? std::vector<WordId>{0, 1, 2, 3} : std::vector<WordId>{0}, idf.data(), &bow);
+    database.Add(bow);  // entries 2..49 hold word 0 only
+  }
+  BowVector query;
+  MakeBowVector({0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1}, idf.data(), &query);
+  QueryOptions options;
+  options.max_words = 1;
+  options.rescored = 1;
+  options.min_skipped_postings = 0;
+  std::vector<QueryResult> results;
+  database.Query(query, 3, {}, &results, options);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].entry, 2u);  // from word 0's list; the rarest word (1) would give entry 0 or 1
+  EXPECT_NEAR(results[0].score, L1Score(query, database.entry(2)), 1e-6);
+  database.Query(
+      query, 3, [](EntryId entry) { return entry > 40; }, &results, options);
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_EQ(results[0].entry, 41u);
+}
+
+// The two-stage query (QueryOptions::max_words): with all the query's words it is the exhaustive query; with a
+// few rare words it still finds an entry that shares them, with the exhaustive score bit for bit; and the entries
 // it rescores are the best partial scores only.
 TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
   constexpr int kWords = 200;
@@ -67,10 +95,13 @@ TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
     entries.push_back(bow);
   }
   std::vector<QueryResult> exact, two_stage;
+  QueryOptions exhaustive;
+  exhaustive.max_words = 0;
   for (const EntryId target : {7u, 150u, 299u}) {
-    database.Query(entries[target], 3, {}, &exact);
+    database.Query(entries[target], 3, {}, &exact, exhaustive);
     QueryOptions all;
     all.max_words = static_cast<int>(entries[target].words.size());
+    all.min_skipped_postings = 0;
     database.Query(entries[target], 3, {}, &two_stage, all);
     ASSERT_EQ(two_stage.size(), exact.size());
     for (std::size_t i = 0; i < exact.size(); ++i) {
@@ -80,6 +111,7 @@ TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
     QueryOptions rarest;
     rarest.max_words = 5;
     rarest.rescored = 10;
+    rarest.min_skipped_postings = 0;
     database.Query(entries[target], 3, {}, &two_stage, rarest);
     ASSERT_FALSE(two_stage.empty());
     EXPECT_EQ(two_stage[0].entry, target);  // an entry is its own best match
@@ -87,6 +119,11 @@ TEST(Database, TwoStageQueryScoresTheEntriesOfTheRarestWordsExactly) {
     rarest.rescored = 1;
     database.Query(entries[target], 3, {}, &two_stage, rarest);
     EXPECT_EQ(two_stage.size(), 1u);
+    // The lists it would skip hold fewer postings than min_skipped_postings: the query is exhaustive.
+    rarest.min_skipped_postings = 100000;
+    database.Query(entries[target], 3, {}, &two_stage, rarest);
+    ASSERT_EQ(two_stage.size(), exact.size());
+    for (std::size_t i = 0; i < exact.size(); ++i) EXPECT_EQ(two_stage[i].entry, exact[i].entry);
   }
   // A query that reads few postings (one rare word: the entries touched are remembered) and one that reads
   // many (every entry: the array is swept) both rank as the L1 score by brute force.

@@ -85,3 +85,33 @@ TEST(Vocabulary, BadTrainingInputIsRefused) {
 
 }  // namespace
 }  // namespace patrolmap::vocab
+
+namespace patrolmap::vocab {
+namespace {
+
+// The words of the shipped vocabulary for 4,000 RootSIFT-like descriptors (cv::RNG, the same on every machine),
+// folded into one number: a faster Quantize must give the same words (issue 17), and a map built before it must
+// still be matched as it was built.
+TEST(Vocabulary, ShippedVocabularyGivesTheSameWords) {
+  Vocabulary vocabulary;
+  ASSERT_TRUE(Vocabulary::Load(std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc", &vocabulary).ok());
+  cv::Mat descriptors(4000, 128, CV_32F);
+  cv::RNG rng(12345);
+  rng.fill(descriptors, cv::RNG::UNIFORM, 0.0, 1.0);
+  for (int row = 0; row < descriptors.rows; ++row) {
+    float* d = descriptors.ptr<float>(row);
+    for (int i = 0; i < 128; ++i) d[i] = d[i] * d[i] * d[i] * d[i];  // a few strong bins, as SIFT has
+    const double sum = cv::sum(descriptors.row(row))[0];
+    for (int i = 0; i < 128; ++i) d[i] = static_cast<float>(std::sqrt(d[i] / sum));
+  }
+  std::vector<WordId> words;
+  vocabulary.Quantize(descriptors, &words);
+  std::uint64_t fold = 1469598103934665603ull;  // FNV-1a over the word ids
+  for (const WordId w : words) fold = (fold ^ w) * 1099511628211ull;
+  std::set<WordId> distinct(words.begin(), words.end());
+  EXPECT_GT(distinct.size(), 200u);  // the descriptors spread over the vocabulary
+  EXPECT_EQ(fold, 8711685481199666263ull);
+}
+
+}  // namespace
+}  // namespace patrolmap::vocab

@@ -76,6 +76,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
   visitor->Field("place.query_words", &place.query.max_words);
   visitor->Field("place.rescored_entries", &place.query.rescored);
+  visitor->Field("place.query_min_skipped_postings", &place.query.min_skipped_postings);
   auto& change = config->change;
   visitor->Field("change.appearance.ratio", &change.appearance.ratio);
   visitor->Field("change.appearance.inlier_threshold_px", &change.appearance.inlier_threshold_px);

@@ -19,14 +19,17 @@ struct QueryResult {
   double score = 0.0;  // L1Score with the query, in [0, 1]
 };
 
-// How much of the inverted index a query reads. Exhaustive (the default) scores every entry that shares a word
-// with the query. Two-stage (max_words > 0): only the posting lists of the query's max_words rarest words (the
-// shortest lists: the most discriminative words) are read, and the `rescored` entries with the best partial
-// scores are scored exactly (the exhaustive score, bit for bit). The result equals the exhaustive one whenever
-// its entries are among those (BENCHMARKS.md, "Fleet scale", measures how often and how much faster).
+// How much of the inverted index a query reads. Exhaustive (max_words 0) scores every entry that shares a word
+// with the query. Two-stage (max_words > 0): only the posting lists of the query's max_words words that hold the
+// most query weight per posting (a word adds at most its query weight to a score; the rare words, and among them
+// the ones the query holds most) are read, and the `rescored` entries with the best partial scores are scored
+// exactly (the exhaustive score, bit for bit). The result equals the exhaustive one whenever its entries are
+// among those. A query whose skipped lists would hold fewer than min_skipped_postings postings is exhaustive:
+// on small databases that is faster than rescoring (BENCHMARKS.md, "Fleet scale", measures both).
 struct QueryOptions {
-  int max_words = 0;   // 0: exhaustive
-  int rescored = 100;  // entries scored exactly after the first stage
+  int max_words = 64;                 // 0: exhaustive
+  int rescored = 100;                 // entries scored exactly after the first stage
+  int min_skipped_postings = 100000;  // two-stage only when it skips at least this many postings
 
   bool IsValid(std::string* error) const;
 };
@@ -54,8 +57,14 @@ class Database {
   };
   // The exact score of `entry`, as the exhaustive pass sums it (in float, in the query's word order).
   float Common(const BowVector& query, EntryId entry) const;
-  // The query's words whose lists are read (indices into `bow`, ascending): all, or its max_words rarest.
-  void ReadWords(const BowVector& bow, int max_words, std::vector<std::uint32_t>* order) const;
+  // The query's words whose lists are read (indices into `bow`, ascending): all, or the max_words that hold the
+  // most query weight per posting when the others hold at least min_skipped_postings.
+  void ReadWords(const BowVector& bow, const QueryOptions& options, std::vector<std::uint32_t>* order) const;
+
+  // Adds each read word's share to the sums of the entries in its list; `touched` notes the entries whose
+  // sum was zero (unless `dense`).
+  void AddPartialScores(const BowVector& bow, const std::vector<std::uint32_t>& order, bool dense, float* common,
+                        std::vector<EntryId>* touched) const;
 
   std::vector<std::vector<Posting>> postings_;
   std::vector<BowVector> entries_;
