@@ -1,8 +1,7 @@
 // Fleet scale (issue 17): place queries of the pruned inverted index against the exhaustive one on the
 // simulator's places, and merging maps.
 //
-// BM_LoadLargeMap and BM_MergeTwoMaps build synthetic maps (PATROLMAP_BENCH_LARGE_NODES nodes for the load,
-// 1,000,000 when unset is too large for a small machine: the default is 100,000).
+// BM_LoadLargeMap and BM_MergeTwoMaps build synthetic maps; the largest need about 8 GB of memory and disk.
 //
 // BM_SimulatedPlaceQuery needs maps of simulated patrol series: PATROLMAP_BENCH_MAPS=a.pmap:b.pmap:... (for
 // example the run_3 maps of scripts/change_study.sh; skipped without). Their nodes form one database, padded
@@ -155,6 +154,8 @@ class SyntheticFrames {
     draw_ = std::discrete_distribution<vocab::WordId>(frequency.begin(), frequency.end());
   }
 
+  void set_thumbnail_width(int width) { thumbnail_width_ = width; }
+
   static std::string VocabularyPath() { return std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc"; }
 
   // A new key frame of `flight` at second `second`; with `seen` (the frame made just before this one), that
@@ -162,6 +163,8 @@ class SyntheticFrames {
   graph::NodeData Frame(const std::string& flight, int second, int features, const graph::NodeData* seen) {
     graph::NodeData node;
     node.flight = flight;
+    node.thumbnail = cv::Mat(thumbnail_width_ * 480 / 752, thumbnail_width_, CV_8UC1);
+    rng_.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);
     node.timestamp_ns = SecondsToNs(second);
     node.frame_index = second;
     node.descriptors = cv::Mat(features, 128, CV_8UC1);
@@ -202,6 +205,7 @@ class SyntheticFrames {
   std::mt19937 engine_{17};
   cv::RNG rng_{17};
   std::vector<vocab::WordId> words_, seen_words_;
+  int thumbnail_width_ = 160;
 };
 
 double PeakMegabytes() {
@@ -210,28 +214,35 @@ double PeakMegabytes() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
-// Loading a map of PATROLMAP_BENCH_LARGE_NODES (default 100,000) nodes of 64 features each, without
-// thumbnails: the size of a simulated 376x240 key frame's features.
+// Loading a map of one flight: `nodes` nodes of `features` features and a thumbnail `thumbnail` pixels wide
+// (a map keeps 160). The million-node map has small nodes so that it fits in this machine's memory.
 void BM_LoadLargeMap(benchmark::State& state) {
-  const char* env = std::getenv("PATROLMAP_BENCH_LARGE_NODES");
-  const int nodes = env != nullptr ? std::atoi(env) : 100000;
+  const auto nodes = static_cast<int>(state.range(0));
   const std::string path = (std::filesystem::temp_directory_path() / "patrolmap_bench_large.pmap").string();
   {
     graph::TopoMap map;
-    SyntheticFrames().Flights(nodes, 64, &map, nullptr);
+    SyntheticFrames frames;
+    frames.set_thumbnail_width(static_cast<int>(state.range(2)));
+    frames.Flights(nodes, static_cast<int>(state.range(1)), &map, nullptr);
     if (!graph::SaveMap(map, path).ok()) std::abort();
   }
   graph::TopoMap loaded;
   for (auto _ : state) {
     loaded = graph::TopoMap();
-    if (!graph::LoadMap(path, &loaded).ok()) state.SkipWithError("load failed");
+    const Status status = graph::LoadMap(path, &loaded);
+    if (!status.ok()) state.SkipWithError(status.message().c_str());
   }
   state.counters["nodes"] = loaded.node_count();
   state.counters["file_MB"] = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
   state.counters["peak_MB"] = PeakMegabytes();
   std::filesystem::remove(path);
 }
-BENCHMARK(BM_LoadLargeMap)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_LoadLargeMap)
+    ->ArgNames({"nodes", "features", "thumbnail"})
+    ->Args({100000, 64, 160})
+    ->Args({1000000, 32, 40})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 // `patrolmap merge` of two one-flight maps of `nodes` nodes (150 features) where the second flight revisits the
 // first: every node of the second map should close a loop to its twin in the first.
@@ -251,7 +262,8 @@ void BM_MergeTwoMaps(benchmark::State& state) {
   pipeline::MergeOutcome outcome;
   for (auto _ : state) {
     std::filesystem::remove_all(request.out);
-    if (!pipeline::RunMerge(request, &outcome).ok()) state.SkipWithError("merge failed");
+    const Status status = pipeline::RunMerge(request, &outcome);
+    if (!status.ok()) state.SkipWithError(status.message().c_str());
   }
   state.counters["nodes"] = outcome.nodes;
   state.counters["closures"] = outcome.loop_closures;

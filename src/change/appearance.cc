@@ -163,6 +163,23 @@ double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv:
 
 }  // namespace
 
+// Per label, whether the region comes within `margin` pixels of the compared area's edge: the frame's border or
+// where the registered prior frame ends (all false when margin is 0).
+std::vector<bool> TouchingEdge(const cv::Mat& labels, int count, const cv::Mat& compared, int margin) {
+  std::vector<bool> touching(count, false);
+  if (margin <= 0) return touching;
+  cv::Mat inner;
+  cv::erode(compared, inner, cv::Mat(), cv::Point(-1, -1), margin);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* label = labels.ptr<int>(y);
+    const std::uint8_t* in = inner.ptr<std::uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (label[x] > 0 && in[x] == 0) touching[label[x]] = true;
+    }
+  }
+  return touching;
+}
+
 bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions& options) {
   const int features = region.prior_features + region.current_features;
   const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
@@ -228,6 +245,7 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
 
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(changed, labels, stats, centroids, 8, CV_32S);
+  const std::vector<bool> at_edge = TouchingEdge(labels, count, mask, options.edge_margin_px);
   const int min_area = std::max(1, static_cast<int>(options.min_area_fraction * compared));
   const double min_side = options.min_side_fraction * std::min(current_f.cols, current_f.rows);
   std::vector<bool> matched_prior(prior.keypoints.size(), false), matched_current(current.keypoints.size(), false);
@@ -242,6 +260,7 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
     region.current_box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                                   stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
     if (std::min(region.current_box.width, region.current_box.height) < min_side) continue;  // a seam, not a thing
+    if (at_edge[label]) continue;  // only part of it is seen, or the prior frame ends there
     region.prior_box = PriorBox(region.current_box, h, prior.image.size());
     region.score = cv::mean(local, labels == label)[0];
     const cv::Rect2f box(region.current_box);

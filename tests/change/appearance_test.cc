@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -75,6 +76,32 @@ TEST(Appearance, AnAddedObjectIsARegionInBothImages) {
   EXPECT_NEAR(region.prior_box.x, region.current_box.x + 2, 2);  // the prior view is 2 px to the right
   EXPECT_GT(region.score, 0.0);
   EXPECT_GT(region.unmatched_prior_features, 0);  // the prior texture under the object no longer matches
+}
+
+// A change that reaches the frame's border is only partly seen, and there the prior frame may end or show
+// something off the registered plane (graf1/graf3 in route_compare_test): with edge_margin_px it is dropped, and
+// one inside the frame is kept.
+TEST(Appearance, ARegionAtTheFramesEdgeIsDroppedWithAnEdgeMargin) {
+  const cv::Mat scene = Scene(2);
+  cv::Mat current = Relit(scene, 1.1, 0.9, -2.0);
+  const cv::Rect inside(60, 40, 26, 22), at_edge(0, 80, 26, 22);
+  for (const cv::Rect& object : {inside, at_edge}) {
+    current(object).setTo(30);
+    cv::rectangle(current, object, cv::Scalar(220), 2);
+  }
+  AppearanceOptions options;
+  const auto found = [&](const cv::Rect& object) {
+    const AppearanceChange change = DetectAppearanceChange(Describe(scene), Describe(current), options);
+    EXPECT_TRUE(change.registered);
+    return std::any_of(change.regions.begin(), change.regions.end(),
+                       [&](const AppearanceRegion& r) { return (r.current_box & object).area() > 0; });
+  };
+  options.edge_margin_px = 0;
+  EXPECT_TRUE(found(inside));
+  EXPECT_TRUE(found(at_edge));
+  options.edge_margin_px = 1;
+  EXPECT_TRUE(found(inside));
+  EXPECT_FALSE(found(at_edge));
 }
 
 TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
