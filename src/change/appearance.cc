@@ -163,8 +163,9 @@ double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv:
 
 }  // namespace
 
-// Per label, whether the region comes within `margin` pixels of the compared area's edge: the frame's border or
-// where the registered prior frame ends (all false when margin is 0).
+// Per label, whether the region comes within `margin` pixels of where the registered prior frame ends inside the
+// current one (all false when margin is 0). The current frame's own border does not count: objects there are
+// seen again from the next route frames.
 std::vector<bool> TouchingEdge(const cv::Mat& labels, int count, const cv::Mat& compared, int margin) {
   std::vector<bool> touching(count, false);
   if (margin <= 0) return touching;
@@ -260,7 +261,7 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
     region.current_box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                                   stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
     if (std::min(region.current_box.width, region.current_box.height) < min_side) continue;  // a seam, not a thing
-    if (at_edge[label]) continue;  // only part of it is seen, or the prior frame ends there
+    if (at_edge[label]) continue;  // the prior frame ends there: what it shows is cut or smeared
     region.prior_box = PriorBox(region.current_box, h, prior.image.size());
     region.score = cv::mean(local, labels == label)[0];
     const cv::Rect2f box(region.current_box);
