@@ -216,6 +216,8 @@ TEST_P(RealUnchangedPair, GivesNoRegion) {
 
 INSTANTIATE_TEST_SUITE_P(OpencvDoc, RealUnchangedPair,
                          testing::Values(std::make_pair("leuvenA.jpg", "leuvenB.jpg"),
+                                         std::make_pair("graf1.png", "graf3.png"),
+                                         std::make_pair("graf3.png", "graf1.png"),
                                          std::make_pair("aero1.jpg", "aero3.jpg")));
 
 }  // namespace

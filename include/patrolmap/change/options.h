@@ -24,7 +24,7 @@ struct AppearanceOptions {
                                         // their match between the key frames (parallax, not change)
   int parallax_search_px = 8;           // ... and regions whose content the registered prior image shows, up to
   double max_shifted_similarity = 0.6;  // this far off, with a normalised cross-correlation above this, ...
-  int edge_margin_px = 0;               // ... and regions within this far of where the registered prior frame
+  int edge_margin_px = 1;               // ... and regions within this far of where the registered prior frame
                                         // ends inside the current one (0: kept)
   // After the homography, register the pair locally by dense optical flow (DIS), so parallax off the
   // homography's plane does not differ; flows longer than max_flow_px are not followed.
