@@ -167,9 +167,10 @@ const RealisticDatabase& RealisticOf(int entries) {
   return *slot;
 }
 
-// Top-3 queries, exhaustive (words 0) or two-stage (the lists of the query's `words` rarest words, then
-// `rescored` entries scored exactly); "recall@3" is the
-// share of the exhaustive top 3 that the query returns, over 100 queries.
+// Top-3 queries, exhaustive (words 0) or two-stage (the lists of the query's `words` words with the most weight
+// per posting, then `rescored` entries scored exactly; where the skipped lists hold fewer postings than the
+// default minimum, exhaustive). "same_top3" is the share of the exhaustive top 3 that the query returns,
+// "recall@3" the share of queries whose source entry it returns, over 100 queries.
 void BM_RealisticQuery(benchmark::State& state) {
   const RealisticDatabase& data = RealisticOf(static_cast<int>(state.range(0)));
   vocab::QueryOptions options;
