@@ -39,6 +39,7 @@ void BM_StereoDepth(benchmark::State& state) {
   const Pair pair = RenderPair(static_cast<int>(state.range(0)));
   depth::StereoOptions options;
   options.lr_check = state.range(1) != 0;
+  options.edge_radius_px = static_cast<int>(state.range(2));
   std::unique_ptr<depth::StereoDepth> stereo;
   if (!depth::StereoDepth::Create(pair.calibration, options, &stereo).ok()) return state.SkipWithError("calibration");
   cv::Mat depth;
@@ -49,11 +50,13 @@ void BM_StereoDepth(benchmark::State& state) {
   state.counters["known"] = static_cast<double>(cv::countNonZero(depth)) / depth.total();
 }
 BENCHMARK(BM_StereoDepth)
-    ->ArgNames({"width", "lr_check"})
-    ->Args({376, 1})
-    ->Args({752, 1})
-    ->Args({376, 0})
-    ->Args({752, 0})
+    ->ArgNames({"width", "lr_check", "edge_radius"})
+    ->Args({376, 1, 0})
+    ->Args({752, 1, 0})
+    ->Args({376, 0, 0})
+    ->Args({752, 0, 0})
+    ->Args({376, 1, 2})
+    ->Args({752, 1, 2})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -6,7 +6,7 @@
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
 # Environment: ROUTES, SEEDS (or SERIES="route:seed ..."), OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before;
 # STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
-# NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
+# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -24,6 +24,10 @@ printf 'flow:\n  frames:\n    scale: %s\n' "${SCALE:-1.0}" > "$config"
 simulate_extra=()
 [ -n "${STEREO:-}" ] && simulate_extra+=(--stereo "$STEREO")
 printf 'depth:\n  source: %s\n' "${DEPTH:-auto}" >> "$config"
+if [ -n "${STEREO_KEYS:-}" ]; then  # STEREO_KEYS="edge_radius_px=2 edge_jump_px=2": depth.stereo options
+  printf '  stereo:\n' >> "$config"
+  for pair in $STEREO_KEYS; do printf '    %s: %s\n' "${pair%%=*}" "${pair#*=}" >> "$config"; done
+fi
 run_series() {  # name route seed extra-simulate-options...
   local name=$1 route=$2 seed=$3
   shift 3

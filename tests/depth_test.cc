@@ -82,6 +82,33 @@ TEST(StereoMatching, TheLeftRightCheckKeepsTheRightDisparities) {
   EXPECT_GT(with.within_1px / with.density, without.within_1px / without.density + 0.01);
 }
 
+// Dropping the disparities next to depth edges (where SGBM's aggregation mixes the two surfaces) removes a
+// share of the gross errors and little else. Measured on Aloe: gross errors (over 3 px) 0.50 % of the matched
+// pixels without, 0.38 % with radius 2 and jump 2 px; 0.779 of the pixels matched without, 0.756 with.
+TEST(StereoMatching, DroppingDepthEdgesRemovesGrossErrors) {
+  const Aloe aloe;
+  if (aloe.truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
+  StereoOptions options;
+  options.num_disparities = 256;  // Aloe's disparities reach 211 px
+  cv::Mat kept, dropped;
+  ComputeDisparity(aloe.left, aloe.right, options, &kept);
+  options.edge_radius_px = 2;
+  options.edge_jump_px = 2.0;
+  ComputeDisparity(aloe.left, aloe.right, options, &dropped);
+  const DisparityScore with = Score(dropped, aloe.truth), without = Score(kept, aloe.truth);
+  const double gross_with = 1.0 - with.within_3px / with.density;
+  const double gross_without = 1.0 - without.within_3px / without.density;
+  EXPECT_LT(gross_with, 0.85 * gross_without);
+  EXPECT_GT(with.density, without.density - 0.04);
+  // Only disparities are dropped, none is changed.
+  for (int y = 0; y < dropped.rows; ++y) {
+    for (int x = 0; x < dropped.cols; ++x) {
+      if (dropped.at<float>(y, x) < 0) continue;
+      ASSERT_EQ(dropped.at<float>(y, x), kept.at<float>(y, x)) << x << "," << y;
+    }
+  }
+}
+
 // A textured wall 8 m in front of a side-by-side pair (f = 400 px, b = 0.5 m): disparity 25 px.
 struct WallPair {
   StereoCalibration calibration;

@@ -31,6 +31,8 @@ bool StereoOptions::IsValid(std::string* error) const {
       .InRange("depth.stereo.max_lr_difference", max_lr_difference, 0.0, 64.0)
       .InRange("depth.stereo.speckle_window", speckle_window, 0, 10000)
       .InRange("depth.stereo.speckle_range", speckle_range, 1, 64)
+      .InRange("depth.stereo.edge_radius_px", edge_radius_px, 0, 16)
+      .AboveAtMost("depth.stereo.edge_jump_px", edge_jump_px, 0.0, 512.0)
       .AboveAtMost("depth.stereo.min_range_m", min_range_m, 0.0, 1000.0)
       .AboveAtMost("depth.stereo.max_range_m", max_range_m, 0.0, 1000.0)
       .Holds("depth.stereo.max_range_m", max_range_m, max_range_m > min_range_m,

@@ -1,6 +1,7 @@
 #include "patrolmap/depth/stereo.h"
 
 #include <cmath>
+#include <limits>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -10,7 +11,8 @@ namespace patrolmap::depth {
 
 // Buffers of one matching, reused from frame to frame.
 struct MatchBuffers {
-  cv::Mat padded_left, padded_right, padded_disparity, flipped_left, flipped_right, right_view;
+  cv::Mat padded_left, padded_right, padded_disparity, flipped_left, flipped_right, right_view, local_max, local_min,
+      unknown;
 };
 
 namespace {
@@ -41,13 +43,10 @@ void MatchPadded(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& ri
   buffers->padded_disparity.colRange(pad, buffers->padded_disparity.cols).copyTo(*disparity);
 }
 
-// Disparity of the left view in SGBM's fixed point (CV_16S, 1/16 px; 0 or below: none). With the left-right
-// check the right view's disparity is matched too (the pair mirrored), and a left disparity is kept only where
-// the right view's, at the pixel it points to, agrees within max_lr_difference.
-void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
-               MatchBuffers* buffers, cv::Mat* disparity) {
-  MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
-  if (!options.lr_check) return;
+// Keeps a left disparity only where the right view's (matched with the pair mirrored), at the pixel it points to,
+// agrees within max_lr_difference.
+void CheckLeftRight(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
+                    MatchBuffers* buffers, cv::Mat* disparity) {
   cv::flip(left, buffers->flipped_left, 1);
   cv::flip(right, buffers->flipped_right, 1);
   // Mirrored: column w-1-x of the result is column x of the right view.
@@ -66,6 +65,37 @@ void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& righ
       if (back <= 0 || std::abs(back - d[x]) > tolerance) d[x] = -1;
     }
   }
+}
+
+// Leaves unknown every disparity (CV_16S fixed point) whose (2 radius + 1)^2 window holds known disparities
+// differing by more than jump_px: a depth edge, where SGBM's aggregated costs mix the two surfaces.
+void DropDepthEdges(int radius, double jump_px, MatchBuffers* buffers, cv::Mat* disparity) {
+  if (radius <= 0) return;
+  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1));
+  cv::dilate(*disparity, buffers->local_max, window);  // unknown (-1 or below) never wins the maximum
+  disparity->copyTo(buffers->local_min);
+  cv::compare(*disparity, 0, buffers->unknown, cv::CMP_LE);
+  buffers->local_min.setTo(std::numeric_limits<std::int16_t>::max(), buffers->unknown);
+  cv::erode(buffers->local_min, buffers->local_min, window);
+  const int jump = static_cast<int>(std::lround(jump_px * cv::StereoMatcher::DISP_SCALE));
+  for (int y = 0; y < disparity->rows; ++y) {
+    std::int16_t* d = disparity->ptr<std::int16_t>(y);
+    const std::int16_t* high = buffers->local_max.ptr<std::int16_t>(y);
+    const std::int16_t* low = buffers->local_min.ptr<std::int16_t>(y);
+    for (int x = 0; x < disparity->cols; ++x) {
+      if (d[x] > 0 && high[x] - low[x] > jump) d[x] = -1;
+    }
+  }
+}
+
+// Disparity of the left view in SGBM's fixed point (CV_16S, 1/16 px; 0 or below: none). With the left-right
+// check the right view's disparity is matched too (the pair mirrored), and a left disparity is kept only where
+// the right view's, at the pixel it points to, agrees within max_lr_difference; then depth edges are dropped.
+void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
+               MatchBuffers* buffers, cv::Mat* disparity) {
+  MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
+  if (options.lr_check) CheckLeftRight(matcher, left, right, options, buffers, disparity);
+  DropDepthEdges(options.edge_radius_px, options.edge_jump_px, buffers, disparity);
 }
 
 // Left pinhole grid -> rectified left pixel, and the factor turning a rectified depth into a left one.

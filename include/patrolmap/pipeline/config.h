@@ -169,6 +169,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.stereo.max_lr_difference", &depth.stereo.max_lr_difference);
   visitor->Field("depth.stereo.speckle_window", &depth.stereo.speckle_window);
   visitor->Field("depth.stereo.speckle_range", &depth.stereo.speckle_range);
+  visitor->Field("depth.stereo.edge_radius_px", &depth.stereo.edge_radius_px);
+  visitor->Field("depth.stereo.edge_jump_px", &depth.stereo.edge_jump_px);
   visitor->Field("depth.stereo.full_paths", &depth.stereo.full_paths);
   visitor->Field("depth.stereo.min_range_m", &depth.stereo.min_range_m);
   visitor->Field("depth.stereo.max_range_m", &depth.stereo.max_range_m);
