@@ -31,8 +31,8 @@ struct StereoOptions {
   // returns into the free space between them. 0: off.
   int edge_radius_px = 0;
   double edge_jump_px = 2.0;
-  bool full_paths = false;         // 8 path directions (slower) instead of OpenCV's 3-way approximation
-  double min_range_m = 0.3;        // depths outside [min_range_m, max_range_m] are left unknown
+  bool full_paths = false;   // 8 path directions (slower) instead of OpenCV's 3-way approximation
+  double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]
   bool IsValid(std::string* error) const;
