@@ -28,8 +28,8 @@ struct StereoOptions {
   int speckle_range = 2;           // ... a blob's disparities vary at most this much [px]
   // Disparities within edge_radius_px of a jump are left unknown: where the window of that radius holds
   // disparities differing by more than edge_jump_px, SGBM's aggregation mixes the two surfaces and puts
-  // returns into the free space between them. 0: off.
-  int edge_radius_px = 0;
+  // returns into the free space between them. 0: off. BENCHMARKS.md, "Stereo depth".
+  int edge_radius_px = 2;
   double edge_jump_px = 2.0;
   bool full_paths = false;   // 8 path directions (slower) instead of OpenCV's 3-way approximation
   double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
