@@ -46,12 +46,18 @@ struct Aloe {
   const cv::Mat truth = cv::imread(kOpencvData + "/aloeGT.png", cv::IMREAD_GRAYSCALE);
 };
 
+// The defaults with Aloe's disparity range (up to 211 px).
+StereoOptions AloeOptions() {
+  StereoOptions options;
+  options.num_disparities = 256;
+  return options;
+}
+
 // Pixels without a disparity count as wrong.
 TEST(StereoMatching, MiddleburyAloeAgreesWithTheTrueDisparity) {
   const Aloe aloe;
   if (aloe.truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
-  StereoOptions options;
-  options.num_disparities = 256;  // Aloe's disparities reach 211 px
+  StereoOptions options = AloeOptions();
   cv::Mat disparity;
   ComputeDisparity(aloe.left, aloe.right, options, &disparity);
   const DisparityScore score = Score(disparity, aloe.truth);
@@ -70,8 +76,7 @@ TEST(StereoMatching, MiddleburyAloeAgreesWithTheTrueDisparity) {
 TEST(StereoMatching, TheLeftRightCheckKeepsTheRightDisparities) {
   const Aloe aloe;
   if (aloe.truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
-  StereoOptions options;
-  options.num_disparities = 256;  // Aloe's disparities reach 211 px
+  StereoOptions options = AloeOptions();
   options.edge_radius_px = 0;
   options.uniqueness_ratio = 10;
   options.speckle_window = 100;
@@ -90,8 +95,7 @@ TEST(StereoMatching, TheLeftRightCheckKeepsTheRightDisparities) {
 TEST(StereoMatching, DroppingDepthEdgesRemovesGrossErrors) {
   const Aloe aloe;
   if (aloe.truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
-  StereoOptions options;
-  options.num_disparities = 256;  // Aloe's disparities reach 211 px
+  StereoOptions options = AloeOptions();
   options.edge_radius_px = 0;
   cv::Mat kept, dropped;
   ComputeDisparity(aloe.left, aloe.right, options, &kept);
