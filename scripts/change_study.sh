@@ -6,7 +6,8 @@
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
 # Environment: ROUTES, SEEDS (or SERIES="route:seed ..."), OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before;
 # STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
-# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series; NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
+# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series;
+# NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images.
 set -euo pipefail
 cd "$(dirname "$0")/.."

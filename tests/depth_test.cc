@@ -57,7 +57,7 @@ StereoOptions AloeOptions() {
 TEST(StereoMatching, MiddleburyAloeAgreesWithTheTrueDisparity) {
   const Aloe aloe;
   if (aloe.truth.empty()) GTEST_SKIP() << "opencv-doc not installed";
-  StereoOptions options = AloeOptions();
+  const StereoOptions options = AloeOptions();
   cv::Mat disparity;
   ComputeDisparity(aloe.left, aloe.right, options, &disparity);
   const DisparityScore score = Score(disparity, aloe.truth);

@@ -71,12 +71,13 @@ void CheckLeftRight(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat&
 // differing by more than jump_px: a depth edge, where SGBM's aggregated costs mix the two surfaces.
 void DropDepthEdges(int radius, double jump_px, MatchBuffers* buffers, cv::Mat* disparity) {
   if (radius <= 0) return;
-  const cv::Mat window = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1));
-  cv::dilate(*disparity, buffers->local_max, window);  // unknown (-1 or below) never wins the maximum
+  // A 3x3 square applied `radius` times is the (2 radius + 1)^2 square, with no kernel made per frame.
+  const cv::Point centre(-1, -1);
+  cv::dilate(*disparity, buffers->local_max, cv::Mat(), centre, radius);  // unknown (0 or below) never wins
   disparity->copyTo(buffers->local_min);
   cv::compare(*disparity, 0, buffers->unknown, cv::CMP_LE);
   buffers->local_min.setTo(std::numeric_limits<std::int16_t>::max(), buffers->unknown);
-  cv::erode(buffers->local_min, buffers->local_min, window);
+  cv::erode(buffers->local_min, buffers->local_min, cv::Mat(), centre, radius);
   const int jump = static_cast<int>(std::lround(jump_px * cv::StereoMatcher::DISP_SCALE));
   for (int y = 0; y < disparity->rows; ++y) {
     std::int16_t* d = disparity->ptr<std::int16_t>(y);
@@ -88,9 +89,8 @@ void DropDepthEdges(int radius, double jump_px, MatchBuffers* buffers, cv::Mat* 
   }
 }
 
-// Disparity of the left view in SGBM's fixed point (CV_16S, 1/16 px; 0 or below: none). With the left-right
-// check the right view's disparity is matched too (the pair mirrored), and a left disparity is kept only where
-// the right view's, at the pixel it points to, agrees within max_lr_difference; then depth edges are dropped.
+// Disparity of the left view in SGBM's fixed point (CV_16S, 1/16 px; 0 or below: none), left-right checked
+// (CheckLeftRight) and with depth edges dropped (DropDepthEdges) as the options ask.
 void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
                MatchBuffers* buffers, cv::Mat* disparity) {
   MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
