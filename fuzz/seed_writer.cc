@@ -16,9 +16,9 @@
 
 int main(int argc, char** argv) {
   using namespace patrolmap;
-  if (argc != 2) {
+  if (argc != 2 || argv[1][0] == '-') {  // "--help" is a question, not a folder to write into
     std::fprintf(stderr, "usage: seed_writer CORPUS_FOLDER\n");
-    return 2;
+    return argc == 2 && std::string(argv[1]) == "--help" ? 0 : 2;
   }
   const std::filesystem::path corpus = argv[1];
   std::filesystem::create_directories(corpus / "vocabulary");
