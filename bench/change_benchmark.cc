@@ -149,7 +149,9 @@ change::KeyFrameView Describe(const cv::Mat& image) {
   cv::resize(image, thumbnail, cv::Size(160, 102), 0, 0, cv::INTER_AREA);
   view.image = thumbnail;
   view.feature_scale = static_cast<double>(image.cols) / thumbnail.cols;
-  cv::SIFT::create(800)->detectAndCompute(image, cv::noArray(), view.keypoints, view.descriptors);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::SIFT::create(800)->detectAndCompute(image, cv::noArray(), keypoints, view.descriptors);
+  cv::KeyPoint::convert(keypoints, view.points);
   return view;
 }
 
@@ -182,7 +184,7 @@ void BM_RouteFrameFeatures(benchmark::State& state) {
   const RouteFrame frame = RouteFrameAt(20.0, sim::PlaceObjects(30, 1), {}, 0.0);
   change::KeyFrameView view;
   for (auto _ : state) view = change::RouteFrameView(frame, change::RouteCompareOptions{}.max_features);
-  state.counters["features"] = static_cast<double>(view.keypoints.size());
+  state.counters["features"] = static_cast<double>(view.points.size());
 }
 BENCHMARK(BM_RouteFrameFeatures)->Unit(benchmark::kMillisecond);
 

@@ -1,5 +1,5 @@
 // Fleet scale (issue 17): place queries of the pruned inverted index against the exhaustive one on the
-// simulator's places, and merging maps.
+// simulator's places, merging maps, and the memory a real key frame's node holds.
 //
 // BM_LoadLargeMap and BM_MergeTwoMaps build synthetic maps; the largest need about 8 GB of memory and disk.
 //
@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <random>
@@ -17,15 +18,19 @@
 #include <string>
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <filesystem>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/graph/topo_map.h"
 #include "patrolmap/pipeline/merge.h"
+#include "patrolmap/place/place_recognizer.h"
 #include "patrolmap/vocab/database.h"
 #include "patrolmap/vocab/vocabulary.h"
 
@@ -142,7 +147,7 @@ BENCHMARK(BM_SimulatedPlaceQuery)
     ->ArgsProduct({{0, 100000, 1000000}, {0, 16, 32, 64}, {100}})
     ->Unit(benchmark::kMillisecond);
 
-// Synthetic key frames for the map benchmarks: `features` keypoints spread over a 752x480 frame, random 8-bit
+// Synthetic key frames for the map benchmarks: `features` features spread over a 752x480 frame, random 8-bit
 // descriptors, and words drawn as often as the shipped vocabulary's training images held them.
 class SyntheticFrames {
  public:
@@ -171,10 +176,10 @@ class SyntheticFrames {
     rng_.fill(node.descriptors, cv::RNG::UNIFORM, 0, 64);
     words_.resize(features);
     for (int f = 0; f < features; ++f) {
-      node.keypoints.emplace_back(rng_.uniform(0.0f, 752.0f), rng_.uniform(0.0f, 480.0f), 4.0f);
+      node.points.emplace_back(rng_.uniform(0.0f, 752.0f), rng_.uniform(0.0f, 480.0f));
       words_[f] = draw_(engine_);
       if (seen != nullptr && f % 2 == 0 && f < seen->descriptors.rows) {
-        node.keypoints[f].pt = seen->keypoints[f].pt + cv::Point2f(6.0f, 0.0f);
+        node.points[f] = seen->points[f] + cv::Point2f(6.0f, 0.0f);
         seen->descriptors.row(f).copyTo(node.descriptors.row(f));
         words_[f] = seen_words_[f];
       }
@@ -273,6 +278,98 @@ void BM_MergeTwoMaps(benchmark::State& state) {
   std::filesystem::remove_all(folder);
 }
 BENCHMARK(BM_MergeTwoMaps)->Arg(1000)->Arg(50000)->Unit(benchmark::kSecond)->Iterations(1);
+
+// Memory per node on real key frames, as `patrolmap map` and `patrol` hold it: every image, resized by `scale`
+// percent (the map command describes key frames at flow.frame.scale, 50 %), goes through
+// PlaceRecognizer::AddKeyFrame (describe, keep the descriptors as place.descriptor_bits says, query, verify,
+// add) and then into a TopoMap with a 160-pixel thumbnail, as the map command builds it. The images come from
+// PATROLMAP_BENCH_IMAGES (a folder; default: the KITTI excerpt beside the repository), cycled. The growth of the
+// resident set between node `warmup` and the last is divided by the nodes added in between (resident_KB); the
+// other counters are the bytes each part keeps, averaged.
+std::vector<cv::Mat> RealImages() {
+  const char* folder = std::getenv("PATROLMAP_BENCH_IMAGES");
+  const std::filesystem::path path =
+      folder != nullptr ? folder : std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/kitti_seq2/image_l";
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(path, error)) files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  std::vector<cv::Mat> images;
+  for (const auto& file : files) {
+    cv::Mat image = cv::imread(file.string(), cv::IMREAD_GRAYSCALE);
+    if (!image.empty()) images.push_back(image);
+  }
+  return images;
+}
+
+double ResidentKilobytes() {
+  std::ifstream statm("/proc/self/statm");
+  double size = 0.0, resident = 0.0;
+  statm >> size >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1024.0;
+}
+
+void BM_RealNodeMemory(benchmark::State& state) {
+  const std::vector<cv::Mat> images = RealImages();
+  if (images.empty()) return state.SkipWithError("no images (PATROLMAP_BENCH_IMAGES, or ../shared/data)");
+  const auto nodes = static_cast<int>(state.range(1)), warmup = 200;
+  std::vector<cv::Mat> scaled(images.size());
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    const double scale = static_cast<double>(state.range(2)) / 100.0;
+    cv::resize(images[i], scaled[i], cv::Size(), scale, scale, cv::INTER_AREA);
+  }
+  place::PlaceOptions options;
+  options.descriptor_bits = static_cast<int>(state.range(0));
+  vocab::Vocabulary vocabulary;
+  if (!vocab::Vocabulary::Load(SyntheticFrames::VocabularyPath(), &vocabulary).ok()) std::abort();
+  double resident_kb = 0.0, descriptors = 0.0, points = 0.0, words = 0.0, thumbnails = 0.0;
+  for (auto _ : state) {
+    place::PlaceRecognizer recognizer(&vocabulary, options);
+    graph::TopoMap map;
+    double start_kb = 0.0;
+    for (int i = 0; i < warmup + nodes; ++i) {
+      if (i == warmup) start_kb = ResidentKilobytes();
+      place::KeyFrame key_frame{"real", 0, i, scaled[i % scaled.size()], false};
+      place::PlaceResult result;
+      if (!recognizer.AddKeyFrame(key_frame, &result).ok()) std::abort();
+      place::PlaceRecognizer::NodeFeatures features = recognizer.Features(result.node);
+      graph::NodeData data;
+      data.flight = features.flight;
+      data.frame_index = i;
+      const double scale = 160.0 / key_frame.image.cols;
+      cv::resize(key_frame.image, data.thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
+      data.points = std::move(features.points);
+      data.descriptors = std::move(features.descriptors);  // shared with the recognizer, as in the map command
+      data.bow = std::move(features.bow);
+      map.AddNode(std::move(data));
+    }
+    resident_kb = (ResidentKilobytes() - start_kb) / nodes;
+    for (int i = 0; i < map.node_count(); ++i) {
+      const graph::NodeData& n = map.node(i);
+      descriptors += static_cast<double>(n.descriptors.total() * n.descriptors.elemSize());
+      points += 2.0 * static_cast<double>(n.points.size() * sizeof(cv::Point2f));  // the recognizer's and the map's
+      words += static_cast<double>(n.bow.words.size());
+      thumbnails += static_cast<double>(n.thumbnail.total());
+    }
+    const double count = map.node_count();
+    descriptors /= count, points /= count, words /= count, thumbnails /= count;
+  }
+  state.counters["resident_KB"] = resident_kb;
+  state.counters["descriptors_KB"] = descriptors / 1024.0;
+  state.counters["points_KB"] = points / 1024.0;
+  // A word is kept three times: the database's entry and posting (8 bytes each) and the map's BoW vector (8).
+  state.counters["bow_KB"] = 24.0 * words / 1024.0;
+  state.counters["thumbnail_KB"] = thumbnails / 1024.0;
+  state.counters["features"] = descriptors / (options.descriptor_bits == 4 ? 64.0 : 128.0);
+}
+BENCHMARK(BM_RealNodeMemory)
+    ->ArgNames({"bits", "nodes", "scale"})
+    ->Args({8, 2000, 50})
+    ->Args({4, 2000, 50})
+    ->Args({8, 2000, 100})
+    ->Args({4, 2000, 100})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1);
 
 }  // namespace
 

@@ -21,7 +21,7 @@ graph::TopoMap TenThousandNodes() {
     node.flight = "flight-" + std::to_string(i / 2500);
     node.thumbnail = cv::Mat(102, 160, CV_8UC1);
     rng.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);
-    node.keypoints.assign(200, cv::KeyPoint(1.0f, 2.0f, 3.0f));
+    node.points.assign(200, cv::Point2f(1.0f, 2.0f));
     node.descriptors = cv::Mat(200, 128, CV_8UC1);
     rng.fill(node.descriptors, cv::RNG::UNIFORM, 0, 255);
     for (int w = 0; w < 150; ++w) node.bow.words.push_back(w * 60 + i % 60), node.bow.weights.push_back(1.0f / 150);

@@ -48,12 +48,12 @@ void BM_KeyFrameFeaturesAndWords(benchmark::State& state) {
   const cv::Mat& image = StreetPair(static_cast<int>(state.range(0)))[0];
   const vocab::Vocabulary& vocabulary = ShippedVocabulary();
   const place::PlaceOptions options;
-  std::vector<cv::KeyPoint> keypoints;
+  std::vector<cv::Point2f> points;
   cv::Mat descriptors;
   std::vector<vocab::WordId> words;
   vocab::BowVector bow;
   for (auto _ : state) {
-    place::DescribeFeatures(image, options, &keypoints, &descriptors);
+    place::DescribeFeatures(image, options, &points, &descriptors);
     vocabulary.Quantize(descriptors, &words);
     vocab::MakeBowVector(words, vocabulary.idf().data(), &bow);
     benchmark::DoNotOptimize(bow.words.data());
@@ -67,7 +67,7 @@ void BM_KeyFrameVerification(benchmark::State& state) {
   cv::setNumThreads(1);
   const std::vector<cv::Mat>& pair = StreetPair(static_cast<int>(state.range(0)));
   const place::PlaceOptions options;
-  std::vector<cv::KeyPoint> query_points, candidate_points;
+  std::vector<cv::Point2f> query_points, candidate_points;
   cv::Mat query, candidate;
   place::DescribeFeatures(pair[0], options, &query_points, &query);
   place::DescribeFeatures(pair[1], options, &candidate_points, &candidate);

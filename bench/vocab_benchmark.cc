@@ -77,9 +77,9 @@ void BM_QuantizeRealFeatures(benchmark::State& state) {
   for (const char* name : {"aero1.jpg", "graf1.png", "leuvenA.jpg", "building.jpg"}) {
     const cv::Mat image = cv::imread(folder + name, cv::IMREAD_GRAYSCALE);
     if (image.empty()) continue;
-    std::vector<cv::KeyPoint> keypoints;
+    std::vector<cv::Point2f> points;
     frames.emplace_back();
-    place::DescribeFeatures(image, place::PlaceOptions{}, &keypoints, &frames.back());
+    place::DescribeFeatures(image, place::PlaceOptions{}, &points, &frames.back());
   }
   if (frames.empty()) {
     state.SkipWithError("opencv-doc's example images are not installed");

@@ -4,7 +4,8 @@
 # simulates the logs into LOGS once (double loop and L-shape at 90°, inner loop at 45° and 90°), then
 # runs `detect` + `eval` per flight (Table II) and `map` + `eval` per experiment (Table III: the double
 # loop alone, then the inner loop and the L-shape each mapped after it), and prints one line per run.
-# TABLES ("2 3" by default) chooses which tables to run.
+# TABLES ("2 3" by default) chooses which tables to run. With CONFIG=FILE in the environment, `map` runs
+# with that configuration (for example one that changes a place.* option).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 bin="${1:-$root/build/tools/patrolmap}"
@@ -12,6 +13,8 @@ vocabulary="${2:-$root/vocab/default.pmvoc}"
 logs="${3:-/tmp/patrolmap_sim_logs}"
 out="${4:-/tmp/patrolmap_sim_study}"
 tables="${5:-2 3}"
+config=()
+[[ -n "${CONFIG:-}" ]] && config=(--config "$CONFIG")
 mkdir -p "$logs" "$out"
 
 simulate() {  # NAME ROUTE MOUNT SEED
@@ -45,7 +48,7 @@ for seed in 1 2 3; do
     extra=()
     [[ $experiment == 2 ]] && extra=("$logs/inner90-$seed")
     [[ $experiment == 3 ]] && extra=("$logs/l-$seed")
-    "$bin" --quiet map "$logs/double-$seed" "${extra[@]}" --vocabulary "$vocabulary" --out "$run" >/dev/null
+    "$bin" --quiet map "$logs/double-$seed" "${extra[@]}" "${config[@]}" --vocabulary "$vocabulary" --out "$run" >/dev/null
     eval_logs=(--log "$logs/double-$seed")
     [[ ${#extra[@]} -gt 0 ]] && eval_logs+=(--log "${extra[0]}")
     printf 'experiment %s seed %s ' "$experiment" "$seed"

@@ -61,7 +61,7 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   KeyKinds kinds;
   Config defaults;
   VisitConfig(&defaults, &kinds);
-  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 127u);  // every numeric key (the rest are switches)
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 128u);  // every numeric key (the rest are switches)
   const auto refused = [&](const std::string& key, const std::string& value) {
     testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
     Config config;
@@ -419,9 +419,9 @@ void TwoStreetFlights(const std::filesystem::path& dir, const Config& config, vo
   while (source->Next(true, &frame).ok()) {
     if (frame.index % 10 != 0) continue;
     cv::Mat small, descriptors;
-    std::vector<cv::KeyPoint> keypoints;
+    std::vector<cv::Point2f> points;
     cv::resize(frame.image, small, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+    place::DescribeFeatures(small, config.place, &points, &descriptors);
     training.push_back(descriptors);
   }
   vocab::VocabularyOptions vocabulary_options;

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/place/place_recognizer.h"
+#include "patrolmap/vocab/descriptors.h"
 
 namespace patrolmap::place {
 namespace {
@@ -21,9 +22,9 @@ vocab::Vocabulary VocabularyFor(const std::vector<cv::Mat>& images, const PlaceO
   vocab::Vocabulary vocabulary;
   std::vector<cv::Mat> descriptors;
   for (const cv::Mat& image : images) {
-    std::vector<cv::KeyPoint> keypoints;
+    std::vector<cv::Point2f> points;
     cv::Mat d;
-    DescribeFeatures(image, options, &keypoints, &d);
+    DescribeFeatures(image, options, &points, &d);
     descriptors.push_back(d);
   }
   vocab::VocabularyOptions vocabulary_options;
@@ -41,15 +42,13 @@ TEST(Verify, SyntheticTwoViewGeometryWithOutliers) {
   std::normal_distribution<double> pixel_noise(0.0, 0.3);
   std::normal_distribution<float> descriptor_noise(0.0f, 3.0f);
   const double f = 400.0, cx = 320.0, cy = 240.0;
-  std::vector<cv::KeyPoint> a, b;
+  std::vector<cv::Point2f> a, b;
   cv::Mat da(0, 128, CV_32F), db(0, 128, CV_32F);
   for (int i = 0; i < 300; ++i) {
     const Eigen::Vector3d p(4.0 * u(rng), 3.0 * u(rng), 8.0 + 4.0 * u(rng));
     const Eigen::Vector3d q = Eigen::Vector3d(p.x() - 0.8, p.y() - 0.1, p.z() - 0.3);  // camera moved right
-    a.emplace_back(float(f * p.x() / p.z() + cx + pixel_noise(rng)), float(f * p.y() / p.z() + cy + pixel_noise(rng)),
-                   5.f);
-    b.emplace_back(float(f * q.x() / q.z() + cx + pixel_noise(rng)), float(f * q.y() / q.z() + cy + pixel_noise(rng)),
-                   5.f);
+    a.emplace_back(float(f * p.x() / p.z() + cx + pixel_noise(rng)), float(f * p.y() / p.z() + cy + pixel_noise(rng)));
+    b.emplace_back(float(f * q.x() / q.z() + cx + pixel_noise(rng)), float(f * q.y() / q.z() + cy + pixel_noise(rng)));
     cv::Mat row(1, 128, CV_32F);
     cv::randu(row, 0, 255);
     da.push_back(row);
@@ -58,7 +57,7 @@ TEST(Verify, SyntheticTwoViewGeometryWithOutliers) {
     db.push_back(noisy);
   }
   for (int i = 0; i < 200; ++i) {  // clutter in the second view
-    b.emplace_back(float(640 * (u(rng) + 1) / 2), float(480 * (u(rng) + 1) / 2), 5.f);
+    b.emplace_back(float(640 * (u(rng) + 1) / 2), float(480 * (u(rng) + 1) / 2));
     cv::Mat row(1, 128, CV_32F);
     cv::randu(row, 0, 255);
     db.push_back(row);
@@ -78,11 +77,34 @@ TEST(Verify, SyntheticTwoViewGeometryWithOutliers) {
   EXPECT_GE(verification.inliers, 280);
   EXPECT_TRUE(verification.accepted);
   // Shuffled correspondences break the geometry: few inliers, not accepted.
-  std::vector<cv::KeyPoint> shuffled = b;
+  std::vector<cv::Point2f> shuffled = b;
   std::shuffle(shuffled.begin(), shuffled.begin() + 300, rng);
   const Verification broken = recognizer.Verify(a, da, shuffled, db);
   EXPECT_FALSE(broken.accepted);
   EXPECT_LT(broken.inliers, 60);
+}
+
+// The 4-bit levels hold real descriptors: on three opencv-doc photographs (800 features each), no 8-bit
+// RootSIFT component lies above 84, the last level of the uniform steps, and hardly any plain SIFT component
+// above 210, the largest level.
+TEST(PackedDescriptors, RealComponentsFitTheLevels) {
+  for (bool root_sift : {true, false}) {
+    PlaceOptions options;
+    options.root_sift = root_sift;
+    const int top = root_sift ? vocab::kPackedLevels[12] : vocab::kPackedLevels[15];
+    double above = 0.0, total = 0.0;
+    for (const char* name : {"graf1.png", "aero1.jpg", "leuvenA.jpg"}) {
+      const cv::Mat image = cv::imread(kOpencvData + "/" + name, cv::IMREAD_GRAYSCALE);
+      if (image.empty()) GTEST_SKIP() << "opencv-doc not installed";
+      std::vector<cv::Point2f> points;
+      cv::Mat floats, bytes;
+      DescribeFeatures(image, options, &points, &floats);
+      floats.convertTo(bytes, CV_8U, root_sift ? 255.0 : 1.0);
+      above += cv::countNonZero(bytes > top);
+      total += static_cast<double>(bytes.total());
+    }
+    EXPECT_LE(above / total, root_sift ? 0.0 : 0.001) << (root_sift ? "RootSIFT" : "SIFT");
+  }
 }
 
 TEST(Verify, GraffitiPairFromOpencvDoc) {
@@ -92,7 +114,7 @@ TEST(Verify, GraffitiPairFromOpencvDoc) {
   PlaceOptions options;
   const vocab::Vocabulary vocabulary = VocabularyFor({one, three}, options);
   PlaceRecognizer recognizer(&vocabulary, options);
-  std::vector<cv::KeyPoint> ka, kb;
+  std::vector<cv::Point2f> ka, kb;
   cv::Mat da, db;
   DescribeFeatures(one, options, &ka, &da);
   DescribeFeatures(three, options, &kb, &db);
@@ -106,6 +128,28 @@ TEST(Verify, GraffitiPairFromOpencvDoc) {
   EXPECT_TRUE(compact.accepted);
   EXPECT_NEAR(compact.matches, verification.matches, 0.05 * verification.matches);
   EXPECT_EQ(recognizer.Verify(ka, da, kb, cb).matches, 0);  // float against 8-bit is refused, not mixed
+  // Packed 4-bit, as nodes keep them by default: still accepted, with at most 15 % fewer matches.
+  const cv::Mat pa = vocab::PackDescriptors(ca), pb = vocab::PackDescriptors(cb);
+  ASSERT_EQ(pa.cols, 64);
+  const Verification packed = recognizer.Verify(ka, pa, kb, pb);
+  EXPECT_TRUE(packed.accepted) << packed.matches << " matches, " << packed.inliers << " inliers";
+  EXPECT_GE(packed.matches, 0.85 * compact.matches);
+  EXPECT_LE(packed.matches, 1.05 * compact.matches);
+  // Plain SIFT (8-bit already) packed: its larger components fall on the coarse top levels.
+  options.root_sift = false;
+  std::vector<cv::Point2f> sa, sb;
+  cv::Mat fa, fb, ba, bb;
+  DescribeFeatures(one, options, &sa, &fa);
+  DescribeFeatures(three, options, &sb, &fb);
+  fa.convertTo(ba, CV_8U);
+  fb.convertTo(bb, CV_8U);
+  const Verification sift = VerifyPair(options, sa, ba, sb, bb);
+  const Verification sift_packed = VerifyPair(options, sa, vocab::PackDescriptors(ba), sb, vocab::PackDescriptors(bb));
+  EXPECT_TRUE(sift.accepted);
+  EXPECT_TRUE(sift_packed.accepted) << sift_packed.matches << " matches, " << sift_packed.inliers << " inliers";
+  EXPECT_GE(sift_packed.matches, 0.85 * sift.matches);
+  std::printf("graf 1/3 matches: RootSIFT float %d, 8-bit %d, 4-bit %d; SIFT 8-bit %d, 4-bit %d\n",
+              verification.matches, compact.matches, packed.matches, sift.matches, sift_packed.matches);
 }
 
 // Shared real revisits: EuRoC left_img_0/1 and 2/3, DBoW2 image1/image3 are the same place; image0/image2 not.
@@ -312,19 +356,19 @@ TEST(VerifyPair, RatioTestKeepsOnlyUnambiguousMatches) {
   cv::RNG rng(11);
   cv::Mat query(20, 128, CV_32F), candidate(30, 128, CV_32F);
   rng.fill(query, cv::RNG::UNIFORM, 0.0, 1.0);
-  std::vector<cv::KeyPoint> query_points, candidate_points;
+  std::vector<cv::Point2f> query_points, candidate_points;
   const auto offset = [&rng](double length) {
     cv::Mat direction(1, 128, CV_32F);
     rng.fill(direction, cv::RNG::NORMAL, 0.0, 1.0);
     return cv::Mat(direction * (length / cv::norm(direction)));
   };
-  for (int i = 0; i < 20; ++i) query_points.emplace_back(cv::Point2f(10.0f * i, 5.0f), 2.0f);
+  for (int i = 0; i < 20; ++i) query_points.emplace_back(10.0f * i, 5.0f);
   for (int i = 0; i < 10; ++i) candidate.row(i) = query.row(i) + offset(0.1);
   for (int i = 10; i < 20; ++i) {
     candidate.row(i) = query.row(i) + offset(0.50);
     candidate.row(i + 10) = query.row(i) + offset(0.52);
   }
-  for (int j = 0; j < 30; ++j) candidate_points.emplace_back(cv::Point2f(7.0f * j, 9.0f), 2.0f);
+  for (int j = 0; j < 30; ++j) candidate_points.emplace_back(7.0f * j, 9.0f);
   const Verification v = VerifyPair(PlaceOptions(), query_points, query, candidate_points, candidate);
   EXPECT_EQ(v.matches, 10);
   EXPECT_DOUBLE_EQ(v.matched_fraction, 10.0 / 20.0);

@@ -24,7 +24,7 @@ struct Described {
   std::string name;
   std::string set;  // images of one set and one place id show the same place
   int place = -1;   // -1: a place no other image shows
-  std::vector<cv::KeyPoint> keypoints;
+  std::vector<cv::Point2f> points;
   cv::Mat descriptors;
 };
 
@@ -36,7 +36,7 @@ bool Describe(const std::string& path, const std::string& set, int place, std::v
   const double scale = flow::FrameOptions().scale;
   cv::resize(image, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
   Described d{std::filesystem::path(path).filename().string(), set, place, {}, {}};
-  DescribeFeatures(scaled, PlaceOptions(), &d.keypoints, &d.descriptors);
+  DescribeFeatures(scaled, PlaceOptions(), &d.points, &d.descriptors);
   out->push_back(std::move(d));
   return true;
 }
@@ -46,7 +46,8 @@ struct PairCounts {
   int found_by_fifty_inliers = 0, false_by_fifty_inliers = 0;  // the former rule: 50 inliers
 };
 
-// Verifies every pair with `options`; a pair is a revisit when both show the same place of one set.
+// Verifies every pair with `options`, with the descriptors a node keeps; a pair is a revisit when both show the
+// same place of one set.
 PairCounts VerifyAllPairs(const std::vector<Described>& images, const PlaceOptions& options = PlaceOptions()) {
   PairCounts counts;
   for (std::size_t i = 0; i < images.size(); ++i) {
@@ -54,7 +55,8 @@ PairCounts VerifyAllPairs(const std::vector<Described>& images, const PlaceOptio
       const Described& a = images[i];
       const Described& b = images[j];
       const bool revisit = a.set == b.set && a.place >= 0 && a.place == b.place;
-      const Verification v = VerifyPair(options, a.keypoints, a.descriptors, b.keypoints, b.descriptors);
+      const Verification v = VerifyPair(options, a.points, StoredDescriptors(a.descriptors, options), b.points,
+                                        StoredDescriptors(b.descriptors, options));
       const bool fifty = v.inliers >= 50;
       if (revisit || v.matches >= 8) {
         std::printf("%-16s %-16s %s features %4d/%4d matches %4d inliers %4d log NFA %8.1f %s\n", a.name.c_str(),
@@ -105,6 +107,15 @@ TEST(RealPairs, DefaultVerificationFindsRevisitsAndRejectsEveryOtherPair) {
   const PairCounts alone = VerifyAllPairs(images, ungated);
   EXPECT_EQ(alone.false_accepts, 0);
   EXPECT_EQ(alone.found, counts.found);
+  // Nodes keep 4-bit descriptors by default; with 8 bits and with floats every pair is judged the same.
+  for (const bool compact : {true, false}) {
+    PlaceOptions wider;
+    wider.compact_descriptors = compact;
+    wider.descriptor_bits = 8;
+    const PairCounts other = VerifyAllPairs(images, wider);
+    EXPECT_EQ(other.found, counts.found) << compact;
+    EXPECT_EQ(other.false_accepts, counts.false_accepts) << compact;
+  }
 }
 
 // KITTI poses.txt: the camera centre of each frame (the translation column of its 3x4 matrix).
@@ -132,25 +143,33 @@ TEST(RealPairs, KittiFramesNearEachOtherVerify) {
   for (std::size_t i = 0; i < centres.size(); ++i) {
     ASSERT_TRUE(Describe(folder + cv::format("/image_l/%06zu.png", i), "kitti", -1, &images));
   }
-  const PlaceOptions options;
-  int same = 0, found = 0, found_fifty = 0, other = 0, false_accepts = 0, false_fifty = 0;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    for (std::size_t j = i + kMinGapFrames; j < images.size(); ++j) {
-      const bool near = cv::norm(centres[i] - centres[j]) <= kSamePlaceM;
-      const Verification v =
-          VerifyPair(options, images[i].keypoints, images[i].descriptors, images[j].keypoints, images[j].descriptors);
-      (near ? same : other) += 1;
-      (near ? found : false_accepts) += v.accepted;
-      (near ? found_fifty : false_fifty) += v.inliers >= 50;
+  // As nodes keep them: 4-bit (the default) and 8-bit descriptors.
+  int found_by_bits[2] = {0, 0};
+  for (const int bits : {4, 8}) {
+    PlaceOptions options;
+    options.descriptor_bits = bits;
+    std::vector<cv::Mat> stored;
+    for (const Described& image : images) stored.push_back(StoredDescriptors(image.descriptors, options));
+    int same = 0, found = 0, found_fifty = 0, other = 0, false_accepts = 0, false_fifty = 0;
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      for (std::size_t j = i + kMinGapFrames; j < images.size(); ++j) {
+        const bool near = cv::norm(centres[i] - centres[j]) <= kSamePlaceM;
+        const Verification v = VerifyPair(options, images[i].points, stored[i], images[j].points, stored[j]);
+        (near ? same : other) += 1;
+        (near ? found : false_accepts) += v.accepted;
+        (near ? found_fifty : false_fifty) += v.inliers >= 50;
+      }
     }
+    // Pairs farther apart still share much of the view of a forward camera (the road ahead): those that
+    // verify are overlapping views, not false matches, and are only counted.
+    std::printf(
+        "KITTI, %d-bit: %d same-place pairs, %d verified (50-inlier rule %d); %d pairs farther apart, %d verified "
+        "(50-inlier rule %d)\n",
+        bits, same, found, found_fifty, other, false_accepts, false_fifty);
+    EXPECT_GE(found, same * 9 / 10) << bits << " bits";
+    found_by_bits[bits == 8] = found;
   }
-  // Pairs farther apart still share much of the view of a forward camera (the road ahead): those that
-  // verify are overlapping views, not false matches, and are only counted.
-  std::printf(
-      "KITTI: %d same-place pairs, %d verified (50-inlier rule %d); %d pairs farther apart, %d verified "
-      "(50-inlier rule %d)\n",
-      same, found, found_fifty, other, false_accepts, false_fifty);
-  EXPECT_GE(found, same * 9 / 10);
+  EXPECT_GE(found_by_bits[0], found_by_bits[1] * 97 / 100);  // 4 bits lose at most 3 % of the verified pairs
 }
 
 // The KITTI retrieval protocol as `patrolmap map --every-frame` runs it: every frame is a node, described

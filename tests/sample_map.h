@@ -23,7 +23,7 @@ inline graph::TopoMap TwoFlights() {
     node.frame_index = 30 * i;
     node.thumbnail = cv::Mat(12, 16, CV_8UC1);
     rng.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);
-    for (int k = 0; k < 5; ++k) node.keypoints.emplace_back(cv::Point2f(k * 3.5f, i + 0.25f), 2.0f, 10.0f * k, 0.5f, 1);
+    for (int k = 0; k < 5; ++k) node.points.emplace_back(k * 3.5f, i + 0.25f);
     node.descriptors = cv::Mat(5, 128, CV_8UC1);
     rng.fill(node.descriptors, cv::RNG::UNIFORM, 0, 255);
     node.bow.words = {static_cast<vocab::WordId>(i), 100};

@@ -7,12 +7,14 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "patrolmap/vocab/descriptors.h"
+
 namespace patrolmap::change {
 namespace {
 
 cv::Mat AsFloat(const cv::Mat& descriptors) {
   cv::Mat floats;
-  descriptors.convertTo(floats, CV_32F);
+  vocab::Expanded(descriptors).convertTo(floats, CV_32F);
   return floats;
 }
 
@@ -193,8 +195,8 @@ Registration Register(const KeyFrameView& prior, const KeyFrameView& current, co
   if (static_cast<int>(registration.matches.size()) < std::max(4, options.min_inliers)) return registration;
   std::vector<cv::Point2f> from, to;
   for (const cv::DMatch& m : registration.matches) {
-    from.push_back(prior.keypoints[m.trainIdx].pt / prior.feature_scale);
-    to.push_back(current.keypoints[m.queryIdx].pt / current.feature_scale);
+    from.push_back(prior.points[m.trainIdx] / prior.feature_scale);
+    to.push_back(current.points[m.queryIdx] / current.feature_scale);
   }
   std::vector<unsigned char> inlier;
   cv::Mat h = cv::findHomography(from, to, cv::RANSAC, options.inlier_threshold_px, inlier, 2000, 0.999);
@@ -249,10 +251,10 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
   const std::vector<bool> at_edge = TouchingEdge(labels, count, mask, options.edge_margin_px);
   const int min_area = std::max(1, static_cast<int>(options.min_area_fraction * compared));
   const double min_side = options.min_side_fraction * std::min(current_f.cols, current_f.rows);
-  std::vector<bool> matched_prior(prior.keypoints.size(), false), matched_current(current.keypoints.size(), false);
+  std::vector<bool> matched_prior(prior.points.size(), false), matched_current(current.points.size(), false);
   for (const cv::DMatch& m : matches) matched_prior[m.trainIdx] = matched_current[m.queryIdx] = true;
   std::vector<cv::Point2f> prior_points, prior_in_current;
-  for (const cv::KeyPoint& k : prior.keypoints) prior_points.push_back(k.pt / prior.feature_scale);
+  for (const cv::Point2f& p : prior.points) prior_points.push_back(p / prior.feature_scale);
   if (!prior_points.empty()) cv::perspectiveTransform(prior_points, prior_in_current, h);
   for (int label = 1; label < count; ++label) {
     AppearanceRegion region;
@@ -270,8 +272,8 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       ++region.prior_features;
       region.unmatched_prior_features += !matched_prior[k];
     }
-    for (std::size_t k = 0; k < current.keypoints.size(); ++k) {
-      if (!box.contains(current.keypoints[k].pt / current.feature_scale)) continue;
+    for (std::size_t k = 0; k < current.points.size(); ++k) {
+      if (!box.contains(current.points[k] / current.feature_scale)) continue;
       ++region.current_features;
       region.unmatched_current_features += !matched_current[k];
     }

@@ -259,7 +259,9 @@ KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features) {
   KeyFrameView view;
   if (!frame.jpeg.empty()) view.image = cv::imdecode(frame.jpeg, cv::IMREAD_GRAYSCALE);
   if (view.image.empty()) return view;
-  cv::SIFT::create(max_features)->detectAndCompute(view.image, cv::noArray(), view.keypoints, view.descriptors);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::SIFT::create(max_features)->detectAndCompute(view.image, cv::noArray(), keypoints, view.descriptors);
+  cv::KeyPoint::convert(keypoints, view.points);
   return view;
 }
 

@@ -10,18 +10,19 @@
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/vocab/descriptors.h"
 
 namespace patrolmap::graph {
 namespace {
 
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
-// 5: the patrol's depth source; 6: the frames kept along the route
-constexpr std::uint32_t kVersion = 7;
+// 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
+// 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit
+constexpr std::uint32_t kVersion = 8;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
-constexpr int kDescriptorWidth = 128;  // SIFT
 
 // Where a section's bytes go: counted (its length), checksummed, or written to the file. A section is built
 // once for each, so saving never holds a section in memory: the features of an hour's map are 45 MB.
@@ -155,6 +156,7 @@ class Reader {
   bool failed_ = false;
 };
 
+// A feature as map format 7 and older kept it; only the position is read.
 struct KeyPointRecord {
   float x, y, size, angle, response;
   std::int32_t octave;
@@ -195,9 +197,7 @@ void FeatureSection(const TopoMap& map, Writer* out) {
   w.Value(static_cast<std::uint32_t>(map.node_count()));
   for (int i = 0; i < map.node_count(); ++i) {
     const NodeData& n = map.node(i);
-    std::vector<KeyPointRecord> points;
-    for (const cv::KeyPoint& k : n.keypoints) points.push_back({k.pt.x, k.pt.y, k.size, k.angle, k.response, k.octave});
-    w.Vector(points);
+    w.Vector(n.points);
     w.Mat(n.descriptors);
     w.Vector(n.bow.words);
     w.Vector(n.bow.weights);
@@ -376,19 +376,22 @@ Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, Top
   return r->failed() || !r->done() ? Corrupt(path, "edge section") : Status::Ok();
 }
 
-Status ParseFeatures(const std::string& path, Reader* r, TopoMap* map) {
+Status ParseFeatures(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   if (r->Value<std::uint32_t>() != static_cast<std::uint32_t>(map->node_count())) return Corrupt(path, "feature count");
   for (int i = 0; i < map->node_count() && !r->failed(); ++i) {
     NodeData& n = map->mutable_node(i);
-    for (const KeyPointRecord& k : r->Vector<KeyPointRecord>()) {
-      n.keypoints.emplace_back(cv::Point2f(k.x, k.y), k.size, k.angle, k.response, k.octave);
+    if (version >= 8) {
+      n.points = r->Vector<cv::Point2f>();
+    } else {
+      for (const KeyPointRecord& k : r->Vector<KeyPointRecord>()) n.points.emplace_back(k.x, k.y);
     }
     n.descriptors = r->Mat();
     n.bow.words = r->Vector<vocab::WordId>();
     n.bow.weights = r->Vector<float>();
     if (n.bow.words.size() != n.bow.weights.size() ||
-        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.keypoints.size()) ||
-        (!n.descriptors.empty() && n.descriptors.cols != kDescriptorWidth) ||
+        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.points.size()) ||
+        !vocab::IsStoredDescriptorKind(n.descriptors) ||
+        !std::all_of(n.points.begin(), n.points.end(), [](const cv::Point2f& p) { return std::isfinite(p.x + p.y); }) ||
         !std::all_of(n.bow.weights.begin(), n.bow.weights.end(), [](float w) { return std::isfinite(w); })) {
       return Corrupt(path, "features of node " + std::to_string(i));
     }
@@ -592,7 +595,7 @@ Status ParseSection(const std::string& path, std::uint32_t version, const std::s
   };
   if (tag == "NODE" && once(&seen->nodes)) return ParseNodes(path, &reader, map);
   if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, version, &reader, map);
-  if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, &reader, map);
+  if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, version, &reader, map);
   if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, version, &reader, map);
   if (tag == "VOCB" && once(&seen->vocabulary)) return ParseVocabulary(path, &reader, map);
   return Corrupt(path, "unexpected or repeated section " + tag);

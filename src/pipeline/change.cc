@@ -39,7 +39,7 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     if (map.node(a).flight != prior || map.node(b).flight != current) continue;
     const auto view = [&map](int node, const PatrolRecord* record) {
       const graph::NodeData& n = map.node(node);
-      change::KeyFrameView v{n.thumbnail, n.keypoints, n.descriptors, 1.0};
+      change::KeyFrameView v{n.thumbnail, n.points, n.descriptors, 1.0};
       if (record != nullptr && record->feature_image_width > 0 && !n.thumbnail.empty()) {
         v.feature_scale = static_cast<double>(record->feature_image_width) / n.thumbnail.cols;
       }

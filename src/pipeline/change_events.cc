@@ -39,9 +39,9 @@ bool Reported(change::ObjectState state) {
 }
 
 // The key frame of a node as the appearance comparison needs it (as pipeline::CompareFlights builds it).
-change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::KeyPoint> keypoints, cv::Mat descriptors,
+change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::Point2f> points, cv::Mat descriptors,
                             int feature_width) {
-  change::KeyFrameView view{thumbnail, std::move(keypoints), std::move(descriptors), 1.0};
+  change::KeyFrameView view{thumbnail, std::move(points), std::move(descriptors), 1.0};
   if (feature_width > 0 && !thumbnail.empty()) view.feature_scale = static_cast<double>(feature_width) / thumbnail.cols;
   return view;
 }
@@ -161,9 +161,9 @@ void ChangeMonitor::OnNode(const MapNode& node, const std::optional<CameraPoseSa
   if (before.flight != prior_flight_) return;
   place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
   const change::AppearanceChange appearance = change::DetectAppearanceChange(
-      ViewOf(before.thumbnail, before.keypoints, before.descriptors,
+      ViewOf(before.thumbnail, before.points, before.descriptors,
              prior_record_ != nullptr ? prior_record_->feature_image_width : 0),
-      ViewOf(node.thumbnail, std::move(features.keypoints), std::move(features.descriptors), node.feature_width),
+      ViewOf(node.thumbnail, std::move(features.points), std::move(features.descriptors), node.feature_width),
       config_.change.appearance);
   if (appearance.regions.empty()) return;
   Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns,

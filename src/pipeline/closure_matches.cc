@@ -21,11 +21,11 @@ std::vector<graph::ClosureMatches> MatchClosures(const graph::TopoMap& map, cons
     const double scale_a = ThumbnailScale(map, e.a), scale_b = ThumbnailScale(map, e.b);
     if (scale_a <= 0.0 || scale_b <= 0.0) continue;
     const graph::NodeData &a = map.node(e.a), &b = map.node(e.b);
-    place::VerifyPair(options, a.keypoints, a.descriptors, b.keypoints, b.descriptors, nullptr, nullptr, &inliers);
+    place::VerifyPair(options, a.points, a.descriptors, b.points, b.descriptors, nullptr, nullptr, &inliers);
     for (const auto& [i, j] : inliers) {
-      matches.pairs.push_back(
-          {static_cast<float>(a.keypoints[i].pt.x * scale_a), static_cast<float>(a.keypoints[i].pt.y * scale_a),
-           static_cast<float>(b.keypoints[j].pt.x * scale_b), static_cast<float>(b.keypoints[j].pt.y * scale_b)});
+      matches.pairs.push_back({static_cast<float>(a.points[i].x * scale_a), static_cast<float>(a.points[i].y * scale_a),
+                               static_cast<float>(b.points[j].x * scale_b),
+                               static_cast<float>(b.points[j].y * scale_b)});
     }
   }
   return closures;

@@ -12,6 +12,7 @@
 #include "patrolmap/graph/layout.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/pipeline/data_files.h"
+#include "patrolmap/vocab/descriptors.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -83,7 +84,8 @@ Status CheckNodeFits(const graph::TopoMap& map, const std::string& path, int id,
   const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(), [&](vocab::WordId word) {
     return word < static_cast<vocab::WordId>(vocabulary.word_count());
   });
-  if (words_fit && (node.descriptors.empty() || node.descriptors.cols == vocabulary.dimension())) return Status::Ok();
+  const int width = vocab::IsPacked(node.descriptors) ? vocab::kDescriptorDimension : node.descriptors.cols;
+  if (words_fit && (node.descriptors.empty() || width == vocabulary.dimension())) return Status::Ok();
   return Status::DataLoss(path + ": node " + std::to_string(id) +
                           " was not described with this vocabulary (word ids or descriptor width out of range)");
 }
@@ -95,7 +97,7 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
     PATROLMAP_RETURN_IF_ERROR(CheckNodeFits(prior, prior_path, i, vocabulary));
     const graph::NodeData& node = prior.node(i);
     recognizer->AddDescribedNode(
-        {node.flight, node.timestamp_ns, node.frame_index, node.keypoints, node.descriptors, node.bow});
+        {node.flight, node.timestamp_ns, node.frame_index, node.points, node.descriptors, node.bow});
   }
   return Status::Ok();
 }
@@ -113,7 +115,7 @@ graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognize
     data.thumbnail = node.thumbnail;
     data.heading = node.heading;
     data.gps = node.gps;
-    data.keypoints = std::move(features.keypoints);
+    data.points = std::move(features.points);
     data.descriptors = std::move(features.descriptors);
     data.bow = std::move(features.bow);
     const int id = map.AddNode(std::move(data));
@@ -134,7 +136,7 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
   nodes << "node,flight,timestamp_ns,frame_index,features\n";
   for (int i = 0; i < map.node_count(); ++i) {
     const graph::NodeData& n = map.node(i);
-    nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.keypoints.size() << "\n";
+    nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.points.size() << "\n";
   }
   closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers,log_nfa\n";
   char line[256];

@@ -108,8 +108,7 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
       node.flight = part.id;
       place::PlaceResult result;
       recognizer.AddDescribedKeyFrame(
-          {node.flight, node.timestamp_ns, node.frame_index, node.keypoints, node.descriptors, node.bow}, timed,
-          &result);
+          {node.flight, node.timestamp_ns, node.frame_index, node.points, node.descriptors, node.bow}, timed, &result);
       outcome->seconds_query += result.seconds_query;
       outcome->seconds_verify += result.seconds_verify;
       const int id = merged.AddNode(std::move(node));

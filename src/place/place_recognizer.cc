@@ -7,6 +7,7 @@
 #include <map>
 
 #include "patrolmap/core/option_check.h"
+#include "patrolmap/vocab/descriptors.h"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
@@ -36,13 +37,6 @@ void ToRootSift(cv::Mat* descriptors) {
     if (sum <= 0.0) continue;
     for (int i = 0; i < descriptors->cols; ++i) d[i] = static_cast<float>(std::sqrt(std::abs(d[i]) / sum));
   }
-}
-
-// 8-bit copy of float descriptors: RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is.
-cv::Mat Compact(const cv::Mat& descriptors, bool root_sift) {
-  cv::Mat compact;
-  descriptors.convertTo(compact, CV_8U, root_sift ? 255.0 : 1.0);
-  return compact;
 }
 
 // Ratio-test matches of query features among the candidate features of the same group.
@@ -89,12 +83,12 @@ double LineDistance(const cv::Vec3d& line, const cv::Point2f& point) {
 
 }  // namespace
 
-FeatureExtent ExtentOf(const std::vector<cv::KeyPoint>& keypoints) {
-  if (keypoints.empty()) return {};
-  float min_x = keypoints[0].pt.x, max_x = min_x, min_y = keypoints[0].pt.y, max_y = min_y;
-  for (const cv::KeyPoint& keypoint : keypoints) {
-    min_x = std::min(min_x, keypoint.pt.x), max_x = std::max(max_x, keypoint.pt.x);
-    min_y = std::min(min_y, keypoint.pt.y), max_y = std::max(max_y, keypoint.pt.y);
+FeatureExtent ExtentOf(const std::vector<cv::Point2f>& points) {
+  if (points.empty()) return {};
+  float min_x = points[0].x, max_x = min_x, min_y = points[0].y, max_y = min_y;
+  for (const cv::Point2f& point : points) {
+    min_x = std::min(min_x, point.x), max_x = std::max(max_x, point.x);
+    min_y = std::min(min_y, point.y), max_y = std::max(max_y, point.y);
   }
   const double width = std::max(1.0f, max_x - min_x), height = std::max(1.0f, max_y - min_y);
   return {width * height, std::hypot(width, height)};
@@ -145,6 +139,7 @@ bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method) 
 bool PlaceOptions::IsValid(std::string* error) const {
   return OptionCheck(error)
              .InRange("place.max_features", max_features, 8, 100000)
+             .Holds("place.descriptor_bits", descriptor_bits, descriptor_bits == 4 || descriptor_bits == 8, "4 or 8")
              .InRange("place.candidates", candidates, 1, 1000)
              .InRange("place.exclude_recent_s", exclude_recent_s, 0.0, 1e10)
              .InRange("place.exclude_recent_images", exclude_recent_images, 0, 1000000)
@@ -166,25 +161,36 @@ PlaceRecognizer::PlaceRecognizer(const vocab::Vocabulary* vocabulary, const Plac
   PATROLMAP_CHECK(vocabulary != nullptr && !vocabulary->empty() && vocabulary->dimension() == 128);
 }
 
-void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::vector<cv::KeyPoint>* keypoints,
+void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::vector<cv::Point2f>* points,
                       cv::Mat* descriptors) {
   cv::Ptr<cv::SIFT> sift = cv::SIFT::create(options.max_features);
-  sift->detectAndCompute(image, cv::noArray(), *keypoints, *descriptors);
+  std::vector<cv::KeyPoint> keypoints;
+  sift->detectAndCompute(image, cv::noArray(), keypoints, *descriptors);
+  cv::KeyPoint::convert(keypoints, *points);
   if (descriptors->empty()) *descriptors = cv::Mat(0, 128, CV_32F);
   if (options.root_sift) ToRootSift(descriptors);
 }
 
-Verification PlaceRecognizer::Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
-                                     const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& options) {
+  if (!options.compact_descriptors) return descriptors;
+  cv::Mat bytes;  // RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is
+  descriptors.convertTo(bytes, CV_8U, options.root_sift ? 255.0 : 1.0);
+  return options.descriptor_bits == 4 ? vocab::PackDescriptors(bytes) : bytes;
+}
+
+Verification PlaceRecognizer::Verify(const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
+                                     const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
                                      const std::vector<std::uint32_t>* query_groups,
                                      const std::vector<std::uint32_t>* candidate_groups) const {
   return VerifyPair(options_, query_points, query, candidate_points, candidate, query_groups, candidate_groups);
 }
 
-Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
-                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
-                        const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups,
+Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point2f>& query_points,
+                        const cv::Mat& query_descriptors, const std::vector<cv::Point2f>& candidate_points,
+                        const cv::Mat& candidate_descriptors, const std::vector<std::uint32_t>* query_groups,
                         const std::vector<std::uint32_t>* candidate_groups, std::vector<std::pair<int, int>>* inliers) {
+  // Packed 4-bit rows are matched as the 8-bit values they stand for.
+  const cv::Mat query = vocab::Expanded(query_descriptors), candidate = vocab::Expanded(candidate_descriptors);
   Verification verification;
   if (inliers != nullptr) inliers->clear();
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
@@ -196,8 +202,8 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPo
   }
   std::vector<cv::Point2f> from, to;
   for (const auto& [i, j] : matches) {
-    from.push_back(query_points[i].pt);
-    to.push_back(candidate_points[j].pt);
+    from.push_back(query_points[i]);
+    to.push_back(candidate_points[j]);
   }
   verification.matches = static_cast<int>(from.size());
   verification.matched_fraction = static_cast<double>(from.size()) / std::min(query.rows, candidate.rows);
@@ -236,14 +242,15 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
 
 PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
   const Node& n = nodes_.at(node);
-  return {n.flight,    n.timestamp_ns, n.frame_index,
-          n.keypoints, n.descriptors,  database_.entry(static_cast<vocab::EntryId>(node))};
+  return {n.flight, n.timestamp_ns, n.frame_index,
+          n.points, n.descriptors,  database_.entry(static_cast<vocab::EntryId>(node))};
 }
 
 std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) const {
   // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
   cv::Mat as_float;
-  descriptors.convertTo(as_float, CV_32F, descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
+  vocab::Expanded(descriptors)
+      .convertTo(as_float, CV_32F, descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
   std::vector<vocab::WordId> words;
   vocabulary_->Quantize(as_float, &words);
   std::vector<std::uint32_t> groups;
@@ -252,8 +259,8 @@ std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) c
 }
 
 int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
-  Node node{std::move(features.flight),    features.timestamp_ns,           features.frame_index,
-            std::move(features.keypoints), std::move(features.descriptors), {}};
+  Node node{std::move(features.flight), features.timestamp_ns,           features.frame_index,
+            std::move(features.points), std::move(features.descriptors), {}};
   if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
   const int id = static_cast<int>(database_.Add(features.bow));
   nodes_.push_back(std::move(node));
@@ -267,7 +274,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   *result = PlaceResult();
   const auto start = std::chrono::steady_clock::now();
   Node node{key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, {}, {}, {}};
-  DescribeFeatures(key_frame.image, options_, &node.keypoints, &node.descriptors);
+  DescribeFeatures(key_frame.image, options_, &node.points, &node.descriptors);
   vocab::BowVector bow;
   std::vector<vocab::WordId> words;
   vocabulary_->Quantize(node.descriptors, &words);
@@ -277,7 +284,7 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
       node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
   }
   result->features = node.descriptors.rows;
-  if (options_.compact_descriptors) node.descriptors = Compact(node.descriptors, options_.root_sift);
+  node.descriptors = StoredDescriptors(node.descriptors, options_);
   result->seconds_features = Since(start);
   Recognise(key_frame, std::move(node), bow, result);
   return Status::Ok();
@@ -290,8 +297,8 @@ void PlaceRecognizer::AddDescribedKeyFrame(NodeFeatures features, bool timed, Pl
   key_frame.timestamp_ns = features.timestamp_ns;
   key_frame.frame_index = features.frame_index;
   key_frame.timed = timed;
-  Node node{std::move(features.flight),    features.timestamp_ns,           features.frame_index,
-            std::move(features.keypoints), std::move(features.descriptors), {}};
+  Node node{std::move(features.flight), features.timestamp_ns,           features.frame_index,
+            std::move(features.points), std::move(features.descriptors), {}};
   if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
   result->features = node.descriptors.rows;
   Recognise(key_frame, std::move(node), features.bow, result);
@@ -310,7 +317,7 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   for (const vocab::QueryResult& candidate : candidates) {
     const Node& other = nodes_[candidate.entry];
     const bool direct = options_.direct_index_levels_up > 0;
-    Verification verification = Verify(node.keypoints, node.descriptors, other.keypoints, other.descriptors,
+    Verification verification = Verify(node.points, node.descriptors, other.points, other.descriptors,
                                        direct ? &node.groups : nullptr, direct ? &other.groups : nullptr);
     verification.node = static_cast<int>(candidate.entry);
     verification.bow_score = candidate.score;

@@ -24,7 +24,9 @@ struct Pair {
 KeyFrameView Describe(const cv::Mat& image) {
   KeyFrameView view;
   view.image = image;
-  cv::SIFT::create(500)->detectAndCompute(image, cv::noArray(), view.keypoints, view.descriptors);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::SIFT::create(500)->detectAndCompute(image, cv::noArray(), keypoints, view.descriptors);
+  cv::KeyPoint::convert(keypoints, view.points);
   return view;
 }
 

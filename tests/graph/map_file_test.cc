@@ -45,9 +45,8 @@ TEST(MapFile, RoundTripKeepsEverything) {
     EXPECT_EQ(a.frame_index, b.frame_index);
     EXPECT_EQ(cv::norm(a.thumbnail, b.thumbnail, cv::NORM_INF), 0.0);
     EXPECT_EQ(cv::norm(a.descriptors, b.descriptors, cv::NORM_INF), 0.0);
-    ASSERT_EQ(a.keypoints.size(), b.keypoints.size());
-    EXPECT_EQ(a.keypoints[3].pt, b.keypoints[3].pt);
-    EXPECT_EQ(a.keypoints[3].angle, b.keypoints[3].angle);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    EXPECT_EQ(a.points[3], b.points[3]);
     EXPECT_EQ(a.bow.words, b.bow.words);
     EXPECT_EQ(a.bow.weights, b.bow.weights);
     EXPECT_EQ(a.gps.has_value(), b.gps.has_value());
@@ -198,6 +197,52 @@ void DowngradeEdges(std::string* bytes) {
   bytes->replace(tag, 20 + length, section + old);
 }
 
+// Rewrites the FEAT section of a saved map in the layout of format versions 1 to 7, where a feature was a
+// 24-byte keypoint record (x, y, size, angle, response, octave) instead of its 8-byte position, with its
+// checksum. `size` is written as 3, which newer readers must ignore.
+void DowngradeFeatures(std::string* bytes) {
+  const std::size_t tag = bytes->find("FEAT", 16);
+  ASSERT_NE(tag, std::string::npos);
+  std::uint64_t length = 0;
+  std::memcpy(&length, bytes->data() + tag + 4, 8);
+  const std::string payload = bytes->substr(tag + 20, length);
+  std::size_t at = 0;
+  const auto take = [&](std::size_t n) {
+    std::string piece = payload.substr(at, n);
+    at += n;
+    return piece;
+  };
+  const auto count = [&] {
+    std::uint32_t n = 0;
+    std::memcpy(&n, payload.data() + at, 4);
+    return n;
+  };
+  const std::uint32_t nodes = count();
+  std::string old = take(4);
+  for (std::uint32_t i = 0; i < nodes; ++i) {
+    const std::uint32_t points = count();
+    old += take(4);
+    for (std::uint32_t k = 0; k < points; ++k) {
+      const std::string xy = take(8);
+      const float rest[3] = {3.0f, 0.0f, 0.0f};
+      const std::int32_t octave = 0;
+      old += xy + std::string(reinterpret_cast<const char*>(rest), 12) +
+             std::string(reinterpret_cast<const char*>(&octave), 4);
+    }
+    std::int32_t mat[3];  // type, rows, cols
+    std::memcpy(mat, payload.data() + at, 12);
+    old += take(12 + static_cast<std::size_t>(mat[1]) * mat[2] * (mat[0] == CV_32F ? 4 : 1));
+    old += take(4 + 4 * static_cast<std::size_t>(count()));  // BoW words
+    old += take(4 + 4 * static_cast<std::size_t>(count()));  // BoW weights
+  }
+  ASSERT_EQ(at, payload.size());
+  const std::uint64_t old_length = old.size(), checksum = Checksum(old.data(), old.size());
+  std::string section("FEAT", 4);
+  section.append(reinterpret_cast<const char*>(&old_length), 8);
+  section.append(reinterpret_cast<const char*>(&checksum), 8);
+  bytes->replace(tag, 20 + length, section + old);
+}
+
 // The map file of `map` as an older version wrote it: the last `dropped` bytes of the one patrol record (its
 // newest fields) cut off.
 std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std::uint32_t version,
@@ -213,6 +258,7 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
   std::memcpy(bytes.data() + tag + 4, &old_length, 8);
   std::memcpy(bytes.data() + 8, &version, sizeof(version));
   testing::RecomputeMapChecksums(&bytes);
+  DowngradeFeatures(&bytes);
   return bytes;
 }
 
@@ -338,11 +384,42 @@ TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
   EXPECT_FALSE(map.Patrol("b")->timed);
 }
 
+// A version-7 map (keypoint records) loads with the positions of its features, and saves as version 8.
+TEST(MapFile, VersionSevenKeypointRecordsLoadAsPositions) {
+  testing::TempDir dir;
+  const TopoMap original = TwoFlights();
+  std::ofstream(dir / "v7.pmap", std::ios::binary) << OlderPatrolSection(original, dir / "m.pmap", 7, 0);
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "v7.pmap", &map).ok()) << LoadMap(dir / "v7.pmap", &map).message();
+  ASSERT_EQ(map.node_count(), original.node_count());
+  for (int i = 0; i < map.node_count(); ++i) {
+    EXPECT_EQ(map.node(i).points, original.node(i).points);
+    EXPECT_EQ(cv::norm(map.node(i).descriptors, original.node(i).descriptors, cv::NORM_INF), 0.0);
+  }
+  ASSERT_TRUE(SaveMap(map, dir / "again.pmap").ok());
+  EXPECT_EQ(testing::ReadText(dir / "again.pmap"), testing::ReadText(dir / "m.pmap"));
+}
+
+// Feature positions must be finite, and descriptors one of the stored kinds (vocab/descriptors.h).
+TEST(MapFile, FeaturesOfAnUnknownKindAreRefused) {
+  testing::TempDir dir;
+  for (int damage = 0; damage < 2; ++damage) {
+    TopoMap map = TwoFlights();
+    NodeData& node = map.mutable_node(1);
+    if (damage == 0) node.points[0].x = std::numeric_limits<float>::quiet_NaN();
+    if (damage == 1) node.descriptors = cv::Mat::zeros(static_cast<int>(node.points.size()), 100, CV_8U);
+    ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+    TopoMap loaded;
+    EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("features of node 1"), std::string::npos) << damage;
+  }
+}
+
 TEST(MapFile, VersionOneFilesStillLoad) {
   testing::TempDir dir;
   ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
   std::string bytes = testing::ReadText(dir / "m.pmap");
   ASSERT_NO_FATAL_FAILURE(DowngradeEdges(&bytes));
+  ASSERT_NO_FATAL_FAILURE(DowngradeFeatures(&bytes));
   const std::size_t ptrl = bytes.rfind("PTRL");
   ASSERT_NE(ptrl, std::string::npos);
   bytes.resize(ptrl);
@@ -375,7 +452,7 @@ TopoMap BigMap(int nodes) {
     NodeData node;
     node.flight = "f";
     node.thumbnail = cv::Mat(102, 160, CV_8UC1, cv::Scalar(i % 255));
-    node.keypoints.assign(200, cv::KeyPoint(1.0f, 2.0f, 3.0f));
+    node.points.assign(200, cv::Point2f(1.0f, 2.0f));
     node.descriptors = cv::Mat(200, 128, CV_8UC1);
     rng.fill(node.descriptors, cv::RNG::UNIFORM, 0, 255);
     map.AddNode(std::move(node));

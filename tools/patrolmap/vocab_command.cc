@@ -46,9 +46,9 @@ Status CollectPhotograph(const std::string& input, const pipeline::Config& confi
   cv::Mat small;
   const double scale = static_cast<double>(kPhotoWidth) / image.cols;
   cv::resize(image, small, cv::Size(), scale, scale, scale < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
-  std::vector<cv::KeyPoint> keypoints;
+  std::vector<cv::Point2f> points;
   cv::Mat descriptors;
-  place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+  place::DescribeFeatures(small, config.place, &points, &descriptors);
   images->push_back(descriptors);
   return Status::Ok();
 }
@@ -67,9 +67,9 @@ Status CollectFeatures(const std::string& input, const VocabArguments& arguments
     next = frame.index + 1;
     if (frame.image.empty() || frame.index % arguments.every != 0) continue;
     cv::resize(frame.image, small, cv::Size(), config.flow.frames.scale, config.flow.frames.scale, cv::INTER_AREA);
-    std::vector<cv::KeyPoint> keypoints;
+    std::vector<cv::Point2f> points;
     cv::Mat descriptors;
-    place::DescribeFeatures(small, config.place, &keypoints, &descriptors);
+    place::DescribeFeatures(small, config.place, &points, &descriptors);
     images->push_back(descriptors);
     progress.Update(frame.index, source->info().frame_count);
   }

@@ -26,8 +26,8 @@ namespace patrolmap::change {
 // 160 px thumbnail: 188 / 160).
 struct KeyFrameView {
   cv::Mat image;
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat descriptors;  // CV_32F or CV_8U rows (RootSIFT, 8-bit compact)
+  std::vector<cv::Point2f> points;  // feature positions
+  cv::Mat descriptors;              // float, 8-bit or packed 4-bit rows (vocab/descriptors.h)
   double feature_scale = 1.0;
 };
 

@@ -8,7 +8,9 @@
 //   sections tag (4 bytes), u64 payload length, u64 checksum of the payload, payload
 //            NODE: per node flight, time, frame, thumbnail, GPS, layout, heading
 //            EDGE: per edge the two nodes, kind and verification scores
-//            FEAT: per node keypoints, descriptors and BoW vector
+//            FEAT: per node feature positions, descriptors (float, 8-bit or packed 4-bit rows,
+//                  vocab/descriptors.h) and BoW vector (format version 8; before it, 24-byte
+//                  keypoint records, of which only the position is read)
 //            PTRL: per patrol its camera, views, object map and evidence grid
 //                  (format version 2; version 1 files have no PTRL and still load)
 // Saving is atomic (temporary file, fsync, rename): a crash never leaves a

@@ -23,9 +23,9 @@ struct NodeData {
   std::string flight;
   TimestampNs timestamp_ns = 0;
   std::int64_t frame_index = 0;
-  cv::Mat thumbnail;                    // CV_8UC1 key frame, small (for pictures and exports)
-  std::vector<cv::KeyPoint> keypoints;  // features kept so a later flight can be matched
-  cv::Mat descriptors;                  // without the original log (CV_8U or CV_32F rows)
+  cv::Mat thumbnail;                // CV_8UC1 key frame, small (for pictures and exports)
+  std::vector<cv::Point2f> points;  // feature positions [pixels] and descriptors kept so a later flight can
+  cv::Mat descriptors;              // be matched without the original log (vocab/descriptors.h)
   vocab::BowVector bow;
   std::optional<Eigen::Vector2d> gps;                // latitude, longitude [deg], when the log has them
   double heading = 0.0;                              // integrated gyro yaw at the node [rad] (0 without an IMU)

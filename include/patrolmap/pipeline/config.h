@@ -72,6 +72,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.max_log_nfa", &place.max_log_nfa);
   visitor->Field("place.accept_best", &place.accept_best);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
+  visitor->Field("place.descriptor_bits", &place.descriptor_bits);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);
   visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
   visitor->Field("place.query_words", &place.query.max_words);

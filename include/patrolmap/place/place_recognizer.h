@@ -44,9 +44,11 @@ struct PlaceOptions {
   int min_inliers = 15;
   double max_log_nfa = -30.0;  // BENCHMARKS.md: closures far from their place >= -17.2, true ones down to -30.1
   bool accept_best = false;    // verify every candidate and keep the best (paper: the first that passes)
-  // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already): a quarter
-  // of the memory per node; matching distances are computed from the 8-bit values.
+  // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already), matched as such; with
+  // descriptor_bits 4, two components a byte at steps of 7 (vocab/descriptors.h): 64 instead of 512 bytes a
+  // feature. Query and stored descriptors are quantised alike.
   bool compact_descriptors = true;
+  int descriptor_bits = 4;  // 8 or 4, when compact
   // Reject topologically implausible candidates (the paper's future work): when the previous node
   // of the query's flight closed a loop to node m, a candidate must lie on m's flight within this
   // many nodes of m along the path. 0 turns the check off.
@@ -64,8 +66,12 @@ struct PlaceOptions {
 // SIFT (or RootSIFT) features of a grey image, strongest max_features, as
 // place recognition uses them and as vocabularies are trained on. Descriptors
 // are CV_32F rows of 128 (an empty 0x128 matrix when there are none).
-void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::vector<cv::KeyPoint>* keypoints,
+void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::vector<cv::Point2f>* points,
                       cv::Mat* descriptors);
+
+// The descriptors a node keeps of DescribeFeatures' float rows: as they are, 8-bit, or packed 4-bit
+// (`compact_descriptors`, `descriptor_bits`; vocab/descriptors.h).
+cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& options);
 
 // A key frame to recognise.
 struct KeyFrame {
@@ -88,12 +94,12 @@ struct Verification {
 };
 
 // Size of the image a frame's features were found in, as verification measures it: the bounding box of
-// the keypoints (a map file keeps keypoints, not image sizes).
+// the feature positions (a map file keeps positions, not image sizes).
 struct FeatureExtent {
   double area = 1.0;      // [pixels^2]
   double diagonal = 1.0;  // [pixels]
 };
-FeatureExtent ExtentOf(const std::vector<cv::KeyPoint>& keypoints);
+FeatureExtent ExtentOf(const std::vector<cv::Point2f>& points);
 
 // The a-contrario test of ORSA / AC-RANSAC (Moisan and Stival 2004; Moisan, Moulon and Monasse 2012) for a
 // fundamental matrix F with x2^T F x1 = 0 over n matches: with the matches sorted by the probability
@@ -116,9 +122,9 @@ struct PlaceResult {
 // Verifies two described frames: ratio-test matching (within equal direct-index groups when both are given),
 // the matched-fraction rule, a fundamental matrix by `options.method`, and the inlier and a-contrario rules.
 // With `inliers`, the fundamental matrix's inlier matches as (query feature, candidate feature) pairs.
-Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::KeyPoint>& query_points,
-                        const cv::Mat& query, const std::vector<cv::KeyPoint>& candidate_points,
-                        const cv::Mat& candidate, const std::vector<std::uint32_t>* query_groups = nullptr,
+Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
+                        const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
+                        const std::vector<std::uint32_t>* query_groups = nullptr,
                         const std::vector<std::uint32_t>* candidate_groups = nullptr,
                         std::vector<std::pair<int, int>>* inliers = nullptr);
 
@@ -138,8 +144,8 @@ class PlaceRecognizer {
     std::string flight;
     TimestampNs timestamp_ns = 0;
     std::int64_t frame_index = 0;
-    std::vector<cv::KeyPoint> keypoints;
-    cv::Mat descriptors;
+    std::vector<cv::Point2f> points;  // feature positions [pixels]
+    cv::Mat descriptors;              // vocab/descriptors.h: float, 8-bit or packed 4-bit rows
     vocab::BowVector bow;
   };
   NodeFeatures Features(int node) const;
@@ -155,8 +161,8 @@ class PlaceRecognizer {
 
   // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
   // direct-index node of each feature) matching stays inside equal groups.
-  Verification Verify(const std::vector<cv::KeyPoint>& query_points, const cv::Mat& query,
-                      const std::vector<cv::KeyPoint>& candidate_points, const cv::Mat& candidate,
+  Verification Verify(const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
+                      const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
                       const std::vector<std::uint32_t>* query_groups = nullptr,
                       const std::vector<std::uint32_t>* candidate_groups = nullptr) const;
 
@@ -165,7 +171,7 @@ class PlaceRecognizer {
     std::string flight;
     TimestampNs timestamp_ns = 0;
     std::int64_t frame_index = 0;
-    std::vector<cv::KeyPoint> keypoints;
+    std::vector<cv::Point2f> points;
     cv::Mat descriptors;
     std::vector<std::uint32_t> groups;  // direct-index node of each feature (when enabled)
   };

@@ -1,0 +1,68 @@
+#include "patrolmap/vocab/descriptors.h"
+
+#include <cstdlib>
+
+#include "patrolmap/core/status.h"
+
+namespace patrolmap::vocab {
+namespace {
+
+// The nearest level of every 8-bit value (ties to the lower).
+struct LevelTable {
+  LevelTable() {
+    for (int value = 0; value < 256; ++value) {
+      int best = 0;
+      for (int level = 1; level < 16; ++level) {
+        if (std::abs(kPackedLevels[level] - value) < std::abs(kPackedLevels[best] - value)) best = level;
+      }
+      of[value] = static_cast<std::uint8_t>(best);
+    }
+  }
+  std::uint8_t of[256];
+};
+
+const LevelTable& Levels() {
+  static const LevelTable table;
+  return table;
+}
+
+}  // namespace
+
+bool IsPacked(const cv::Mat& descriptors) { return descriptors.type() == CV_8U && descriptors.cols == kPackedColumns; }
+
+cv::Mat PackDescriptors(const cv::Mat& bytes) {
+  PATROLMAP_CHECK(bytes.type() == CV_8U && bytes.cols == kDescriptorDimension);
+  const std::uint8_t* level = Levels().of;
+  cv::Mat packed(bytes.rows, kPackedColumns, CV_8U);
+  for (int row = 0; row < bytes.rows; ++row) {
+    const std::uint8_t* in = bytes.ptr<std::uint8_t>(row);
+    std::uint8_t* out = packed.ptr<std::uint8_t>(row);
+    for (int k = 0; k < kPackedColumns; ++k) {
+      out[k] = static_cast<std::uint8_t>(level[in[2 * k]] << 4 | level[in[2 * k + 1]]);
+    }
+  }
+  return packed;
+}
+
+cv::Mat Expanded(const cv::Mat& descriptors) {
+  if (!IsPacked(descriptors)) return descriptors;
+  cv::Mat bytes(descriptors.rows, kDescriptorDimension, CV_8U);
+  for (int row = 0; row < descriptors.rows; ++row) {
+    const std::uint8_t* in = descriptors.ptr<std::uint8_t>(row);
+    std::uint8_t* out = bytes.ptr<std::uint8_t>(row);
+    for (int k = 0; k < kPackedColumns; ++k) {
+      out[2 * k] = static_cast<std::uint8_t>(kPackedLevels[in[k] >> 4]);
+      out[2 * k + 1] = static_cast<std::uint8_t>(kPackedLevels[in[k] & 15]);
+    }
+  }
+  return bytes;
+}
+
+bool IsStoredDescriptorKind(const cv::Mat& descriptors) {
+  if (descriptors.empty()) return true;
+  if (descriptors.dims != 2 || descriptors.channels() != 1) return false;
+  return (descriptors.depth() == CV_32F && descriptors.cols == kDescriptorDimension) ||
+         (descriptors.depth() == CV_8U && (descriptors.cols == kDescriptorDimension || IsPacked(descriptors)));
+}
+
+}  // namespace patrolmap::vocab
