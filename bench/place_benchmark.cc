@@ -66,13 +66,14 @@ BENCHMARK(BM_KeyFrameFeaturesAndWords)->Arg(376)->Arg(752)->Unit(benchmark::kMil
 void BM_KeyFrameVerification(benchmark::State& state) {
   cv::setNumThreads(1);
   const std::vector<cv::Mat>& pair = StreetPair(static_cast<int>(state.range(0)));
-  const place::PlaceOptions options;
+  place::PlaceOptions options;
+  options.descriptor_bits = static_cast<int>(state.range(1));
   std::vector<cv::Point2f> query_points, candidate_points;
   cv::Mat query, candidate;
   place::DescribeFeatures(pair[0], options, &query_points, &query);
   place::DescribeFeatures(pair[1], options, &candidate_points, &candidate);
-  query.convertTo(query, CV_8U, 255.0);  // as the map keeps them (compact RootSIFT)
-  candidate.convertTo(candidate, CV_8U, 255.0);
+  query = place::StoredDescriptors(query, options);  // as a node keeps them
+  candidate = place::StoredDescriptors(candidate, options);
   place::Verification verification;
   for (auto _ : state) {
     verification = place::VerifyPair(options, query_points, query, candidate_points, candidate);
@@ -83,7 +84,13 @@ void BM_KeyFrameVerification(benchmark::State& state) {
                  std::to_string(static_cast<int>(verification.log_nfa)) +
                  (verification.accepted ? ", accepted" : ", rejected"));
 }
-BENCHMARK(BM_KeyFrameVerification)->Arg(376)->Arg(752)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_KeyFrameVerification)
+    ->ArgNames({"width", "bits"})
+    ->Args({376, 8})
+    ->Args({376, 4})
+    ->Args({752, 8})
+    ->Args({752, 4})
+    ->Unit(benchmark::kMillisecond);
 
 // The a-contrario test alone, for 300 matches of which 250 obey the geometry.
 void BM_LogNumberOfFalseAlarms(benchmark::State& state) {

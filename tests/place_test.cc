@@ -135,6 +135,10 @@ TEST(Verify, GraffitiPairFromOpencvDoc) {
   EXPECT_TRUE(packed.accepted) << packed.matches << " matches, " << packed.inliers << " inliers";
   EXPECT_GE(packed.matches, 0.85 * compact.matches);
   EXPECT_LE(packed.matches, 1.05 * compact.matches);
+  // A map of format 7 keeps 8-bit descriptors; a new patrol's 4-bit ones match them on the same scale.
+  const Verification mixed = recognizer.Verify(ka, ca, kb, pb);
+  EXPECT_TRUE(mixed.accepted);
+  EXPECT_GE(mixed.matches, 0.85 * compact.matches);
   // Plain SIFT (8-bit already) packed: its larger components fall on the coarse top levels.
   options.root_sift = false;
   std::vector<cv::Point2f> sa, sb;
