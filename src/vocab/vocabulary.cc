@@ -1,5 +1,6 @@
 #include "patrolmap/vocab/vocabulary.h"
 
+#include "distance.h"
 #include "patrolmap/core/checksum.h"
 
 #include <algorithm>
@@ -152,31 +153,8 @@ Status Vocabulary::Train(const std::vector<cv::Mat>& images, const VocabularyOpt
   return Status::Ok();
 }
 
-namespace {
-
-// Eight independent partial sums, so the compiler keeps them in vector registers (a single running float sum
-// is a dependency chain it may not reorder); the tail, when the dimension is not a multiple of 8, runs alone.
-float SquaredDistanceTo8Bit(const float* a, const std::uint8_t* b, int dimension) {
-  constexpr int kLanes = 8;
-  float lanes[kLanes] = {};
-  int d = 0;
-  for (; d + kLanes <= dimension; d += kLanes) {
-    for (int l = 0; l < kLanes; ++l) {
-      const float difference = a[d + l] - static_cast<float>(b[d + l]);
-      lanes[l] += difference * difference;
-    }
-  }
-  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
-  for (; d < dimension; ++d) {
-    const float difference = a[d] - static_cast<float>(b[d]);
-    sum += difference * difference;
-  }
-  return sum;
-}
-
-}  // namespace
-
 WordId Vocabulary::WordOfDescriptor(const float* descriptor, float* scaled) const {
+  const DistanceFunction distance = FastestDistance();  // AVX2 where the processor has it
   for (int d = 0; d < dimension_; ++d) scaled[d] = descriptor[d] * scale_;
   std::uint32_t node = 0;
   while (child_count_[node] > 0) {
@@ -184,8 +162,7 @@ WordId Vocabulary::WordOfDescriptor(const float* descriptor, float* scaled) cons
     std::uint32_t best = first;
     float best_distance = std::numeric_limits<float>::max();
     for (std::uint32_t child = first; child < first + child_count_[node]; ++child) {
-      const float d =
-          SquaredDistanceTo8Bit(scaled, &centres_[static_cast<std::size_t>(child) * dimension_], dimension_);
+      const float d = distance(scaled, &centres_[static_cast<std::size_t>(child) * dimension_], dimension_);
       if (d < best_distance) best_distance = d, best = child;
     }
     node = best;

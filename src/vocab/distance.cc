@@ -1,0 +1,71 @@
+#include "distance.h"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#endif
+
+namespace patrolmap::vocab {
+
+// Eight independent partial sums, so the compiler keeps them in vector registers (a single running float sum
+// is a dependency chain it may not reorder); the tail, when the dimension is not a multiple of 8, runs alone.
+float SquaredDistanceTo8Bit(const float* a, const std::uint8_t* b, int dimension) {
+  constexpr int kLanes = 8;
+  float lanes[kLanes] = {};
+  int d = 0;
+  for (; d + kLanes <= dimension; d += kLanes) {
+    for (int l = 0; l < kLanes; ++l) {
+      const float difference = a[d + l] - static_cast<float>(b[d + l]);
+      lanes[l] += difference * difference;
+    }
+  }
+  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
+  for (; d < dimension; ++d) {
+    const float difference = a[d] - static_cast<float>(b[d]);
+    sum += difference * difference;
+  }
+  return sum;
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// The same eight lanes as one AVX register: each lane subtracts, squares and adds in the same order as above,
+// and the lanes and the tail are summed as above, so the distances are the same to the bit. (AVX2 alone does
+// not fuse the multiply and the add.) GCC does not find this form itself: it keeps the lanes in pairs.
+namespace {
+
+__attribute__((target("avx2"))) float SquaredDistanceTo8BitAvx2(const float* a, const std::uint8_t* b, int dimension) {
+  __m256 sums = _mm256_setzero_ps();
+  int d = 0;
+  for (; d + 8 <= dimension; d += 8) {
+    const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(b + d));
+    const __m256 difference = _mm256_sub_ps(_mm256_loadu_ps(a + d), _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(bytes)));
+    sums = _mm256_add_ps(sums, _mm256_mul_ps(difference, difference));
+  }
+  float lanes[8];
+  _mm256_storeu_ps(lanes, sums);
+  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
+  for (; d < dimension; ++d) {
+    const float difference = a[d] - static_cast<float>(b[d]);
+    sum += difference * difference;
+  }
+  return sum;
+}
+
+}  // namespace
+
+const DistanceFunction kSquaredDistanceTo8BitAvx2 = SquaredDistanceTo8BitAvx2;
+#else
+const DistanceFunction kSquaredDistanceTo8BitAvx2 = nullptr;
+#endif
+
+// The distance this processor computes fastest, chosen once.
+DistanceFunction FastestDistance() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const DistanceFunction chosen =
+      __builtin_cpu_supports("avx2") ? SquaredDistanceTo8BitAvx2 : SquaredDistanceTo8Bit;
+  return chosen;
+#else
+  return SquaredDistanceTo8Bit;
+#endif
+}
+
+}  // namespace patrolmap::vocab
