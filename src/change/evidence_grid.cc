@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 namespace patrolmap::change {
 namespace {
@@ -333,33 +332,6 @@ bool OccupiedNeighbour(const FindVoxelIn& find, const Eigen::Vector3i& index, in
   return false;
 }
 
-// Drops the changed voxels whose hits are below `share` of a face neighbour's that changed the same way (the
-// same sign of delta): returns of the neighbour's surface that the range error put a voxel off.
-void DropRangeSpill(double share, const std::vector<int>& hits, std::vector<Eigen::Vector3i>* changed,
-                    std::vector<Eigen::Vector3d>* centres, std::vector<double>* deltas) {
-  std::unordered_map<std::uint64_t, std::size_t> at;
-  for (std::size_t i = 0; i < changed->size(); ++i) at.emplace(VoxelKey((*changed)[i]), i);
-  std::vector<bool> keep(changed->size(), true);
-  for (std::size_t i = 0; i < changed->size(); ++i) {
-    for (int axis = 0; axis < 3 && keep[i]; ++axis) {
-      for (int side : {-1, 1}) {
-        Eigen::Vector3i neighbour = (*changed)[i];
-        neighbour[axis] += side;
-        const auto found = at.find(VoxelKey(neighbour));
-        if (found == at.end() || ((*deltas)[found->second] > 0) != ((*deltas)[i] > 0)) continue;
-        if (hits[i] < share * hits[found->second]) keep[i] = false;
-      }
-    }
-  }
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < changed->size(); ++i) {
-    if (!keep[i]) continue;
-    (*changed)[kept] = (*changed)[i], (*centres)[kept] = (*centres)[i], (*deltas)[kept] = (*deltas)[i];
-    ++kept;
-  }
-  changed->resize(kept), centres->resize(kept), deltas->resize(kept);
-}
-
 // DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
 // `for_each_common` visits in `before`'s order.
 template <typename FindAfter, typename ForEachCommon>
@@ -372,7 +344,6 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
   std::vector<Eigen::Vector3i> changed;
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> deltas;
-  std::vector<int> hits;  // of each changed voxel, in the patrol where it is occupied
   const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
   for_each_common([&](const VoxelEvidence& a, const VoxelEvidence& b) {
     if (!observed(a) || !observed(b)) return;
@@ -391,9 +362,7 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     changed.push_back(index);
     centres.push_back(index.cast<double>() * size);
     deltas.push_back(delta);
-    hits.push_back(delta > 0 ? b.hits : a.hits);
   });
-  if (options.spill_hit_share > 0.0) DropRangeSpill(options.spill_hit_share, hits, &changed, &centres, &deltas);
   std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
   MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
   std::vector<std::size_t> members;         // the changed voxels of the reported regions

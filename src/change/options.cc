@@ -73,8 +73,6 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
       .InRange("change.geometry.max_free_occupancy", g.max_free_occupancy, 0.0, 1.0)
       .InRange("change.geometry.min_observations", g.min_observations, 1, 1000000)
       .InRange("change.geometry.surface_tolerance_voxels", g.surface_tolerance_voxels, 0, 10)
-      .Holds("change.geometry.spill_hit_share", g.spill_hit_share, g.spill_hit_share >= 0.0 && g.spill_hit_share < 1.0,
-             "must be a number in [0, 1)")
       .InRange("change.geometry.join_distance_m", g.join_distance_m, 0.0, 1000.0)
       .InRange("change.geometry.min_region_voxels", g.min_region_voxels, 1, 100000000)
       .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0);

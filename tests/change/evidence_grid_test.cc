@@ -251,28 +251,6 @@ TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
   EXPECT_EQ(change.regions[1].voxels, 12);
 }
 
-// A new wall face whose returns partly land a voxel in front of it (range error): the spill layer has few hits
-// beside the face's many, and spill_hit_share drops it; a second wall whose layers hold alike keeps both.
-TEST(GeometryChange, RangeSpillBesideASurfaceIsDropped) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
-  for (int x = 0; x < 6; ++x) {
-    for (int z = 1; z < 4; ++z) {
-      before.push_back({{x, 5, z}, {0, 10}}), after.push_back({{x, 5, z}, {12, 1}});           // the face
-      before.push_back({{x, 4, z}, {0, 10}}), after.push_back({{x, 4, z}, {3, 0}});            // its spill
-      before.push_back({{x + 30, 5, z}, {0, 10}}), after.push_back({{x + 30, 5, z}, {9, 1}});  // a thick wall
-      before.push_back({{x + 30, 4, z}, {0, 10}}), after.push_back({{x + 30, 4, z}, {7, 1}});
-    }
-  }
-  GeometryDiffOptions options;
-  GeometryChange change;
-  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
-  EXPECT_EQ(change.changed_voxels.size(), 72u);  // off: every layer
-  options.spill_hit_share = 0.5;
-  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
-  ASSERT_EQ(change.changed_voxels.size(), 54u);
-  for (const Eigen::Vector3i& v : change.changed_voxels) EXPECT_FALSE(v.x() < 6 && v.y() == 4) << v.transpose();
-}
-
 TEST(GeometryChange, DifferentVoxelSizesCannotBeCompared) {
   EvidenceGridData a, b;
   a.voxel_size = 0.2, b.voxel_size = 0.25;

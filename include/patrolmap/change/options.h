@@ -134,13 +134,9 @@ struct GeometryDiffOptions {
   int surface_tolerance_voxels = 1;    // no change where the free patrol has an occupied voxel this near
                                        // (a surface seen a voxel off: edges, corners); 0 = off
   bool vertical_tolerance = false;     // ... counting voxels above and below too (not only beside)
-  // Range spill: a changed voxel whose hits (in the patrol where it is occupied) are below this share of a
-  // face neighbour's, changed the same way, is taken as returns of that neighbour's surface placed a voxel off
-  // by the depth's range error (stereo), and dropped. 0 = off.
-  double spill_hit_share = 0.0;
-  double join_distance_m = 1.0;     // a changed voxel joins a region whose centroid is this close
-  int min_region_voxels = 10;       // smaller regions are dropped as outliers, ...
-  double min_region_width_m = 0.4;  // ... and so are narrower ones (a lone column of voxels at an edge)
+  double join_distance_m = 1.0;        // a changed voxel joins a region whose centroid is this close
+  int min_region_voxels = 10;          // smaller regions are dropped as outliers, ...
+  double min_region_width_m = 0.4;     // ... and so are narrower ones (a lone column of voxels at an edge)
 };
 
 // Frames kept along the route in the patrol record (RouteFrame): the change report's before and after

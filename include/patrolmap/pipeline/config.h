@@ -132,7 +132,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);
   visitor->Field("change.geometry.surface_tolerance_voxels", &change.geometry.surface_tolerance_voxels);
   visitor->Field("change.geometry.vertical_tolerance", &change.geometry.vertical_tolerance);
-  visitor->Field("change.geometry.spill_hit_share", &change.geometry.spill_hit_share);
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
   visitor->Field("change.geometry.min_region_voxels", &change.geometry.min_region_voxels);
   visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
