@@ -8,7 +8,8 @@
 # STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
 # STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series;
 # NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
-# scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images.
+# scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images;
+# EXTRA_CONFIG=FILE appends FILE's keys (not flow: or depth:) to the study's configuration.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/change_study}
@@ -29,6 +30,7 @@ if [ -n "${STEREO_KEYS:-}" ]; then  # STEREO_KEYS="edge_radius_px=2 edge_jump_px
   printf '  stereo:\n' >> "$config"
   for pair in $STEREO_KEYS; do printf '    %s: %s\n' "${pair%%=*}" "${pair#*=}" >> "$config"; done
 fi
+[ -n "${EXTRA_CONFIG:-}" ] && cat "$EXTRA_CONFIG" >> "$config"  # EXTRA_CONFIG=FILE: more keys (not flow: or depth:)
 run_series() {  # name route seed extra-simulate-options...
   local name=$1 route=$2 seed=$3
   shift 3
