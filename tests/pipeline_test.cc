@@ -374,7 +374,7 @@ TEST(DetectEndToEnd, LogOnDiskToOutputFiles) {
   EXPECT_TRUE(result.derotated);
   EXPECT_EQ(result.frames_read, source->info().frame_count);
   EXPECT_EQ(static_cast<std::int64_t>(result.samples.size()), (result.frames_read + 4) / 5);
-  ASSERT_TRUE(WriteDetectionOutputs(result, dir / "out", {{1.0, 2.0}}).ok());
+  ASSERT_TRUE(WriteDetectionOutputs(result, dir / "out", PlotTruth{{1.0, 2.0}, {}, {}}).ok());
   const std::string nodes = testing::ReadText(dir / "out/key_locations.csv");
   EXPECT_EQ(nodes.substr(0, nodes.find('\n')), "node,timestamp_ns,frame_index,response,kind");
   EXPECT_EQ(static_cast<std::size_t>(std::count(nodes.begin(), nodes.end(), '\n')), result.key_locations.size() + 1);
