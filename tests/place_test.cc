@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <Eigen/Core>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -104,6 +105,40 @@ TEST(PackedDescriptors, RealComponentsFitTheLevels) {
       total += static_cast<double>(bytes.total());
     }
     EXPECT_LE(above / total, root_sift ? 0.0 : 0.001) << (root_sift ? "RootSIFT" : "SIFT");
+  }
+}
+
+// The 8-bit nearest-two search gives cv::BFMatcher's two nearest rows and distances, to the bit, on real
+// descriptors (8-bit and expanded 4-bit), and on rows with equal distances (the lower row first, as OpenCV).
+TEST(PackedDescriptors, NearestTwoIsBruteForceMatchersResult) {
+  const cv::Mat one = cv::imread(kOpencvData + "/graf1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat three = cv::imread(kOpencvData + "/graf3.png", cv::IMREAD_GRAYSCALE);
+  if (one.empty() || three.empty()) GTEST_SKIP() << "opencv-doc not installed";
+  PlaceOptions options;
+  std::vector<cv::Point2f> points;
+  cv::Mat fa, fb;
+  DescribeFeatures(one, options, &points, &fa);
+  DescribeFeatures(three, options, &points, &fb);
+  cv::Mat ties(6, 128, CV_8U, cv::Scalar(20));
+  ties.row(3).setTo(cv::Scalar(21));  // rows 0-2 and 4-5 equally near to a query of 20s
+  for (const int bits : {8, 4}) {
+    options.descriptor_bits = bits;
+    const cv::Mat a = vocab::Expanded(StoredDescriptors(fa, options)),
+                  b = vocab::Expanded(StoredDescriptors(fb, options));
+    for (const auto& [query, train] : {std::pair(a, b), std::pair(ties.rowRange(0, 1), ties)}) {
+      std::vector<std::vector<cv::DMatch>> knn;
+      cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, knn, 2);
+      std::vector<vocab::NearestTwo> nearest;
+      vocab::FindNearestTwo(query, train, &nearest);
+      ASSERT_EQ(nearest.size(), knn.size());
+      for (std::size_t i = 0; i < knn.size(); ++i) {
+        ASSERT_EQ(knn[i].size(), 2u);
+        EXPECT_EQ(nearest[i].first, knn[i][0].trainIdx) << bits << " bits, row " << i;
+        EXPECT_EQ(nearest[i].second, knn[i][1].trainIdx) << bits << " bits, row " << i;
+        EXPECT_EQ(nearest[i].first_distance, knn[i][0].distance) << bits << " bits, row " << i;
+        EXPECT_EQ(nearest[i].second_distance, knn[i][1].distance) << bits << " bits, row " << i;
+      }
+    }
   }
 }
 

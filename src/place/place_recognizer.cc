@@ -61,6 +61,16 @@ void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& q
 }
 
 void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std::vector<std::pair<int, int>>* matches) {
+  if (query.type() == CV_8U && candidate.type() == CV_8U) {  // as a node keeps them: BFMatcher's result, faster
+    std::vector<vocab::NearestTwo> nearest;
+    vocab::FindNearestTwo(query, candidate, &nearest);
+    for (int i = 0; i < query.rows; ++i) {
+      const vocab::NearestTwo& pair = nearest[i];
+      if (pair.second < 0 || pair.first_distance >= ratio * pair.second_distance) continue;
+      matches->emplace_back(i, pair.first);
+    }
+    return;
+  }
   std::vector<std::vector<cv::DMatch>> knn;
   cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
   for (const auto& pair : knn) {

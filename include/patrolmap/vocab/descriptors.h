@@ -29,4 +29,17 @@ cv::Mat Expanded(const cv::Mat& descriptors);
 // Whether a stored descriptor matrix has one of the three kinds above (for readers of map files).
 bool IsStoredDescriptorKind(const cv::Mat& descriptors);
 
+// The two rows of `train` nearest to a row of `query` by Euclidean distance, the nearer first (on equal
+// distances the lower row); -1 and infinity where `train` has fewer rows.
+struct NearestTwo {
+  int first = -1, second = -1;
+  float first_distance = 0.0f, second_distance = 0.0f;
+};
+
+// NearestTwo of every row of `query` among the rows of `train`, both 8-bit rows of 128. The squared distances
+// are summed exactly in integers (AVX2 where the processor has it), then square-rooted in float: the distances
+// and the order of cv::BFMatcher(cv::NORM_L2).knnMatch(query, train, k = 2), whose 8-bit loop OpenCV 4.6 runs
+// one component at a time.
+void FindNearestTwo(const cv::Mat& query, const cv::Mat& train, std::vector<NearestTwo>* nearest);
+
 }  // namespace patrolmap::vocab
