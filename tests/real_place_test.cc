@@ -50,13 +50,14 @@ struct PairCounts {
 // same place of one set.
 PairCounts VerifyAllPairs(const std::vector<Described>& images, const PlaceOptions& options = PlaceOptions()) {
   PairCounts counts;
+  std::vector<cv::Mat> stored;
+  for (const Described& image : images) stored.push_back(StoredDescriptors(image.descriptors, options));
   for (std::size_t i = 0; i < images.size(); ++i) {
     for (std::size_t j = i + 1; j < images.size(); ++j) {
       const Described& a = images[i];
       const Described& b = images[j];
       const bool revisit = a.set == b.set && a.place >= 0 && a.place == b.place;
-      const Verification v = VerifyPair(options, a.points, StoredDescriptors(a.descriptors, options), b.points,
-                                        StoredDescriptors(b.descriptors, options));
+      const Verification v = VerifyPair(options, a.points, stored[i], b.points, stored[j]);
       const bool fifty = v.inliers >= 50;
       if (revisit || v.matches >= 8) {
         std::printf("%-16s %-16s %s features %4d/%4d matches %4d inliers %4d log NFA %8.1f %s\n", a.name.c_str(),

@@ -5,10 +5,7 @@
 #include <cstdlib>
 #include <limits>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
-#endif
-
+#include "distance.h"
 #include "patrolmap/core/status.h"
 
 namespace patrolmap::vocab {
@@ -65,52 +62,10 @@ cv::Mat Expanded(const cv::Mat& descriptors) {
   return bytes;
 }
 
-namespace {
-
-using SquaredDistanceFunction = std::uint32_t (*)(const std::uint8_t* a, const std::uint8_t* b);
-
-std::uint32_t SquaredDistance(const std::uint8_t* a, const std::uint8_t* b) {
-  std::uint32_t sum = 0;
-  for (int k = 0; k < kDescriptorDimension; ++k) {
-    const int difference = static_cast<int>(a[k]) - static_cast<int>(b[k]);
-    sum += static_cast<std::uint32_t>(difference * difference);
-  }
-  return sum;
-}
-
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-// The same sum, sixteen components at a time: widened to 16 bits, subtracted, and squared and added in pairs
-// into 32-bit lanes (vpmaddwd). Integer sums are exact, so it equals the loop above.
-__attribute__((target("avx2"))) std::uint32_t SquaredDistanceAvx2(const std::uint8_t* a, const std::uint8_t* b) {
-  __m256i sums = _mm256_setzero_si256();
-  for (int k = 0; k < kDescriptorDimension; k += 16) {
-    const __m256i x = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k)));
-    const __m256i y = _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k)));
-    const __m256i difference = _mm256_sub_epi16(x, y);
-    sums = _mm256_add_epi32(sums, _mm256_madd_epi16(difference, difference));
-  }
-  const __m128i half = _mm_add_epi32(_mm256_castsi256_si128(sums), _mm256_extracti128_si256(sums, 1));
-  const __m128i quarter = _mm_add_epi32(half, _mm_shuffle_epi32(half, _MM_SHUFFLE(1, 0, 3, 2)));
-  const __m128i total = _mm_add_epi32(quarter, _mm_shuffle_epi32(quarter, _MM_SHUFFLE(2, 3, 0, 1)));
-  return static_cast<std::uint32_t>(_mm_cvtsi128_si32(total));
-}
-#endif
-
-SquaredDistanceFunction FastestSquaredDistance() {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const SquaredDistanceFunction chosen = __builtin_cpu_supports("avx2") ? SquaredDistanceAvx2 : SquaredDistance;
-  return chosen;
-#else
-  return SquaredDistance;
-#endif
-}
-
-}  // namespace
-
 void FindNearestTwo(const cv::Mat& query, const cv::Mat& train, std::vector<NearestTwo>* nearest) {
   PATROLMAP_CHECK(query.type() == CV_8U && train.type() == CV_8U && query.cols == kDescriptorDimension &&
                   train.cols == kDescriptorDimension);
-  const SquaredDistanceFunction distance = FastestSquaredDistance();
+  const ByteDistanceFunction distance = FastestByteDistance();
   constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   nearest->assign(query.rows, NearestTwo());
   for (int i = 0; i < query.rows; ++i) {

@@ -1,9 +1,12 @@
-// Internal: the squared Euclidean distance from a float descriptor to an 8-bit vocabulary centre, the inner
-// loop of quantisation. Two builds of it, portable and AVX2, give the same value to the bit, so a vocabulary
-// gives the same words on any x86-64 processor.
+// Internal: the squared Euclidean distances of the descriptor inner loops, each built portable and with AVX2,
+// the two giving the same value to the bit, so results do not depend on the processor.
+// - From a float descriptor to an 8-bit vocabulary centre: quantisation.
+// - Between two 8-bit descriptors of 128 components, summed exactly in integers: matching (FindNearestTwo).
 #pragma once
 
 #include <cstdint>
+
+#include "patrolmap/vocab/descriptors.h"
 
 namespace patrolmap::vocab {
 
@@ -16,5 +19,11 @@ extern const DistanceFunction kSquaredDistanceTo8BitAvx2;
 
 // The fastest of the two this processor runs, chosen once.
 DistanceFunction FastestDistance();
+
+using ByteDistanceFunction = std::uint32_t (*)(const std::uint8_t* a, const std::uint8_t* b);
+
+std::uint32_t SquaredByteDistance(const std::uint8_t* a, const std::uint8_t* b);
+extern const ByteDistanceFunction kSquaredByteDistanceAvx2;  // nullptr as above
+ByteDistanceFunction FastestByteDistance();
 
 }  // namespace patrolmap::vocab

@@ -178,6 +178,17 @@ TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
   EXPECT_NE(LoadBytes(version_zero).find("version 0 is not one patrolmap wrote"), std::string::npos);
 }
 
+// Replaces the payload of the section whose tag starts at `tag` with `payload`, with its length and checksum.
+void ReplaceSection(std::string* bytes, std::size_t tag, const std::string& payload) {
+  std::uint64_t length = 0;
+  std::memcpy(&length, bytes->data() + tag + 4, 8);
+  const std::uint64_t new_length = payload.size(), checksum = Checksum(payload.data(), payload.size());
+  std::string section = bytes->substr(tag, 4);
+  section.append(reinterpret_cast<const char*>(&new_length), 8);
+  section.append(reinterpret_cast<const char*>(&checksum), 8);
+  bytes->replace(tag, 20 + length, section + payload);
+}
+
 // A version 1 file (before patrol records): header version 1, three sections, no PTRL.
 // Rewrites the EDGE section of a saved map in the layout of format versions 1 and 2 (edge records without
 // log_nfa), with its checksum.
@@ -190,11 +201,7 @@ void DowngradeEdges(std::string* bytes) {
   constexpr std::size_t kOld = 29, kNew = 37;  // a, b, kind, bow score, matched fraction, inliers (+ log_nfa)
   std::string old = payload.substr(0, 4);
   for (std::size_t at = 4; at + kNew <= payload.size(); at += kNew) old += payload.substr(at, kOld);
-  const std::uint64_t old_length = old.size(), checksum = Checksum(old.data(), old.size());
-  std::string section("EDGE", 4);
-  section.append(reinterpret_cast<const char*>(&old_length), 8);
-  section.append(reinterpret_cast<const char*>(&checksum), 8);
-  bytes->replace(tag, 20 + length, section + old);
+  ReplaceSection(bytes, tag, old);
 }
 
 // Rewrites the FEAT section of a saved map in the layout of format versions 1 to 7, where a feature was a
@@ -236,11 +243,7 @@ void DowngradeFeatures(std::string* bytes) {
     old += take(4 + 4 * static_cast<std::size_t>(count()));  // BoW weights
   }
   ASSERT_EQ(at, payload.size());
-  const std::uint64_t old_length = old.size(), checksum = Checksum(old.data(), old.size());
-  std::string section("FEAT", 4);
-  section.append(reinterpret_cast<const char*>(&old_length), 8);
-  section.append(reinterpret_cast<const char*>(&checksum), 8);
-  bytes->replace(tag, 20 + length, section + old);
+  ReplaceSection(bytes, tag, old);
 }
 
 // The map file of `map` as an older version wrote it: the last `dropped` bytes of the one patrol record (its

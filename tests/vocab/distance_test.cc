@@ -1,5 +1,6 @@
 #include "../src/vocab/distance.h"
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -32,6 +33,29 @@ TEST(QuantiserDistance, Avx2GivesThePortableValueToTheBit) {
     }
   }
   EXPECT_EQ(FastestDistance(), kSquaredDistanceTo8BitAvx2);
+}
+
+// The matcher's 8-bit distance: the AVX2 build equals the portable one (exact integer sums), from equal rows
+// to the largest possible distance.
+TEST(MatcherDistance, Avx2GivesThePortableSum) {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (kSquaredByteDistanceAvx2 == nullptr || !__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 here";
+#else
+  GTEST_SKIP() << "no AVX2 build";
+#endif
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::vector<std::uint8_t> a(kDescriptorDimension), b(kDescriptorDimension);
+  for (int trial = 0; trial < 2000; ++trial) {
+    for (std::size_t k = 0; k < a.size(); ++k)
+      a[k] = static_cast<std::uint8_t>(byte(rng)), b[k] = static_cast<std::uint8_t>(byte(rng));
+    ASSERT_EQ(kSquaredByteDistanceAvx2(a.data(), b.data()), SquaredByteDistance(a.data(), b.data()));
+  }
+  std::fill(a.begin(), a.end(), 0), std::fill(b.begin(), b.end(), 255);
+  EXPECT_EQ(SquaredByteDistance(a.data(), b.data()), 128u * 255u * 255u);
+  EXPECT_EQ(kSquaredByteDistanceAvx2(a.data(), b.data()), 128u * 255u * 255u);
+  EXPECT_EQ(kSquaredByteDistanceAvx2(a.data(), a.data()), 0u);
+  EXPECT_EQ(FastestByteDistance(), kSquaredByteDistanceAvx2);
 }
 
 }  // namespace
