@@ -78,6 +78,7 @@ geo = [0, 0, 0]
 app = [0, 0, 0, 0]  # regions, on a change, visible changes, found
 route = [0, 0, 0, 0, 0, 0]  # changes, on a change, visible, found, frames, compared pairs
 lighting_route = 0  # changes reported on lighting-only patrols
+lost_at = {}  # route: per step, the object changes not found whose furthest region it dropped
 for r in lines:
     c = r["changes"]
     states = c.get("objects", {})
@@ -101,6 +102,8 @@ for r in lines:
             route[i] += ro[k]
         if r["series"] == "lighting-only":
             lighting_route += ro["changes"]
+        for step, n in ro.get("lost_at", {}).items():
+            lost_at[step] = lost_at.get(step, 0) + n
         row.append(f"route {ro['changes_on_change']}/{ro['changes']} on changes, {ro['found']}/{ro['visible']} found, {ro['pairs']}/{ro['frames']} frames")
     row.append(f"places {c['places_changed']}/{c['places_compared']} changed")
     print("  ".join(row))
@@ -128,7 +131,9 @@ r = route[3] / route[2] if route[2] else 0.0
 share = route[5] / route[4] if route[4] else 0.0
 summary["route"] = {"changes": route[0], "changes_on_change": route[1], "visible": route[2], "found": route[3],
                     "frames": route[4], "pairs": route[5], "precision": p, "recall": r, "compared_share": share,
-                    "lighting_only_changes": lighting_route}
+                    "lighting_only_changes": lighting_route, "lost_at": lost_at}
 print(f"  route      {route[1]}/{route[0]} changes on object changes (P {p:.2f}), {route[3]}/{route[2]} visible changes found (R {r:.2f}), {share:.0%} of the route compared, {lighting_route} changes on lighting-only patrols")
+if lost_at:
+    print("             not found, lost at: " + ", ".join(f"{k} {v}" for k, v in sorted(lost_at.items())))
 json.dump(summary, open(out + "/summary.json", "w"), indent=1)
 PY

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -305,6 +306,31 @@ TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
   KeepInOverlap(shift, 160, 100, &kept);
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_GT(kept[0].x, prior[0].x);
+}
+
+// Object changes visible in two compared pairs of route frames; one reported change, and candidates that were
+// dropped at different steps. Each change not found is counted once, at the furthest step any candidate on it
+// reached in any pair.
+TEST(ChangeScore, RouteChangesNotFoundAreCountedAtTheirFurthestStep) {
+  const cv::Rect2d a(10, 10, 20, 20), b(60, 10, 20, 20), c(110, 10, 20, 20), d(10, 60, 20, 20), off(200, 200, 5, 5);
+  // Pair 0: prior shows 1 (removed) and 2; current shows 3 (new). Pair 1: prior shows 2 again, current shows 4.
+  const std::vector<RoutePairTruth> truth = {{{{1, a}, {2, b}}, {{3, c}}}, {{{2, b}}, {{4, d}}}};
+  ReportedRouteChange reported;  // on 1, in pair 0
+  reported.pairs = {0};
+  reported.boxes = {{a, off}};
+  const std::vector<RouteCandidate> candidates = {
+      {0, {b, off}, 1, "early"},  // on 2 in pair 0 ...
+      {1, {b, off}, 3, "late"},   // ... and further in pair 1
+      {0, {a, off}, 0, "first"},  // on 1, which is found anyway
+      {1, {off, c}, 3, "late"},   // on nothing: 3 is visible in pair 0, not 1
+      {7, {off, d}, 3, "late"},   // a pair that was not scored
+  };
+  const RouteScore score = ScoreRoute(truth, {reported}, candidates, ChangeScoreOptions{});
+  EXPECT_EQ(score.visible, 4);
+  EXPECT_EQ(score.found, 1);
+  EXPECT_EQ(score.changes_on_truth, 1);
+  const std::map<std::string, int> expected = {{"late", 1}, {"no_region", 2}};  // 2 late; 3 and 4 none
+  EXPECT_EQ(score.lost_at, expected);
 }
 
 }  // namespace

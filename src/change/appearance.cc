@@ -183,6 +183,17 @@ std::vector<bool> TouchingEdge(const cv::Mat& labels, int count, const cv::Mat& 
   return touching;
 }
 
+const char* DropReasonName(DropReason reason) {
+  switch (reason) {
+    case DropReason::kThin: return "thin";
+    case DropReason::kAtPriorEdge: return "at_prior_edge";
+    case DropReason::kFeaturesStillMatch: return "features_still_match";
+    case DropReason::kShiftedCopy: return "shifted_copy";
+    case DropReason::kNotSeenFromSecondPrior: return "not_seen_from_second_prior";
+  }
+  return "unknown";
+}
+
 bool KeepsUnmatchedShare(const AppearanceRegion& region, const AppearanceOptions& options) {
   const int features = region.prior_features + region.current_features;
   const int unmatched = region.unmatched_prior_features + region.unmatched_current_features;
@@ -262,9 +273,16 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
     if (region.area_px < min_area) continue;
     region.current_box = cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                                   stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    if (std::min(region.current_box.width, region.current_box.height) < min_side) continue;  // a seam, not a thing
-    if (at_edge[label]) continue;  // the prior frame ends there: what it shows is cut or smeared
     region.prior_box = PriorBox(region.current_box, h, prior.image.size());
+    const auto drop = [&](DropReason reason) { result.dropped.push_back({region, reason}); };
+    if (std::min(region.current_box.width, region.current_box.height) < min_side) {
+      drop(DropReason::kThin);  // a seam, not a thing
+      continue;
+    }
+    if (at_edge[label]) {
+      drop(DropReason::kAtPriorEdge);  // the prior frame ends there: what it shows is cut or smeared
+      continue;
+    }
     region.score = cv::mean(local, labels == label)[0];
     const cv::Rect2f box(region.current_box);
     for (std::size_t k = 0; k < prior_in_current.size(); ++k) {
@@ -277,10 +295,14 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       ++region.current_features;
       region.unmatched_current_features += !matched_current[k];
     }
-    if (!KeepsUnmatchedShare(region, options)) continue;
+    if (!KeepsUnmatchedShare(region, options)) {
+      drop(DropReason::kFeaturesStillMatch);
+      continue;
+    }
     if (ShiftedSimilarity(current_f, warped, region.current_box, options.parallax_search_px) >
         options.max_shifted_similarity) {
-      continue;  // the same content a few pixels off: parallax, not change
+      drop(DropReason::kShiftedCopy);  // the same content a few pixels off: parallax, not change
+      continue;
     }
     result.regions.push_back(region);
   }

@@ -106,14 +106,21 @@ double Coverage(const cv::Mat& current_from_prior, const cv::Size& prior_size, c
 }
 
 // Keeps the regions of `change` that a comparison of the same current frame with a second prior frame also
-// found (a region overlapping by `min_overlap`): what differs only from one viewpoint is parallax.
+// found (a region overlapping by `min_overlap`): what differs only from one viewpoint is parallax. The others
+// move to the dropped ones.
 void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, AppearanceChange* change) {
-  const auto alone = [&](const AppearanceRegion& r) {
-    return std::none_of(second.regions.begin(), second.regions.end(), [&](const AppearanceRegion& s) {
+  std::vector<AppearanceRegion> kept;
+  for (AppearanceRegion& r : change->regions) {
+    const bool seen = std::any_of(second.regions.begin(), second.regions.end(), [&](const AppearanceRegion& s) {
       return OverlapOfSmaller(r.current_box, s.current_box) >= min_overlap;
     });
-  };
-  change->regions.erase(std::remove_if(change->regions.begin(), change->regions.end(), alone), change->regions.end());
+    if (seen) {
+      kept.push_back(std::move(r));
+    } else {
+      change->dropped.push_back({std::move(r), DropReason::kNotSeenFromSecondPrior});
+    }
+  }
+  change->regions = std::move(kept);
 }
 
 // A current frame's partner and the runner-up, registered.

@@ -374,7 +374,7 @@ double RouteScore::Precision() const { return Ratio(changes_on_truth, changes); 
 double RouteScore::Recall() const { return Ratio(found, visible); }
 
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
-                      const ChangeScoreOptions& options) {
+                      const std::vector<RouteCandidate>& candidates, const ChangeScoreOptions& options) {
   RouteScore score;
   // Every object change visible in some compared pair, on either side: (side, object id) -> found.
   std::map<std::pair<bool, int>, bool> visible;
@@ -403,6 +403,23 @@ RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vecto
   score.visible = static_cast<int>(visible.size());
   score.found =
       static_cast<int>(std::count_if(visible.begin(), visible.end(), [](const auto& entry) { return entry.second; }));
+  std::map<std::pair<bool, int>, const RouteCandidate*> furthest;  // per object change not found
+  for (const RouteCandidate& candidate : candidates) {
+    if (candidate.pair < 0 || candidate.pair >= static_cast<int>(truth.size())) continue;
+    for (const bool prior : {true, false}) {
+      const cv::Rect2d& box = prior ? candidate.boxes.prior : candidate.boxes.current;
+      for (const VisibleChange& c : prior ? truth[candidate.pair].prior : truth[candidate.pair].current) {
+        if (visible[{prior, c.id}] || !Overlaps(box, c.box, options.min_overlap)) continue;
+        const RouteCandidate*& best = furthest[{prior, c.id}];
+        if (best == nullptr || candidate.step > best->step) best = &candidate;
+      }
+    }
+  }
+  for (const auto& [change, found] : visible) {
+    if (found) continue;
+    const auto it = furthest.find(change);
+    ++score.lost_at[it != furthest.end() ? it->second->step_name : "no_region"];
+  }
   return score;
 }
 

@@ -127,7 +127,16 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
     EXPECT_GT(r.prior_features + r.current_features, 0);
     EXPECT_LT(r.unmatched_prior_features + r.unmatched_current_features, 0.5 * (r.prior_features + r.current_features));
   }
-  EXPECT_TRUE(DetectAppearanceChange(Describe(scene), Describe(current), AppearanceOptions{}).regions.empty());
+  const AppearanceChange defaults = DetectAppearanceChange(Describe(scene), Describe(current), AppearanceOptions{});
+  EXPECT_TRUE(defaults.regions.empty());
+  ASSERT_FALSE(defaults.dropped.empty());  // they are listed as dropped, with the test that dropped them
+  for (const DroppedRegion& d : defaults.dropped) {
+    EXPECT_TRUE(d.reason == DropReason::kFeaturesStillMatch || d.reason == DropReason::kShiftedCopy ||
+                d.reason == DropReason::kThin)
+        << DropReasonName(d.reason);
+  }
+  EXPECT_TRUE(std::any_of(defaults.dropped.begin(), defaults.dropped.end(),
+                          [](const DroppedRegion& d) { return d.reason == DropReason::kFeaturesStillMatch; }));
   // Each test alone drops them too: the features still match, and the content is there a few pixels off.
   AppearanceOptions features_only = keep_all, shift_only = keep_all;
   features_only.min_unmatched_share = 0.5;

@@ -236,6 +236,32 @@ void KeepInside(const Eigen::Matrix3d& to_other, const cv::Size& size, std::vect
                  changes->end());
 }
 
+// The regions of the scored pairs that no change reports, with the step that dropped them: the appearance
+// tests in their order, then the second prior frame, then the vote.
+std::vector<eval::RouteCandidate> RouteCandidates(const change::RouteComparison& route,
+                                                  const std::vector<bool>& scored) {
+  std::vector<std::vector<bool>> voted(route.pairs.size());
+  for (std::size_t i = 0; i < route.pairs.size(); ++i) voted[i].assign(route.pairs[i].appearance.regions.size(), false);
+  for (const change::RouteChange& change : route.changes) {
+    for (const change::RouteChange::View& v : change.views) voted[v.pair][v.region] = true;
+  }
+  std::vector<eval::RouteCandidate> candidates;
+  const auto add = [&](int pair, const change::AppearanceRegion& region, int step, const std::string& name) {
+    candidates.push_back({pair, {region.prior_box, region.current_box}, step, name});
+  };
+  constexpr int kNotVotedStep = static_cast<int>(change::DropReason::kNotSeenFromSecondPrior) + 1;
+  for (std::size_t i = 0; i < route.pairs.size(); ++i) {
+    if (!scored[i]) continue;
+    const change::AppearanceChange& appearance = route.pairs[i].appearance;
+    for (const change::DroppedRegion& d : appearance.dropped)
+      add(static_cast<int>(i), d.region, static_cast<int>(d.reason), change::DropReasonName(d.reason));
+    for (std::size_t r = 0; r < appearance.regions.size(); ++r) {
+      if (!voted[i][r]) add(static_cast<int>(i), appearance.regions[r], kNotVotedStep, "not_voted");
+    }
+  }
+  return candidates;
+}
+
 // Appearance along the route of the recomputed report against the object changes visible in its compared pairs.
 void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
                   const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
@@ -270,7 +296,7 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
     }
     reported.push_back(r);
   }
-  const eval::RouteScore score = eval::ScoreRoute(truth, reported, options);
+  const eval::RouteScore score = eval::ScoreRoute(truth, reported, RouteCandidates(report.route, scored), options);
   (*result)["route"] = {{"frames", report.route.current_frames},
                         {"pairs", report.route.pairs.size()},
                         {"compared_share", report.route.ComparedShare()},
@@ -279,7 +305,8 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
                         {"visible", score.visible},
                         {"found", score.found},
                         {"precision", score.Precision()},
-                        {"recall", score.Recall()}};
+                        {"recall", score.Recall()},
+                        {"lost_at", score.lost_at}};
 }
 
 // Changes of RUN (changes.json, and the grids in map.pmap) against the two flights' ground truth.
@@ -385,6 +412,12 @@ void PrintChangeTable(const nlohmann::json& c) {
         r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
         r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
         r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
+    if (r.contains("lost_at") && !r["lost_at"].empty()) {
+      std::string lost;
+      for (const auto& [step, count] : r["lost_at"].items())
+        lost += (lost.empty() ? "" : ", ") + step + " " + std::to_string(count.get<int>());
+      std::printf("route: the changes not found were lost at: %s\n", lost.c_str());
+    }
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);

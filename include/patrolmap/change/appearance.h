@@ -42,6 +42,21 @@ struct AppearanceRegion {
   int unmatched_current_features = 0;  // ... of which no prior feature matches
 };
 
+// Why a region of changed pixels was not kept, in the order the tests run.
+enum class DropReason {
+  kThin,                    // thinner than min_side_fraction: a seam at a depth edge
+  kAtPriorEdge,             // within edge_margin_px of where the registered prior frame ends
+  kFeaturesStillMatch,      // under min_unmatched_share of its features lost their match (parallax)
+  kShiftedCopy,             // the prior shows its content up to parallax_search_px off (parallax)
+  kNotSeenFromSecondPrior,  // along the route: a second prior frame shows no region there
+};
+const char* DropReasonName(DropReason reason);  // snake case, as in the evaluation's JSON
+
+struct DroppedRegion {
+  AppearanceRegion region;
+  DropReason reason = DropReason::kThin;
+};
+
 struct AppearanceChange {
   bool registered = false;
   int matches = 0, inliers = 0;
@@ -49,6 +64,9 @@ struct AppearanceChange {
   double compared_fraction = 0.0;         // share of the current image the registered prior covers
   cv::Mat homography;                     // current_from_prior, image pixels (CV_64F 3x3)
   std::vector<AppearanceRegion> regions;  // largest first
+  // The regions that were dropped, and why (those under min_area_fraction are not listed): `eval` tells from
+  // them where a change that was not reported was lost.
+  std::vector<DroppedRegion> dropped;
 };
 
 // Whether a changed region is kept by its features: a region without features is; one with features only

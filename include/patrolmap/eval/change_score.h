@@ -160,13 +160,24 @@ struct ReportedRouteChange {
   std::vector<int> pairs;          // per view: the compared pair (index into the truth)
   std::vector<RegionBoxes> boxes;  // ... and its boxes in the pair's two frames
 };
+// A region the comparison found in a pair and did not report, with the step that dropped it: a higher `step`
+// came later in the comparison; `step_name` names it.
+struct RouteCandidate {
+  int pair = -1;  // index into the truth
+  RegionBoxes boxes;
+  int step = 0;
+  std::string step_name;
+};
 struct RouteScore {
   int changes = 0, changes_on_truth = 0;
   int visible = 0, found = 0;
+  // Per object change visible and not found: the name of the furthest step a candidate lying on it reached, in
+  // any pair ("no_region" when none lay on it). Where recall is lost.
+  std::map<std::string, int> lost_at;
   double Precision() const;
   double Recall() const;
 };
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
-                      const ChangeScoreOptions& options);
+                      const std::vector<RouteCandidate>& candidates, const ChangeScoreOptions& options);
 
 }  // namespace patrolmap::eval
