@@ -149,12 +149,13 @@ cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const 
 }
 
 // The best normalised cross-correlation (free of gain and offset) of the current image's `box` with the
-// registered prior image shifted by up to `radius` pixels: near 1 when the region shows what the prior
-// showed a little further on (parallax off the registered plane).
-double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv::Rect& box, int radius) {
+// registered prior image shifted by up to `across` pixels horizontally and `radius` vertically: near 1 when the
+// region shows what the prior showed a little further on (parallax off the registered plane, or background
+// the prior shows beside a nearer edge that hides it here).
+double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv::Rect& box, int across, int radius) {
   const cv::Rect image(0, 0, current.cols, current.rows);
   const cv::Rect search =
-      cv::Rect(box.x - radius, box.y - radius, box.width + 2 * radius, box.height + 2 * radius) & image;
+      cv::Rect(box.x - across, box.y - radius, box.width + 2 * across, box.height + 2 * radius) & image;
   if (box.width < 3 || box.height < 3 || search.width < box.width || search.height < box.height) return 0.0;
   cv::Mat scores;
   cv::matchTemplate(prior(search), current(box), scores, cv::TM_CCOEFF_NORMED);
@@ -299,7 +300,8 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       drop(DropReason::kFeaturesStillMatch);
       continue;
     }
-    if (ShiftedSimilarity(current_f, warped, region.current_box, options.parallax_search_px) >
+    const int across = std::max(options.parallax_search_px, options.horizontal_parallax_search_px);
+    if (ShiftedSimilarity(current_f, warped, region.current_box, across, options.parallax_search_px) >
         options.max_shifted_similarity) {
       drop(DropReason::kShiftedCopy);  // the same content a few pixels off: parallax, not change
       continue;

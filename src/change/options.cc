@@ -19,6 +19,7 @@ void CheckAppearance(const AppearanceOptions& a, OptionCheck* check) {
       .InRange("change.appearance.min_side_fraction", a.min_side_fraction, 0.0, 1.0)
       .InRange("change.appearance.min_unmatched_share", a.min_unmatched_share, 0.0, 1.0)
       .InRange("change.appearance.parallax_search_px", a.parallax_search_px, 0, 100)
+      .InRange("change.appearance.horizontal_parallax_search_px", a.horizontal_parallax_search_px, 0, 200)
       .InRange("change.appearance.max_shifted_similarity", a.max_shifted_similarity, -1.0, 1.0)
       .InRange("change.appearance.edge_margin_px", a.edge_margin_px, 0, 1000)
       .InRange("change.appearance.max_flow_px", a.max_flow_px, 0.0, 1000.0);

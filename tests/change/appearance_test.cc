@@ -145,6 +145,30 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
   EXPECT_LT(DetectAppearanceChange(Describe(scene), Describe(current), shift_only).regions.size(), all.regions.size());
 }
 
+// A block of the scene seen 18 px further left than the rest (a nearer facade, or background beside a nearer edge):
+// the prior shows its content 18 px off horizontally, beyond parallax_search_px but within
+// horizontal_parallax_search_px, so the shift test drops it; searched only 8 px, it is kept.
+TEST(Appearance, ContentThePriorShowsFurtherAlongTheRowIsParallax) {
+  cv::Mat scene = Scene(5);
+  cv::Mat current = scene.clone();
+  const cv::Rect block(60, 36, 40, 40);
+  scene(block + cv::Point(18, 0)).copyTo(current(block));
+  AppearanceOptions options;
+  options.min_unmatched_share = 0.0;  // only the shift test decides
+  const auto on_block = [&](const AppearanceChange& change) {
+    return std::count_if(change.regions.begin(), change.regions.end(),
+                         [&](const AppearanceRegion& r) { return (r.current_box & block).area() > 0; });
+  };
+  const AppearanceChange defaults = DetectAppearanceChange(Describe(scene), Describe(current), options);
+  ASSERT_TRUE(defaults.registered);
+  EXPECT_EQ(on_block(defaults), 0);
+  EXPECT_TRUE(std::any_of(defaults.dropped.begin(), defaults.dropped.end(), [&](const DroppedRegion& d) {
+    return d.reason == DropReason::kShiftedCopy && (d.region.current_box & block).area() > 0;
+  }));
+  options.horizontal_parallax_search_px = 8;
+  EXPECT_GT(on_block(DetectAppearanceChange(Describe(scene), Describe(current), options)), 0);
+}
+
 TEST(Appearance, ARegionIsKeptAtItsUnmatchedShareAndDroppedBelowIt) {
   AppearanceOptions options;  // min_unmatched_share 0.5
   AppearanceRegion region;

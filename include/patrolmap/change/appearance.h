@@ -47,7 +47,7 @@ enum class DropReason {
   kThin,                    // thinner than min_side_fraction: a seam at a depth edge
   kAtPriorEdge,             // within edge_margin_px of where the registered prior frame ends
   kFeaturesStillMatch,      // under min_unmatched_share of its features lost their match (parallax)
-  kShiftedCopy,             // the prior shows its content up to parallax_search_px off (parallax)
+  kShiftedCopy,             // the prior shows its content a few pixels off (parallax_search_px; parallax)
   kNotSeenFromSecondPrior,  // along the route: a second prior frame shows no region there
 };
 const char* DropReasonName(DropReason reason);  // snake case, as in the evaluation's JSON

@@ -24,8 +24,11 @@ struct AppearanceOptions {
                                         // their match between the key frames (parallax, not change)
   int parallax_search_px = 8;           // ... and regions whose content the registered prior image shows, up to
   double max_shifted_similarity = 0.6;  // this far off, with a normalised cross-correlation above this, ...
-  int edge_margin_px = 1;               // ... and regions within this far of where the registered prior frame
-                                        // ends inside the current one (0: kept)
+  // ... and horizontally up to this far (at least parallax_search_px): the patrols' paths lie side by side, and
+  // background a nearer edge hides in one frame shows beside that edge in the other.
+  int horizontal_parallax_search_px = 24;
+  // ... and regions within this far of where the registered prior frame ends inside the current one (0: kept).
+  int edge_margin_px = 1;
   // After the homography, register the pair locally by dense optical flow (DIS), so parallax off the
   // homography's plane does not differ; flows longer than max_flow_px are not followed.
   bool dense_flow = false;

@@ -92,6 +92,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.appearance.min_side_fraction", &change.appearance.min_side_fraction);
   visitor->Field("change.appearance.min_unmatched_share", &change.appearance.min_unmatched_share);
   visitor->Field("change.appearance.parallax_search_px", &change.appearance.parallax_search_px);
+  visitor->Field("change.appearance.horizontal_parallax_search_px", &change.appearance.horizontal_parallax_search_px);
   visitor->Field("change.appearance.max_shifted_similarity", &change.appearance.max_shifted_similarity);
   visitor->Field("change.appearance.edge_margin_px", &change.appearance.edge_margin_px);
   visitor->Field("change.appearance.dense_flow", &change.appearance.dense_flow);
