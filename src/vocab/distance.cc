@@ -57,16 +57,16 @@ const DistanceFunction kSquaredDistanceTo8BitAvx2 = SquaredDistanceTo8BitAvx2;
 const DistanceFunction kSquaredDistanceTo8BitAvx2 = nullptr;
 #endif
 
-// The distance this processor computes fastest, chosen once.
-DistanceFunction FastestDistance() {
+bool Avx2Available() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const DistanceFunction chosen =
-      __builtin_cpu_supports("avx2") ? SquaredDistanceTo8BitAvx2 : SquaredDistanceTo8Bit;
-  return chosen;
+  static const bool available = __builtin_cpu_supports("avx2");
+  return available;
 #else
-  return SquaredDistanceTo8Bit;
+  return false;
 #endif
 }
+
+DistanceFunction FastestDistance() { return Avx2Available() ? kSquaredDistanceTo8BitAvx2 : SquaredDistanceTo8Bit; }
 
 std::uint32_t SquaredByteDistance(const std::uint8_t* a, const std::uint8_t* b) {
   std::uint32_t sum = 0;
@@ -103,14 +103,6 @@ const ByteDistanceFunction kSquaredByteDistanceAvx2 = SquaredByteDistanceAvx2;
 const ByteDistanceFunction kSquaredByteDistanceAvx2 = nullptr;
 #endif
 
-ByteDistanceFunction FastestByteDistance() {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const ByteDistanceFunction chosen =
-      __builtin_cpu_supports("avx2") ? SquaredByteDistanceAvx2 : SquaredByteDistance;
-  return chosen;
-#else
-  return SquaredByteDistance;
-#endif
-}
+ByteDistanceFunction FastestByteDistance() { return Avx2Available() ? kSquaredByteDistanceAvx2 : SquaredByteDistance; }
 
 }  // namespace patrolmap::vocab

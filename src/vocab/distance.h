@@ -17,7 +17,10 @@ float SquaredDistanceTo8Bit(const float* a, const std::uint8_t* b, int dimension
 // GCC's target attribute). Call it only where the processor has AVX2.
 extern const DistanceFunction kSquaredDistanceTo8BitAvx2;
 
-// The fastest of the two this processor runs, chosen once.
+// Whether this build has the AVX2 loops and this processor runs them (asked once).
+bool Avx2Available();
+
+// The fastest of the two this processor runs.
 DistanceFunction FastestDistance();
 
 using ByteDistanceFunction = std::uint32_t (*)(const std::uint8_t* a, const std::uint8_t* b);

@@ -13,11 +13,7 @@ namespace {
 // The AVX2 build of the quantiser's distance gives the portable build's value to the bit (so words do not
 // depend on the processor), for SIFT's 128 components and for a dimension with a tail.
 TEST(QuantiserDistance, Avx2GivesThePortableValueToTheBit) {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  if (kSquaredDistanceTo8BitAvx2 == nullptr || !__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 here";
-#else
-  GTEST_SKIP() << "no AVX2 build";
-#endif
+  if (!Avx2Available()) GTEST_SKIP() << "no AVX2 build, or no AVX2 on this processor";
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> value(0.0f, 255.0f);
   std::uniform_int_distribution<int> byte(0, 255);
@@ -38,11 +34,7 @@ TEST(QuantiserDistance, Avx2GivesThePortableValueToTheBit) {
 // The matcher's 8-bit distance: the AVX2 build equals the portable one (exact integer sums), from equal rows
 // to the largest possible distance.
 TEST(MatcherDistance, Avx2GivesThePortableSum) {
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  if (kSquaredByteDistanceAvx2 == nullptr || !__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 here";
-#else
-  GTEST_SKIP() << "no AVX2 build";
-#endif
+  if (!Avx2Available()) GTEST_SKIP() << "no AVX2 build, or no AVX2 on this processor";
   std::mt19937 rng(9);
   std::uniform_int_distribution<int> byte(0, 255);
   std::vector<std::uint8_t> a(kDescriptorDimension), b(kDescriptorDimension);
