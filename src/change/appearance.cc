@@ -138,6 +138,40 @@ void FollowFlow(const cv::Mat& current, double gain, double offset, double max_f
   *warped = resampled;
 }
 
+// Fits up to max_planes - 1 more homographies, each to the matches (`from` -> `to`) that no plane before
+// explains; a plane needs min_inliers of them. `explained` holds the first plane's inliers.
+std::vector<cv::Mat> FitMorePlanes(const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to,
+                                   std::vector<unsigned char> explained, const AppearanceOptions& options) {
+  std::vector<cv::Mat> planes;
+  for (int plane = 1; plane < options.max_planes; ++plane) {
+    std::vector<cv::Point2f> rest_from, rest_to;
+    std::vector<std::size_t> index;
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      if (explained[i]) continue;
+      rest_from.push_back(from[i]);
+      rest_to.push_back(to[i]);
+      index.push_back(i);
+    }
+    if (static_cast<int>(index.size()) < std::max(4, options.min_inliers)) break;
+    std::vector<unsigned char> inlier;
+    cv::Mat h = cv::findHomography(rest_from, rest_to, cv::RANSAC, options.inlier_threshold_px, inlier, 2000, 0.999);
+    if (h.empty() || cv::countNonZero(inlier) < options.min_inliers) break;
+    for (std::size_t k = 0; k < index.size(); ++k) explained[index[k]] |= inlier[k];
+    planes.push_back(h);
+  }
+  return planes;
+}
+
+// The prior image carried onto the current one's `size` by `current_from_prior`, and where it lands (eroded by
+// `margin` pixels: the comparisons there need that much of it around).
+void WarpPrior(const cv::Mat& prior, const cv::Mat& current_from_prior, const cv::Size& size, int margin,
+               cv::Mat* warped, cv::Mat* mask) {
+  cv::warpPerspective(prior, *warped, current_from_prior, size, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::warpPerspective(cv::Mat(prior.size(), CV_8U, cv::Scalar(255)), *mask, current_from_prior, size,
+                      cv::INTER_NEAREST);
+  cv::erode(*mask, *mask, cv::Mat(), cv::Point(-1, -1), margin);
+}
+
 cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const cv::Size& prior_size) {
   std::vector<cv::Point2f> corners = {box.tl(),
                                       {static_cast<float>(box.br().x), static_cast<float>(box.y)},
@@ -213,7 +247,9 @@ Registration Register(const KeyFrameView& prior, const KeyFrameView& current, co
   std::vector<unsigned char> inlier;
   cv::Mat h = cv::findHomography(from, to, cv::RANSAC, options.inlier_threshold_px, inlier, 2000, 0.999);
   registration.inliers = h.empty() ? 0 : cv::countNonZero(inlier);
-  if (!h.empty()) registration.current_from_prior = h;
+  if (h.empty()) return registration;
+  registration.current_from_prior = h;
+  registration.more_planes = FitMorePlanes(from, to, inlier, options);
   return registration;
 }
 
@@ -240,10 +276,8 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
     cv::GaussianBlur(prior_f, prior_f, cv::Size(), options.blur_sigma_px);
     cv::GaussianBlur(current_f, current_f, cv::Size(), options.blur_sigma_px);
   }
-  cv::warpPerspective(prior_f, warped, h, current_f.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-  cv::warpPerspective(cv::Mat(prior_f.size(), CV_8U, cv::Scalar(255)), mask, h, current_f.size(), cv::INTER_NEAREST);
   const int margin = options.search_radius_px + 2;
-  cv::erode(mask, mask, cv::Mat(), cv::Point(-1, -1), margin);
+  WarpPrior(prior_f, h, current_f.size(), margin, &warped, &mask);
   const int compared = cv::countNonZero(mask);
   result.compared_fraction = static_cast<double>(compared) / mask.total();
   if (compared == 0) return result;
@@ -251,8 +285,18 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
   if (options.dense_flow) FollowFlow(current_f, result.gain, result.offset, options.max_flow_px, &warped);
 
   const int r = options.search_radius_px;
-  const cv::Mat global = SmallestDifference(current_f, warped * result.gain + result.offset, r);
-  const cv::Mat local = 1.0 - BestStructure(current_f, warped, r, options.structure_sigma_px);
+  cv::Mat global = SmallestDifference(current_f, warped * result.gain + result.offset, r);
+  cv::Mat local = 1.0 - BestStructure(current_f, warped, r, options.structure_sigma_px);
+  std::vector<cv::Mat> warps = {warped};                   // the prior through each plane
+  for (const cv::Mat& plane : registration.more_planes) {  // where another plane registers better, it counts
+    cv::Mat plane_mask;
+    warps.emplace_back();
+    WarpPrior(prior_f, plane, current_f.size(), margin, &warps.back(), &plane_mask);
+    const cv::Mat other = SmallestDifference(current_f, warps.back() * result.gain + result.offset, r);
+    cv::Mat(cv::min(global, other)).copyTo(global, plane_mask);
+    const cv::Mat other_local = 1.0 - BestStructure(current_f, warps.back(), r, options.structure_sigma_px);
+    cv::Mat(cv::min(local, other_local)).copyTo(local, plane_mask);
+  }
   cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
   cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), options.closing_px);
   cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
@@ -301,8 +345,11 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       continue;
     }
     const int across = std::max(options.parallax_search_px, options.horizontal_parallax_search_px);
-    if (ShiftedSimilarity(current_f, warped, region.current_box, across, options.parallax_search_px) >
-        options.max_shifted_similarity) {
+    const bool shifted = std::any_of(warps.begin(), warps.end(), [&](const cv::Mat& w) {
+      return ShiftedSimilarity(current_f, w, region.current_box, across, options.parallax_search_px) >
+             options.max_shifted_similarity;
+    });
+    if (shifted) {
       drop(DropReason::kShiftedCopy);  // the same content a few pixels off: parallax, not change
       continue;
     }

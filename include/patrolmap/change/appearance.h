@@ -80,6 +80,8 @@ struct Registration {
   std::vector<cv::DMatch> matches;
   int inliers = 0;
   cv::Mat current_from_prior;  // image pixels, CV_64F 3x3
+  // Further planes (AppearanceOptions::max_planes), each fitted to the matches no plane before explains.
+  std::vector<cv::Mat> more_planes;
 };
 Registration Register(const KeyFrameView& prior, const KeyFrameView& current, const AppearanceOptions& options);
 

@@ -33,6 +33,10 @@ struct AppearanceOptions {
   // homography's plane does not differ; flows longer than max_flow_px are not followed.
   bool dense_flow = false;
   double max_flow_px = 12.0;
+  // Planes registered per pair: after the dominant homography, further ones are fitted to the matches none
+  // before explains (each needs min_inliers), and each pixel is compared through the plane that registers it
+  // best: a facade and the ground, or a nearer building, seen with parallax. 1: the dominant plane only.
+  int max_planes = 1;
 };
 
 // Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
