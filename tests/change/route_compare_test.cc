@@ -108,6 +108,34 @@ TEST(RouteCompare, ARegionInOneFrameOnlyIsNotReported) {
   for (const RouteChange& change : single.changes) EXPECT_EQ(single.pairs[change.views[0].pair].current, 6);
 }
 
+// The second prior frame confirms a region when it finds one there too; where it does not show the region whole, it
+// cannot confirm it, and the region is kept.
+TEST(RouteCompare, ARegionIsDroppedOnlyWhereTheSecondPriorFrameShowsItAndFindsNothing) {
+  AppearanceRegion left, right;
+  left.current_box = cv::Rect(10, 100, 40, 40);
+  right.current_box = cv::Rect(250, 100, 40, 40);
+  AppearanceChange change;
+  change.regions = {left, right};
+  AppearanceChange second;  // its prior frame lands 100 px to the right: columns 100-475 of the current frame
+  second.registered = true;
+  second.homography = (cv::Mat_<double>(3, 3) << 1, 0, 100, 0, 1, 0, 0, 0, 1);
+  const cv::Size size(kFrameWidth, kFrameHeight);
+  AppearanceChange unconfirmed = change;
+  KeepSeenFromBoth(second, size, 0.3, &unconfirmed);
+  ASSERT_EQ(unconfirmed.regions.size(), 1u);  // the left one: the second prior frame does not show it
+  EXPECT_EQ(unconfirmed.regions[0].current_box, left.current_box);
+  ASSERT_EQ(unconfirmed.dropped.size(), 1u);
+  EXPECT_EQ(unconfirmed.dropped[0].region.current_box, right.current_box);
+  EXPECT_EQ(unconfirmed.dropped[0].reason, DropReason::kNotSeenFromSecondPrior);
+  AppearanceRegion found;  // the second comparison found the right one too, a little off
+  found.current_box = cv::Rect(260, 105, 40, 40);
+  second.regions = {found};
+  AppearanceChange confirmed = change;
+  KeepSeenFromBoth(second, size, 0.3, &confirmed);
+  EXPECT_EQ(confirmed.regions.size(), 2u);
+  EXPECT_TRUE(confirmed.dropped.empty());
+}
+
 TEST(RouteCompare, OneThreadOrSeveralGiveTheSameComparison) {
   const cv::Mat facade = Facade(7);
   cv::Mat changed = facade.clone();

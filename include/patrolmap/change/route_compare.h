@@ -57,6 +57,13 @@ struct RouteComparison {
   double ComparedShare() const;
 };
 
+// Keeps the regions of `change` that a comparison of the same current frame with a second prior frame (of
+// `second_size`) also found (a region overlapping by `min_overlap` of the smaller box): what differs only from one
+// viewpoint is parallax. A region the second prior frame does not show whole cannot be confirmed and is kept. The
+// others move to change->dropped (kNotSeenFromSecondPrior).
+void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
+                      AppearanceChange* change);
+
 // The route frame decoded (grey), with its SIFT features; feature_scale 1.
 KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features);
 
