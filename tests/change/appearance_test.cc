@@ -106,20 +106,34 @@ TEST(Appearance, ARegionWhereThePriorFrameEndsIsDroppedWithAnEdgeMargin) {
   EXPECT_FALSE(found(at_edge));
 }
 
+// A scene with a textured area, and the current view of it in which the block kNearerBlock of that area is seen 7 px
+// off the rest (a nearer facade, off the plane of the rest).
+const cv::Rect kNearerBlock(50, 30, 60, 60);
+void NearerBlock(cv::Mat* scene, cv::Mat* current) {
+  *scene = Scene(5);
+  cv::Mat texture(60, 80, CV_8UC1);
+  cv::setRNGSeed(8);  // the same texture whatever test ran before
+  cv::randu(texture, 0, 255);
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
+  texture.copyTo((*scene)(cv::Rect(40, 30, 80, 60)));
+  *current = scene->clone();
+  (*scene)(kNearerBlock - cv::Point(7, 0)).copyTo((*current)(kNearerBlock));
+}
+
+// Options that keep every region the pixels form: neither the feature test nor the shift test drops one.
+AppearanceOptions WithoutRegionTests() {
+  AppearanceOptions options;
+  options.min_unmatched_share = 0.0;
+  options.max_shifted_similarity = 1.1;
+  return options;
+}
+
 TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
   // A textured block of the scene seen 7 px off the rest (a nearer facade, off the registered plane): its
   // pixels differ beyond the search radius, but its features match their prior selves.
-  cv::Mat scene = Scene(5);
-  cv::Mat texture(60, 80, CV_8UC1);
-  cv::randu(texture, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
-  texture.copyTo(scene(cv::Rect(40, 30, 80, 60)));
-  cv::Mat current = scene.clone();
-  const cv::Rect block(50, 30, 60, 60);
-  scene(block - cv::Point(7, 0)).copyTo(current(block));
-  AppearanceOptions keep_all;
-  keep_all.min_unmatched_share = 0.0;
-  keep_all.max_shifted_similarity = 1.1;
+  cv::Mat scene, current;
+  NearerBlock(&scene, &current);
+  const AppearanceOptions keep_all = WithoutRegionTests();
   const AppearanceChange all = DetectAppearanceChange(Describe(scene), Describe(current), keep_all);
   ASSERT_TRUE(all.registered);
   ASSERT_FALSE(all.regions.empty());  // the registration cannot fit both planes: pixels differ somewhere
@@ -149,18 +163,9 @@ TEST(Appearance, ARegionWhoseFeaturesStillMatchIsParallaxNotChange) {
 // differs. A second plane, fitted to the matches the first leaves, registers that too: with max_planes 2 no region
 // is left, even with both region tests off.
 TEST(Appearance, ASecondPlaneRegistersANearerBlock) {
-  cv::Mat scene = Scene(5);
-  cv::Mat texture(60, 80, CV_8UC1);
-  cv::setRNGSeed(1);  // the same texture whatever ran before (passes for seeds 1-12)
-  cv::randu(texture, 0, 255);
-  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.2);
-  texture.copyTo(scene(cv::Rect(40, 30, 80, 60)));
-  cv::Mat current = scene.clone();
-  const cv::Rect block(50, 30, 60, 60);
-  scene(block - cv::Point(7, 0)).copyTo(current(block));
-  AppearanceOptions one_plane;
-  one_plane.min_unmatched_share = 0.0;
-  one_plane.max_shifted_similarity = 1.1;
+  cv::Mat scene, current;
+  NearerBlock(&scene, &current);
+  const AppearanceOptions one_plane = WithoutRegionTests();
   const KeyFrameView prior = Describe(scene), now = Describe(current);
   const Registration single = Register(prior, now, one_plane);
   EXPECT_TRUE(single.more_planes.empty());
