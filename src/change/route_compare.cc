@@ -105,17 +105,6 @@ double Coverage(const cv::Mat& current_from_prior, const cv::Size& prior_size, c
   return size.area() > 0 ? area / size.area() : 0.0;
 }
 
-// Whether the prior frame of `comparison` (of `prior_size`, registered onto the current one) shows all of `box`.
-bool Covers(const AppearanceChange& comparison, const cv::Size& prior_size, const cv::Rect& box) {
-  const std::vector<cv::Point2f> corners = {cv::Point2f(box.x, box.y), cv::Point2f(box.x + box.width, box.y),
-                                            cv::Point2f(box.x + box.width, box.y + box.height),
-                                            cv::Point2f(box.x, box.y + box.height)};
-  std::vector<cv::Point2f> in_prior;
-  cv::perspectiveTransform(corners, in_prior, comparison.homography.inv());
-  const cv::Rect2f image(0.0f, 0.0f, static_cast<float>(prior_size.width), static_cast<float>(prior_size.height));
-  return std::all_of(in_prior.begin(), in_prior.end(), [&](const cv::Point2f& p) { return image.contains(p); });
-}
-
 // A current frame's partner and the runner-up, registered.
 struct Alignment {
   int current = -1;
@@ -177,6 +166,12 @@ cv::Rect2d MapBox(const cv::Rect& box, const cv::Mat& homography) {
   std::vector<cv::Point2f> mapped;
   cv::perspectiveTransform(corners, mapped, homography);
   return cv::boundingRect(mapped);
+}
+
+// Whether the prior frame of `comparison` (of `prior_size`, registered onto the current one) shows all of `box`.
+bool Covers(const AppearanceChange& comparison, const cv::Size& prior_size, const cv::Rect& box) {
+  const cv::Rect2d in_prior = MapBox(box, comparison.homography.inv());
+  return (in_prior & cv::Rect2d(0.0, 0.0, prior_size.width, prior_size.height)) == in_prior;
 }
 
 int Find(std::vector<int>* parent, int i) {
