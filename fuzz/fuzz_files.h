@@ -27,16 +27,31 @@ inline void Quiet() {
   (void)quiet;
 }
 
+// The scratch folder of this process, removed when the process ends (the corpus replay of scripts/test.sh
+// would otherwise leave one per harness in $TMPDIR).
+class ScratchFolder {
+ public:
+  ScratchFolder()
+      : path_(std::filesystem::temp_directory_path() / ("patrolmap_fuzz_" + std::to_string(getpid()))) {}
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 // A folder that exists for this process: $TMPDIR/patrolmap_fuzz_<pid>, emptied on each call. Logging is
 // off from the first call on.
 inline std::filesystem::path FreshFolder() {
-  namespace fs = std::filesystem;
   Quiet();
-  static const fs::path folder = fs::temp_directory_path() / ("patrolmap_fuzz_" + std::to_string(getpid()));
+  static const ScratchFolder folder;
   std::error_code ignored;
-  fs::remove_all(folder, ignored);
-  fs::create_directories(folder);
-  return folder;
+  std::filesystem::remove_all(folder.path(), ignored);
+  std::filesystem::create_directories(folder.path());
+  return folder.path();
 }
 
 inline void WriteBytes(const std::filesystem::path& path, std::string_view bytes) {
