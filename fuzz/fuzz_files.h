@@ -31,8 +31,7 @@ inline void Quiet() {
 // would otherwise leave one per harness in $TMPDIR).
 class ScratchFolder {
  public:
-  ScratchFolder()
-      : path_(std::filesystem::temp_directory_path() / ("patrolmap_fuzz_" + std::to_string(getpid()))) {}
+  ScratchFolder() : path_(std::filesystem::temp_directory_path() / ("patrolmap_fuzz_" + std::to_string(getpid()))) {}
   ~ScratchFolder() {
     std::error_code ignored;
     std::filesystem::remove_all(path_, ignored);

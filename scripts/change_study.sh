@@ -9,7 +9,9 @@
 # STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series;
 # NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images;
-# EXTRA_CONFIG=FILE appends FILE's keys (not flow: or depth:) to the study's configuration.
+# EXTRA_CONFIG=FILE appends FILE's keys (not flow: or depth:) to the study's configuration; POSES=gps maps with
+# camera poses from GPS and the IMU's attitude (state_groundtruth_estimate0/ moved aside while mapping; GPS_NOISE
+# and ATTITUDE_NOISE set the simulator's noise, the origin lies on the grid so eval scores in the same frame).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/change_study}
@@ -25,6 +27,16 @@ config="$out/study.yaml"
 printf 'flow:\n  frames:\n    scale: %s\n' "${SCALE:-1.0}" > "$config"
 simulate_extra=()
 [ -n "${STEREO:-}" ] && simulate_extra+=(--stereo "$STEREO")
+if [ "${POSES:-}" = gps ]; then
+  simulate_extra+=(--gps --gps-origin 47.4 8.4 0 --gps-noise "${GPS_NOISE:-1.5}" --attitude-noise "${ATTITUDE_NOISE:-0.5}")
+fi
+hide_state() {  # folder suffix: POSES=gps moves the state estimate aside while mapping, back for eval
+  [ "${POSES:-}" = gps ] || return 0
+  for flight in "$1"/logs/flight_*; do
+    [ -d "$flight/state_groundtruth_estimate0$2" ] && mv "$flight/state_groundtruth_estimate0$2" "$flight/state_groundtruth_estimate0$3"
+  done
+  return 0
+}
 printf 'depth:\n  source: %s\n' "${DEPTH:-auto}" >> "$config"
 if [ -n "${STEREO_KEYS:-}" ]; then  # STEREO_KEYS="edge_radius_px=2 edge_jump_px=2": depth.stereo options
   printf '  stereo:\n' >> "$config"
@@ -46,10 +58,14 @@ run_series() {  # name route seed extra-simulate-options...
       [ -d "$flight/objects0" ] && mv "$flight/objects0" "$flight/objects0.hidden"
     done
   fi
+  hide_state "$dir" "" .hidden
   "$pm" map "$dir/logs/flight_1" --out "$dir/run_1" -c "$config" >/dev/null 2>&1
   for n in 2 3; do
     "$pm" patrol "$dir/logs/flight_$n" --map "$dir/run_$((n - 1))/map.pmap" --out "$dir/run_$n" -c "$config" \
       2>/dev/null | tail -1
+  done
+  hide_state "$dir" .hidden ""
+  for n in 2 3; do
     local logs=(--log "$dir/logs/flight_$n" --log "$dir/logs/flight_$((n - 1))")
     [ "$n" = 3 ] && logs+=(--log "$dir/logs/flight_1")
     "$pm" eval "$dir/run_$n" "${logs[@]}" -c "$config" --json |

@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bag_file.h"
+#include "gps_poses.h"
 #include "image_times.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/pose_file.h"
@@ -424,16 +425,12 @@ class BagSource : public FrameSource {
     if (samples->empty() || t > samples->back().timestamp_ns) samples->push_back({t, value});
   }
 
-  // A fix and the latest attitude as a pose: east, north, up [m] from the first fix (a plane tangent to the
-  // earth there: within centimetres over a few kilometres), turned by the IMU's attitude.
+  // A fix and the latest attitude as a pose: east, north, up [m] about the grid point nearest the first fix
+  // (gps_poses.h: every flight over a site shares the frame), turned by the IMU's attitude.
   rosmsg::PoseMessage PoseFromFix(const Eigen::Vector3d& fix) {
-    constexpr double kEarthRadiusM = 6378137.0;
-    constexpr double kRadians = M_PI / 180.0;
-    if (!gps_origin_) gps_origin_ = fix;
-    const Eigen::Vector3d& origin = *gps_origin_;
+    if (!gps_origin_) gps_origin_ = GpsFrameOrigin(fix);
     rosmsg::PoseMessage pose;
-    pose.position = Eigen::Vector3d((fix.y() - origin.y()) * kRadians * kEarthRadiusM * std::cos(origin.x() * kRadians),
-                                    (fix.x() - origin.x()) * kRadians * kEarthRadiusM, fix.z() - origin.z());
+    pose.position = EastNorthUp(fix, *gps_origin_);
     pose.rotation = *attitude_;
     return pose;
   }
@@ -534,7 +531,7 @@ class BagSource : public FrameSource {
 
   bool poses_from_gps_;
   std::optional<Eigen::Quaterniond> attitude_;  // the IMU's latest, for poses from GPS
-  std::optional<Eigen::Vector3d> gps_origin_;   // the first fix used for a pose
+  std::optional<Eigen::Vector3d> gps_origin_;   // of the poses from GPS (GpsFrameOrigin)
   LogInfo info_;
   std::unique_ptr<BagFile> bag_;
   BagRoles roles_;

@@ -35,10 +35,19 @@ Status ReadCameraTable(const std::string& log, const std::string& camera, std::v
   return Status::Ok();
 }
 
-Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples) {
-  const auto parse = [](const CsvReader& csv, const std::vector<std::string_view>& fields, ImuSample* sample) {
+// imu0/data.csv: timestamp, gyro xyz [rad/s], accelerometer xyz [m/s^2], and optionally the IMU's attitude as a
+// quaternion w, x, y, z (its axes into east, north, up: what an AHRS reports) on the rows that have it.
+Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples, std::vector<AttitudeSample>* attitude) {
+  const auto parse = [attitude](const CsvReader& csv, const std::vector<std::string_view>& fields, ImuSample* sample) {
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample->gyro));
-    return ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample->accel);
+    PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample->accel));
+    if (fields.size() < 11) return Status::Ok();
+    double q[4];
+    for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[7 + i], "q_WS (attitude)", &q[i]));
+    const Eigen::Quaterniond world_from_imu(q[0], q[1], q[2], q[3]);
+    if (!(std::abs(world_from_imu.norm() - 1.0) <= 1e-3)) return csv.Error("q_WS (attitude) is not a unit quaternion");
+    attitude->push_back({sample->timestamp_ns, world_from_imu.normalized()});
+    return Status::Ok();
   };
   return ReadTimedTable(path, 7, parse, samples);
 }
@@ -215,7 +224,7 @@ Status ReadMeta(const std::string& path, LogInfo* info) {
 }
 
 Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<ImuSample>* imu,
-                           std::vector<SpeedSample>* speeds) {
+                           std::vector<AttitudeSample>* attitude, std::vector<SpeedSample>* speeds) {
   Eigen::Matrix3d body_from_camera = Eigen::Matrix3d::Identity();
   const bool has_camera_yaml = fs::exists(log + "/cam0/sensor.yaml");
   if (has_camera_yaml) {
@@ -224,7 +233,7 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
   }
   if (fs::exists(log + "/meta.yaml")) PATROLMAP_RETURN_IF_ERROR(ReadMeta(log + "/meta.yaml", info));
   if (fs::exists(log + "/imu0/data.csv")) {
-    PATROLMAP_RETURN_IF_ERROR(ReadImuTable(log + "/imu0/data.csv", imu));
+    PATROLMAP_RETURN_IF_ERROR(ReadImuTable(log + "/imu0/data.csv", imu, attitude));
     Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();
     if (fs::exists(log + "/imu0/sensor.yaml")) {
       YAML::Node root;
@@ -250,6 +259,31 @@ Status ReadGpsTable(const std::string& path, std::vector<GpsSample>* samples) {
   return ReadTimedTable(path, 4, parse, samples);
 }
 
+// Without a state estimate: camera poses from the GPS fixes and the IMU's attitude, at the frames' times.
+void PosesFromFixes(const std::string& log, const LogInfo& info, const std::vector<GpsSample>& gps,
+                    const std::vector<AttitudeSample>& attitude, const std::vector<ImageEntry>& entries,
+                    PatrolSensors* sensors) {
+  if (!info.camera_from_imu) {
+    spdlog::warn(
+        "{}: gps0/ and imu0/'s attitude, but cam0/sensor.yaml is missing (the camera's rotation in the "
+        "IMU's frame): no camera poses from them",
+        log);
+    return;
+  }
+  std::vector<TimestampNs> times(entries.size());
+  std::transform(entries.begin(), entries.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
+  sensors->poses = PosesFromGps(gps, attitude, Eigen::Quaterniond(info.camera_from_imu->transpose()), times);
+  if (sensors->poses.empty()) {
+    spdlog::warn("{}: gps0/ and imu0/'s attitude give no camera pose: their times do not cover cam0's", log);
+    return;
+  }
+  const Eigen::Vector3d origin = GpsFrameOrigin(gps.front().position);
+  spdlog::info(
+      "{}: camera poses from gps0/ and imu0/'s attitude at {} of {} frames (east, north, up about "
+      "{:.1f}, {:.1f} degrees)",
+      log, sensors->poses.size(), entries.size(), origin.x(), origin.y());
+}
+
 }  // namespace
 
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source) {
@@ -263,10 +297,11 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   info.flight_id = CleanFlightId(info.flight_id);
   std::vector<ImageEntry> entries;
   std::vector<ImuSample> imu;
+  std::vector<AttitudeSample> attitude;
   std::vector<SpeedSample> speeds;
   std::vector<GpsSample> gps;
   PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, "cam0", &entries));
-  PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &speeds));
+  PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &attitude, &speeds));
   if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
   if (!(info.frame_rate_hz > 0.0 && std::isfinite(info.frame_rate_hz))) {
     std::vector<TimestampNs> times(entries.size());
@@ -281,6 +316,8 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   PATROLMAP_RETURN_IF_ERROR(
       ReadSensorTables(log, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), &sensors));
   PATROLMAP_RETURN_IF_ERROR(ReadStereoPairs(log, entries, &info.stereo, &sensors.stereo));
+  if (sensors.poses.empty() && !gps.empty() && !attitude.empty())
+    PosesFromFixes(log, info, gps, attitude, entries, &sensors);
   *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu), std::move(speeds),
                                               std::move(gps), std::move(sensors));
   return Status::Ok();

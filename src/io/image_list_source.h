@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "gps_poses.h"
 #include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
 
@@ -18,11 +19,6 @@ struct ImageEntry {
 struct SpeedSample {
   TimestampNs timestamp_ns = 0;
   double speed_mps = 0.0;
-};
-
-struct GpsSample {
-  TimestampNs timestamp_ns = 0;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // latitude, longitude [deg], altitude [m]
 };
 
 class ImageListSource : public FrameSource {

@@ -229,8 +229,9 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
   const bool change_data = info.has_detections || info.has_depth || info.has_stereo;
   if (change_data && !info.has_poses) {
     warnings.push_back(info.path +
-                       ": no camera poses (state_groundtruth_estimate0/data.csv, or --poses FILE: a TUM or KITTI "
-                       "pose file), so its detections and depth are not used: appearance change only");
+                       ": no camera poses (state_groundtruth_estimate0/data.csv; --poses FILE, a TUM or KITTI pose "
+                       "file; or gps0/ with the IMU's attitude in imu0/data.csv), so its detections and depth are "
+                       "not used: appearance change only");
   } else if (change_data && !info.camera) {
     warnings.push_back(info.path +
                        ": no camera intrinsics (cam0/sensor.yaml), so its detections and depth are not used: "

@@ -68,14 +68,27 @@ std::string MetaYaml(const SimulatedFlight& flight) {
   return out.str();
 }
 
-std::string ImuTable(const SimulatedFlight& flight) {
+// With GPS the IMU also reports its attitude (an AHRS): the body's rotation into east, north, up, off by a rotation
+// drawn once per flight (each axis's angle normal with attitude_noise_deg).
+std::string ImuTable(const SimulatedFlight& flight, const LogOptions& options) {
   std::ostringstream out;
   out.precision(9);
   out << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],"
-         "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+         "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]"
+      << (options.gps ? ",q_WS_w [],q_WS_x [],q_WS_y [],q_WS_z []" : "") << "\n";
+  cv::RNG rng(static_cast<std::uint64_t>(flight.lighting.noise_seed) * 89u + 7u);
+  const double sigma = options.attitude_noise_deg * M_PI / 180.0;
+  const Eigen::Vector3d error_angles(rng.gaussian(sigma), rng.gaussian(sigma), rng.gaussian(sigma));
+  const Eigen::Matrix3d error = Eigen::AngleAxisd(error_angles.norm(), error_angles.normalized()).toRotationMatrix();
   for (const ImuSample& sample : ImuSamples(flight)) {
     out << sample.timestamp_ns << "," << sample.gyro.x() << "," << sample.gyro.y() << "," << sample.gyro.z() << ","
-        << sample.accel.x() << "," << sample.accel.y() << "," << sample.accel.z() << "\n";
+        << sample.accel.x() << "," << sample.accel.y() << "," << sample.accel.z();
+    if (options.gps) {
+      const PlatformState state = flight.trajectory(static_cast<double>(sample.timestamp_ns) * 1e-9);
+      const Eigen::Quaterniond q(error * WorldFromBody(state.heading));
+      out << "," << q.w() << "," << q.x() << "," << q.y() << "," << q.z();
+    }
+    out << "\n";
   }
   return out.str();
 }
@@ -141,7 +154,8 @@ std::string ChangesTable(const std::vector<ObjectChange>& changes) {
 }
 
 std::string GpsTable(const SimulatedFlight& flight, const LogOptions& options) {
-  constexpr double kEarthRadius = 6378137.0, kRateHz = 10.0, kSigma = 1.5;
+  constexpr double kEarthRadius = 6378137.0, kRateHz = 10.0;
+  const double kSigma = options.gps_noise_m;
   cv::RNG rng(static_cast<std::uint64_t>(flight.lighting.noise_seed) * 97u + 1u);
   std::ostringstream out;
   out.precision(10);
@@ -356,7 +370,7 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   PATROLMAP_RETURN_IF_ERROR(
       WriteFileAtomically(folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +
                                                             "rate_hz: " + std::to_string(flight.imu_rate_hz) + "\n"));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/imu0/data.csv", ImuTable(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/imu0/data.csv", ImuTable(flight, options)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/state_groundtruth_estimate0/data.csv", StateTable(flight)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/places.csv", PlacesTable(flight)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/objects.csv", ObjectsTable(flight.objects)));

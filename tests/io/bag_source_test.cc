@@ -300,8 +300,9 @@ TEST_F(BagSourceTest, ChosenTopicsAreChecked) {
   EXPECT_EQ(choice.right, "/r");
 }
 
-// Without a pose topic, GPS fixes and the IMU's attitude give the poses: east, north and up from the first
-// fix, turned by the attitude and the camera's rotation in the IMU's frame.
+// Without a pose topic, GPS fixes and the IMU's attitude give the poses: east, north and up about the point of
+// the 0.1-degree grid nearest the first fix (at altitude 0), turned by the attitude and the camera's rotation in
+// the IMU's frame.
 TEST_F(BagSourceTest, PosesFromGpsAndTheImusAttitude) {
   const Eigen::Quaterniond attitude = Turn(30, {0, 0, 1});
   std::vector<Message> messages;
@@ -312,7 +313,7 @@ TEST_F(BagSourceTest, PosesFromGpsAndTheImusAttitude) {
   // A fix every 0.1 s from 0.95 s, 1e-5 degrees further north each time (1.113 m).
   for (int k = 0; k < 5; ++k) {
     const std::int64_t t = kSecond - kSecond / 20 + k * kSecond / 10;
-    messages.push_back({"/gps", t, Fix(t, 47.0 + 1e-5 * k, 8.0, 400.0 + k)});
+    messages.push_back({"/gps", t, Fix(t, 47.03 + 1e-5 * k, 8.04, 400.0 + k)});
   }
   std::vector<std::pair<std::string, std::string>> topics;
   for (const auto& topic : topics_) {
@@ -328,10 +329,10 @@ TEST_F(BagSourceTest, PosesFromGpsAndTheImusAttitude) {
   EXPECT_TRUE(info.has_poses);
   // Frame 1 at 1.1 s: halfway between the fixes at 1.05 s (k = 1) and 1.15 s (k = 2).
   ASSERT_TRUE(frames[1].pose.has_value());
-  const double metres_per_step = 1e-5 * M_PI / 180.0 * 6378137.0;
-  EXPECT_NEAR(frames[1].pose->position.y(), 1.5 * metres_per_step, 1e-6);
-  EXPECT_NEAR(frames[1].pose->position.x(), 0.0, 1e-9);
-  EXPECT_NEAR(frames[1].pose->position.z(), 1.5, 1e-9);
+  const double metres_per_degree = M_PI / 180.0 * 6378137.0;  // the frame's origin: 47.0, 8.0 degrees
+  EXPECT_NEAR(frames[1].pose->position.y(), (0.03 + 1.5e-5) * metres_per_degree, 1e-6);
+  EXPECT_NEAR(frames[1].pose->position.x(), 0.04 * metres_per_degree * std::cos(47.0 * M_PI / 180.0), 1e-6);
+  EXPECT_NEAR(frames[1].pose->position.z(), 401.5, 1e-9);
   EXPECT_NEAR(frames[1].pose->rotation.angularDistance(attitude * kImuFromCamera), 0.0, 1e-9);
 }
 

@@ -274,6 +274,59 @@ TEST(Euroc, GpsIsInterpolatedAtFrameTimes) {
             std::string::npos);
 }
 
+// A log without a state estimate whose IMU reports its attitude (imu0/'s columns 8-11, w x y z): the camera poses
+// come from gps0/ and that attitude, at the frames' times.
+TEST(Euroc, PosesFromGpsAndTheImusAttitude) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 3);  // frames at 1.00, 1.05 and 1.10 s
+  // The camera looks along the body's x axis (EuRoC's T_BS rotation: camera axes into the body's).
+  WriteText(log + "/cam0/sensor.yaml",
+            "T_BS:\n  data: [0, 0, 1, 0, -1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 0, 1]\n"
+            "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\n");
+  const double c = std::cos(M_PI / 12), s = std::sin(M_PI / 12);  // 30 degrees about up
+  WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az,qw,qx,qy,qz\n1000000000,0,0,0,0,0,9.8,1,0,0,0\n" +
+                                        std::string("1100000000,0,0,0,0,0,9.8,") + std::to_string(c) + ",0,0," +
+                                        std::to_string(s) + "\n");
+  WriteText(log + "/gps0/data.csv", "#t,lat,lon,alt\n1000000000,47.03,8.04,500\n1100000000,47.0302,8.04,510\n");
+  testing::LogCapture capture;
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_TRUE(source->info().has_poses);
+  EXPECT_NE(capture.text().find("camera poses from gps0/ and imu0/'s attitude at 3 of 3 frames"), std::string::npos)
+      << capture.text();
+  Status end;
+  const std::vector<Frame> frames = ReadAll(source.get(), &end);
+  ASSERT_TRUE(frames[1].pose.has_value());
+  const double metres_per_degree = M_PI / 180.0 * 6378137.0;  // about the grid point 47.0, 8.0
+  EXPECT_NEAR(frames[1].pose->position.y(), 0.0301 * metres_per_degree, 1e-6);
+  EXPECT_NEAR(frames[1].pose->position.x(), 0.04 * metres_per_degree * std::cos(47.0 * M_PI / 180.0), 1e-6);
+  EXPECT_NEAR(frames[1].pose->position.z(), 505.0, 1e-9);
+  // Halfway: 15 degrees about up; the camera's optical axis (z) along the body's x axis, turned by it.
+  const Eigen::Vector3d axis = frames[1].pose->rotation * Eigen::Vector3d::UnitZ();
+  EXPECT_NEAR(axis.x(), std::cos(M_PI / 12), 1e-6);
+  EXPECT_NEAR(axis.y(), std::sin(M_PI / 12), 1e-6);
+  EXPECT_NEAR(axis.z(), 0.0, 1e-9);
+
+  // A state estimate takes precedence.
+  WriteText(log + "/state_groundtruth_estimate0/data.csv",
+            "#t,px,py,pz,qw,qx,qy,qz,vx,vy,vz\n1000000000,1,2,3,1,0,0,0,0,0,0\n1100000000,1,2,3,1,0,0,0,0,0,0\n");
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  const std::vector<Frame> estimated = ReadAll(source.get(), &end);
+  ASSERT_TRUE(estimated[1].pose.has_value());
+  EXPECT_TRUE(estimated[1].pose->position.isApprox(Eigen::Vector3d(1, 2, 3)));
+  // Without cam0/sensor.yaml the camera's rotation in the IMU's frame is unknown.
+  std::filesystem::remove_all(log + "/state_groundtruth_estimate0");
+  std::filesystem::remove(log + "/cam0/sensor.yaml");
+  testing::LogCapture second;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_FALSE(source->info().has_poses);
+  EXPECT_NE(second.text().find("cam0/sensor.yaml is missing"), std::string::npos) << second.text();
+  WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az,qw,qx,qy,qz\n1000000000,0,0,0,0,0,9.8,1,0,0,0.5\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("imu0/data.csv:2: q_WS (attitude) is not a unit quaternion"),
+            std::string::npos);
+}
+
 // cam0 and cam1 0.11 m apart (EuRoC's layout): cam1's images at cam0's times make stereo pairs.
 void AddStereoCamera(const std::string& log, const std::string& cam1_model) {
   const std::string intrinsics = "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\n";

@@ -1,7 +1,9 @@
 // patrolmap simulate --route double-loop|inner-loop|l-shape|street|WAYPOINTS.csv --seed N --out DIR
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <spdlog/spdlog.h>
 
@@ -30,6 +32,7 @@ struct SimulateArguments {
   sim::LogOptions log;
   sim::RouteOptions flight;
   sim::StreetOptions street;
+  std::vector<double> gps_origin;  // latitude, longitude [deg], altitude [m]; empty: LogOptions' default
 };
 
 Status ParseResolution(const std::string& text, int* width, int* height) {
@@ -102,8 +105,27 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   return Status::Ok();
 }
 
+// --gps-origin into the log options.
+Status SetGpsOrigin(SimulateArguments* arguments) {
+  if (arguments->gps_origin.empty()) return Status::Ok();
+  const std::vector<double>& origin = arguments->gps_origin;
+  if (!(std::abs(origin[0]) <= 90.0 && std::abs(origin[1]) <= 180.0 && std::abs(origin[2]) <= 10000.0)) {
+    return Status::InvalidArgument(
+        "--gps-origin: latitude must lie in [-90, 90], longitude in [-180, 180] "
+        "degrees and altitude in [-10000, 10000] m");
+  }
+  arguments->log.gps_origin_latitude = origin[0];
+  arguments->log.gps_origin_longitude = origin[1];
+  arguments->log.gps_origin_altitude_m = origin[2];
+  return Status::Ok();
+}
+
 int RunSimulate(SimulateArguments arguments) {
   if (arguments.first_flight > 1) arguments.flights = arguments.first_flight;
+  if (const Status status = SetGpsOrigin(&arguments); !status.ok()) {
+    spdlog::error("{}", status.message());
+    return 2;
+  }
   std::vector<sim::WorldObject> objects;
   for (int number = 1; number <= arguments.flights; ++number) {
     const Status status = WriteFlight(arguments, number, &objects);
@@ -141,7 +163,23 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
       ->check(CLI::Range(1, 100));
   app->add_flag("--detections", arguments->log.detections, "write objects0/ from a simulated object detector");
   app->add_flag("--depth", arguments->log.depth, "write depth0/ (16-bit PNG depth along the optical axis, mm)");
-  app->add_flag("--gps", arguments->log.gps, "write gps0/ (10 Hz, 1.5 m noise)");
+  app->add_flag("--gps", arguments->log.gps,
+                "write gps0/ (10 Hz) and the IMU's attitude (imu0/data.csv's columns 8-11, an AHRS): with "
+                "state_groundtruth_estimate0/ moved aside, the camera poses come from them");
+  app->add_option("--gps-noise", arguments->log.gps_noise_m,
+                  "standard deviation of each GPS fix's east and north, twice that up [m]")
+      ->check(FiniteRange(0.0, 100.0))
+      ->capture_default_str();
+  app->add_option("--attitude-noise", arguments->log.attitude_noise_deg,
+                  "standard deviation of the attitude's error about each axis, fixed per flight [deg]")
+      ->check(FiniteRange(0.0, 30.0))
+      ->capture_default_str();
+  app->add_option("--gps-origin", arguments->gps_origin,
+                  "latitude, longitude [deg] and altitude [m] of the village's origin (47.3572 8.437 480); on "
+                  "a point of the 0.1-degree grid with altitude 0 (47.4 8.4 0), poses from GPS have the "
+                  "simulator's world frame, so eval can score them")
+      ->expected(3)
+      ->type_name("LAT LON ALT");
   app->add_option("--stereo", arguments->log.stereo_baseline_m,
                   "write cam1/, a second camera BASELINE_M to the right of cam0 (a stereo pair, with its sensor.yaml)")
       ->type_name("BASELINE_M")

@@ -41,12 +41,14 @@ struct SimulatedFlight {
 
 // Optional parts of a written log.
 struct LogOptions {
-  bool detections = false;         // objects0/data.csv from the simulated detector
-  bool depth = false;              // depth0/: 16-bit PNG depth along the optical axis [mm]
-  double stereo_baseline_m = 0.0;  // > 0: cam1/, a second camera this far to the right of cam0 (a stereo pair)
-  bool gps = false;                // gps0/data.csv at 10 Hz with 1.5 m noise
-  double exposure_s = 0.0;         // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
-  bool truth_only = false;         // write only groundtruth/key_locations.csv (after a change of its definition)
+  bool detections = false;          // objects0/data.csv from the simulated detector
+  bool depth = false;               // depth0/: 16-bit PNG depth along the optical axis [mm]
+  double stereo_baseline_m = 0.0;   // > 0: cam1/, a second camera this far to the right of cam0 (a stereo pair)
+  bool gps = false;                 // gps0/data.csv at 10 Hz, and the IMU's attitude in imu0/data.csv
+  double gps_noise_m = 1.5;         // standard deviation of each fix's east and north (twice that up) [m]
+  double attitude_noise_deg = 0.5;  // standard deviation of the attitude's error about each axis, fixed per flight
+  double exposure_s = 0.0;          // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
+  bool truth_only = false;          // write only groundtruth/key_locations.csv (after a change of its definition)
   DetectorOptions detector;
   double gps_origin_latitude = 47.3572;  // village origin (the paper's site is near Birmensdorf) [deg]
   double gps_origin_longitude = 8.4370;
