@@ -350,6 +350,9 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     ++change->compared_voxels;
     const double delta = Occupancy(b) - Occupancy(a);
     const bool one_free = std::min(Occupancy(a), Occupancy(b)) <= options.max_free_occupancy;
+    if (std::max(Occupancy(a), Occupancy(b)) > options.max_free_occupancy + options.min_occupancy_change) {
+      ++change->surface_voxels;
+    }
     const Eigen::Vector3i index(a.x, a.y, a.z);
     if (std::abs(delta) <= options.min_occupancy_change || !one_free) return;
     if (options.surface_tolerance_voxels > 0) {
@@ -363,6 +366,11 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     centres.push_back(index.cast<double>() * size);
     deltas.push_back(delta);
   });
+  change->differing_voxels = static_cast<long long>(changed.size());
+  if (change->DifferingShare() > options.max_differing_share) {
+    change->poses_disagree = true;  // surfaces a voxel or more apart everywhere: not changes, a pose error
+    return;
+  }
   std::vector<Region> regions = Cluster(centres, deltas, options.join_distance_m);
   MergeOverlapping(size * 1.01, &regions);  // voxel cubes that touch or overlap
   std::vector<std::size_t> members;         // the changed voxels of the reported regions

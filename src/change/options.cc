@@ -77,7 +77,8 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
       .InRange("change.geometry.surface_tolerance_voxels", g.surface_tolerance_voxels, 0, 10)
       .InRange("change.geometry.join_distance_m", g.join_distance_m, 0.0, 1000.0)
       .InRange("change.geometry.min_region_voxels", g.min_region_voxels, 1, 100000000)
-      .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0);
+      .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0)
+      .InRange("change.geometry.max_differing_share", g.max_differing_share, 0.0, 1.0);
 }
 
 void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {

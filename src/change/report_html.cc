@@ -198,6 +198,12 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
           << Counted(static_cast<long long>(report.geometry.regions.size()), "changed region", "changed regions")
           << " (depth from " << DepthWords(report.geometry.depth_prior) << " before, "
           << DepthWords(report.geometry.depth_current) << " now).";
+    if (report.geometry.poses_disagree) {
+      *html << " No geometry or object change is reported: the two patrols' surfaces differ in "
+            << static_cast<int>(std::lround(100.0 * report.geometry.DifferingShare()))
+            << " % of the voxels both observed, so their camera poses disagree (GPS without RTK, or another "
+               "world frame).";
+    }
     if (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0) {
       *html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped "
             << report.geometry.evicted_prior << " and " << report.geometry.evicted_current

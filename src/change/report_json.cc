@@ -122,6 +122,9 @@ json GeometryJson(const GeometryChange& g, const std::vector<ChangeItem>& items)
           {"evicted_voxels", {{"prior", g.evicted_prior}, {"current", g.evicted_current}}},
           {"depth_source", {{"prior", g.depth_prior}, {"current", g.depth_current}}},
           {"changed_voxels", g.changed_voxels.size()},
+          {"surface_voxels", g.surface_voxels},
+          {"differing_voxels", g.differing_voxels},
+          {"poses_disagree", g.poses_disagree},
           {"regions", regions}};
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <spdlog/spdlog.h>
+
 #include "patrolmap/change/geometry_objects.h"
 
 namespace patrolmap::pipeline {
@@ -62,26 +64,35 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   if (prior_record == nullptr || current_record == nullptr) return Status::Ok();
 
   start = std::chrono::steady_clock::now();
-  if (prior_record->has_objects && current_record->has_objects) {
-    report->objects_compared = true;
-    report->objects = change::DiffObjects(*prior_record, *current_record, options.objects);
-  }
-  report->seconds_objects = SecondsSince(start);
-  start = std::chrono::steady_clock::now();
   report->geometry_compared =
       change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
   report->geometry.depth_prior = prior_record->depth_source;
   report->geometry.depth_current = current_record->depth_source;
+  if (report->geometry.poses_disagree) {
+    // Objects are placed by the same poses: their comparison would be as wrong.
+    spdlog::warn(
+        "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed (more than "
+        "change.geometry.max_differing_share, {:.0f} %): the two flights' camera poses disagree (GPS without "
+        "RTK, or another world frame), so no geometry or object change is reported",
+        prior, current, 100.0 * report->geometry.DifferingShare(), 100.0 * options.geometry.max_differing_share);
+    report->seconds_geometry = SecondsSince(start);
+    return Status::Ok();
+  }
   if (report->geometry_compared && options.geometry_objects.enabled) {
     // Objects no detector named: clusters of changed space (paper 003); detected objects take precedence.
-    for (change::ObjectChange& found : change::GeometryObjects(
-             report->geometry, change::LookupIn(prior_record->grid), change::LookupIn(current_record->grid),
-             prior_record->objects, current_record->objects, options.geometry_objects)) {
-      report->objects.push_back(std::move(found));
-    }
+    report->objects = change::GeometryObjects(report->geometry, change::LookupIn(prior_record->grid),
+                                              change::LookupIn(current_record->grid), prior_record->objects,
+                                              current_record->objects, options.geometry_objects);
     report->objects_compared = true;
   }
   report->seconds_geometry = SecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  if (prior_record->has_objects && current_record->has_objects) {
+    std::vector<change::ObjectChange> detected = change::DiffObjects(*prior_record, *current_record, options.objects);
+    report->objects.insert(report->objects.begin(), detected.begin(), detected.end());
+    report->objects_compared = true;
+  }
+  report->seconds_objects = SecondsSince(start);
   return Status::Ok();
 }
 

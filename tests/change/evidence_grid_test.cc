@@ -200,6 +200,13 @@ EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<i
   return grid;
 }
 
+// The scenes below are mostly the changes themselves, which the pose check would take for a pose error.
+GeometryDiffOptions SceneOfChanges() {
+  GeometryDiffOptions options;
+  options.max_differing_share = 1.0;
+  return options;
+}
+
 TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
   for (int x = 0; x < 4; ++x) {
@@ -220,7 +227,7 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   before.push_back({{60, 0, 1}, {0, 9}});  // an outlier voxel, below the region size
   after.push_back({{60, 0, 1}, {9, 0}});
   GeometryChange change;
-  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), SceneOfChanges(), &change));
   ASSERT_EQ(change.regions.size(), 1u);
   EXPECT_EQ(change.regions[0].voxels, 48);
   EXPECT_EQ(change.regions[0].appeared, 48);
@@ -244,11 +251,53 @@ TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
   removed_box(0, 6);    // 12 voxels
   removed_box(50, 20);  // a 4 m long object: clustering by centroid distance splits it, the cleanup joins it
   GeometryChange change;
-  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), SceneOfChanges(), &change));
   ASSERT_EQ(change.regions.size(), 2u);
   EXPECT_EQ(change.regions[0].voxels, 40);
   EXPECT_EQ(change.regions[0].vanished, 40);
   EXPECT_EQ(change.regions[1].voxels, 12);
+}
+
+// A ground plane and a wall seen two voxels apart everywhere (the second patrol's poses are off): every surface
+// differs, which no change does, so nothing is reported. With a box put down on a ground both patrols agree on,
+// only the box differs and it is reported.
+TEST(GeometryChange, SurfacesThatDifferEverywhereAreAPoseErrorNotAChange) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 40; ++y) {
+      before.push_back({{x, y, 0}, {8, 0}});  // the ground, occupied, with free air above it
+      before.push_back({{x, y, 2}, {0, 8}});
+      after.push_back({{x, y, 0}, {0, 8}});  // ... seen two voxels higher
+      after.push_back({{x, y, 2}, {8, 0}});
+    }
+  }
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  EXPECT_TRUE(change.poses_disagree);
+  EXPECT_TRUE(change.regions.empty());
+  EXPECT_TRUE(change.changed_voxels.empty());
+  EXPECT_EQ(change.surface_voxels, 3200);
+  EXPECT_EQ(change.differing_voxels, 3200);
+  // The same ground in both, and a 4 x 4 x 2 box put down on it.
+  after = before;
+  for (auto& [index, counts] : after) {
+    if (index.z() == 2 && index.x() >= 10 && index.x() < 14 && index.y() >= 10 && index.y() < 14) counts = {8, 0};
+  }
+  for (int x = 10; x < 14; ++x) {
+    for (int y = 10; y < 14; ++y) {
+      before.push_back({{x, y, 1}, {0, 8}});
+      after.push_back({{x, y, 1}, {8, 0}});
+    }
+  }
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  EXPECT_FALSE(change.poses_disagree);
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_EQ(change.regions[0].appeared, 32);
+  EXPECT_EQ(change.differing_voxels, 32);
+  GeometryDiffOptions strict;
+  strict.max_differing_share = 0.01;  // 32 of the 1632 surface voxels differ
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), strict, &change));
+  EXPECT_TRUE(change.poses_disagree);
 }
 
 TEST(GeometryChange, DifferentVoxelSizesCannotBeCompared) {

@@ -199,6 +199,7 @@ TEST(GeometryObjects, DiffGridsSignsEachChangedVoxel) {
   }
   GeometryDiffOptions diff;
   diff.surface_tolerance_voxels = 0;
+  diff.max_differing_share = 1.0;  // a scene of changes only
   GeometryChange change;
   ASSERT_TRUE(DiffGrids(before, after, diff, &change));
   ASSERT_EQ(change.changed_voxels.size(), put.size() + taken.size());
@@ -240,8 +241,10 @@ EvidenceGridData Observed(const std::vector<Eigen::AlignedBox3i>& solid) {
 TEST(GeometryObjects, AnObjectMovedLessThanItsLengthIsCompletedFromEachGrid) {
   const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(20, 8, 7))});
   const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(10, 0, 1), Eigen::Vector3i(30, 8, 7))});
+  GeometryDiffOptions diff;
+  diff.max_differing_share = 1.0;  // a scene of the vehicle only, whose ends differ
   GeometryChange change;
-  ASSERT_TRUE(DiffGrids(before, after, GeometryDiffOptions(), &change));
+  ASSERT_TRUE(DiffGrids(before, after, diff, &change));
   GeometryObjectOptions options;
   std::vector<ObjectChange> objects = GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
   ASSERT_EQ(objects.size(), 1u);

@@ -155,6 +155,8 @@ void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& repo
   (*result)["geometry"]["iou"] = score.Iou();
   (*result)["geometry"]["observed_voxels"] = score.observed_voxels;
   (*result)["geometry"]["regions"] = report.geometry.regions.size();
+  (*result)["geometry"]["surface_voxels"] = report.geometry.surface_voxels;
+  (*result)["geometry"]["differing_voxels"] = report.geometry.differing_voxels;
 }
 
 // The visible object changes in the key frame of `node` (a node of the flight whose objects are `here`), from

@@ -99,7 +99,13 @@ struct GeometryRegion {
 
 struct GeometryChange {
   double voxel_size = 0.0;
-  long long compared_voxels = 0;  // observed enough in both patrols
+  long long compared_voxels = 0;   // observed enough in both patrols
+  long long surface_voxels = 0;    // ... and occupied in at least one of them
+  long long differing_voxels = 0;  // ... of those, changed beyond the surface tolerance (before the region tests)
+  bool poses_disagree = false;     // differing / surface voxels above max_differing_share: no region reported
+  double DifferingShare() const {
+    return surface_voxels > 0 ? static_cast<double>(differing_voxels) / static_cast<double>(surface_voxels) : 0.0;
+  }
   // Voxels each patrol's grid dropped at its memory budget (change.grid.memory_mb): nothing is compared there.
   long long evicted_prior = 0, evicted_current = 0;
   std::string depth_prior, depth_current;       // where each grid's depth came from (PatrolRecord::depth_source)
