@@ -568,6 +568,7 @@ TEST_F(StereoStreet, TheRecordTakesTheDepthTheConfigurationChooses) {
     PatrolRecord record;
     PatrolRecordStats stats;
     recorder.Finish(&record, &stats);
+    EXPECT_EQ(record.pose_source, kPosesFromStateEstimate);
     return record.depth_source;
   };
   EXPECT_EQ(source_of(depth::DepthSource::kAuto), "images");

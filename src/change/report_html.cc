@@ -176,6 +176,14 @@ const char* DepthWords(const std::string& source) {
   return "unrecorded";
 }
 
+const char* PoseWords(const std::string& source) {
+  if (source == kPosesFromStateEstimate) return "the log's state estimate";
+  if (source == kPosesFromTopic) return "the bag's pose topic";
+  if (source == kPosesFromFile) return "a pose file";
+  if (source == kPosesFromGps) return "GPS and the IMU's attitude";
+  return "unrecorded";
+}
+
 void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, std::ostringstream* html) {
   *html << "<p class='summary'>" << Counted(static_cast<long long>(items.size()), "change", "changes") << ". "
         << Counted(static_cast<long long>(report.places.size()), "place", "places") << " seen by both patrols, "
@@ -209,6 +217,10 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
             << report.geometry.evicted_prior << " and " << report.geometry.evicted_current
             << " voxels: no geometry change can be found where they were.";
     }
+  }
+  if (!report.pose_prior.empty() || !report.pose_current.empty()) {
+    *html << " Camera poses from " << PoseWords(report.pose_prior) << " before, " << PoseWords(report.pose_current)
+          << " now.";
   }
   *html << "</p>\n";
 }

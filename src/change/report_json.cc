@@ -188,6 +188,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
       {"version", 2},
       {"prior_flight", report.prior_flight},
       {"current_flight", report.current_flight},
+      {"pose_source", {{"prior", report.pose_prior}, {"current", report.pose_current}}},
       {"summary",
        {{"changes", items.size()},
         {"places_compared", report.places.size()},

@@ -18,8 +18,9 @@ namespace {
 constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
 // 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
-// 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit
-constexpr std::uint32_t kVersion = 8;
+// 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit;
+// 9: where the patrol's camera poses came from
+constexpr std::uint32_t kVersion = 9;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
@@ -279,6 +280,7 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     w.String(p.depth_source);
     WriteRoute(p.route, &w);
     w.Value<std::uint8_t>(p.timed ? 1 : 0);
+    w.String(p.pose_source);
   }
 }
 
@@ -555,6 +557,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     if (version >= 5) p.depth_source = r->String();
     if (version >= 6) p.route = ReadRoute(r);
     if (version >= 7) p.timed = r->Value<std::uint8_t>() != 0;
+    if (version >= 9) p.pose_source = r->String();
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
@@ -566,6 +569,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
       return Corrupt(path, "evidence grid of " + p.flight);
     }
     if (!ValidRoute(p.route)) return Corrupt(path, "route frames of " + p.flight);
+    if (!KnownPoseSource(p.pose_source)) return Corrupt(path, "pose source of " + p.flight);
     map->SetPatrol(std::move(p));
   }
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();

@@ -282,6 +282,7 @@ class BagSource : public FrameSource {
     roles_.pose = -1;
     poses_from_gps_ = false;
     info_.has_poses = true;
+    info_.pose_source = kPosesFromFile;
     return Status::Ok();
   }
 
@@ -706,6 +707,7 @@ void SetRotations(const BagFile& bag, const std::string& path, const BagRoles& r
     spdlog::info("{}: camera poses from {} and the attitude of {}", path, bag.topics()[roles.gps].name,
                  bag.topics()[roles.imu].name);
     info->has_poses = true;
+    info->pose_source = kPosesFromGps;
     info->body_from_camera = (*body_from_camera)->toRotationMatrix();
     return;
   }
@@ -766,6 +768,7 @@ Status ReadLogInfo(BagFile* bag, const std::string& path, const BagRoles& roles,
   info->timing = "header stamps of " + bag->topics()[roles.camera].name;
   info->has_imu = roles.imu >= 0;
   info->has_poses = info->has_poses || roles.pose >= 0;
+  if (roles.pose >= 0) info->pose_source = kPosesFromTopic;
   info->has_speed = roles.pose >= 0 && rosmsg::KindOfType(bag->topics()[roles.pose].type) == MessageKind::kOdometry;
   return Status::Ok();
 }

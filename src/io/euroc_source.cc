@@ -277,6 +277,7 @@ void PosesFromFixes(const std::string& log, const LogInfo& info, const std::vect
     spdlog::warn("{}: gps0/ and imu0/'s attitude give no camera pose: their times do not cover cam0's", log);
     return;
   }
+  sensors->pose_source = kPosesFromGps;
   const Eigen::Vector3d origin = GpsFrameOrigin(gps.front().position);
   spdlog::info(
       "{}: camera poses from gps0/ and imu0/'s attitude at {} of {} frames (east, north, up about "

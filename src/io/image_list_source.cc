@@ -22,6 +22,7 @@ ImageListSource::ImageListSource(LogInfo info, std::vector<ImageEntry> entries, 
   info_.frame_count = static_cast<std::int64_t>(entries_.size());
   info_.has_imu = !imu_.empty();
   info_.has_poses = !sensors_.poses.empty();
+  if (info_.has_poses) info_.pose_source = sensors_.pose_source;
   info_.has_detections = !sensors_.detections.empty();
   info_.has_depth = !sensors_.depth.empty();
   info_.has_stereo = info_.stereo.has_value() && !sensors_.stereo.empty();
@@ -36,6 +37,7 @@ Status ImageListSource::UsePoseFile(const std::string& path) {
   if (info_.has_poses) spdlog::info("{}: camera poses from {}, not the log's state estimate", info_.path, path);
   sensors_.poses = std::move(poses);
   info_.has_poses = true;
+  info_.pose_source = kPosesFromFile;
   return Status::Ok();
 }
 

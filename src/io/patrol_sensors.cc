@@ -94,7 +94,10 @@ Status ReadPatrolSensors(const std::string& log, PatrolSensors* sensors) {
 
 Status ReadSensorTables(const std::string& root, const Eigen::Matrix3d& body_from_camera, PatrolSensors* sensors) {
   const std::string state = root + "/state_groundtruth_estimate0/data.csv";
-  if (fs::exists(state)) PATROLMAP_RETURN_IF_ERROR(ReadPoseTable(state, body_from_camera, &sensors->poses));
+  if (fs::exists(state)) {
+    PATROLMAP_RETURN_IF_ERROR(ReadPoseTable(state, body_from_camera, &sensors->poses));
+    if (!sensors->poses.empty()) sensors->pose_source = kPosesFromStateEstimate;
+  }
   if (fs::exists(root + "/objects0/data.csv")) {
     PATROLMAP_RETURN_IF_ERROR(ReadDetectionTable(root + "/objects0/data.csv", &sensors->detections));
   }

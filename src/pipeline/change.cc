@@ -62,6 +62,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   }
   report->seconds_appearance = SecondsSince(start);
   if (prior_record == nullptr || current_record == nullptr) return Status::Ok();
+  report->pose_prior = prior_record->pose_source;
+  report->pose_current = current_record->pose_source;
 
   start = std::chrono::steady_clock::now();
   report->geometry_compared =

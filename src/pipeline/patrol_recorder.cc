@@ -23,6 +23,7 @@ PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
   next_stereo_ns_ = next_grid_ns_;
   base_.flight = info.flight_id;
   base_.timed = info.timed;
+  if (info.has_poses) base_.pose_source = info.pose_source;
   if (info.camera) base_.camera = *info.camera;
   if (!info.has_poses || !info.camera) return;
   base_.has_objects = info.has_detections;

@@ -132,6 +132,13 @@ TEST(ChangeReportPage, HasAMarkerARowAndBothPicturesPerChange) {
   EXPECT_NE(html.find("data-src='pictures/object-p-1-c7-after.jpg'"), std::string::npos);
   EXPECT_NE(html.find("1 change."), std::string::npos);
   EXPECT_NE(html.find("not in the prior patrol's map"), std::string::npos);
+  EXPECT_EQ(html.find("Camera poses from"), std::string::npos);  // the scene's records do not say
+  ChangeReport posed = scene.report;
+  posed.pose_prior = kPosesFromStateEstimate;
+  posed.pose_current = kPosesFromGps;
+  EXPECT_NE(ToHtml(posed, scene.map, items, std::nullopt, "pictures")
+                .find("Camera poses from the log's state estimate before, GPS and the IMU's attitude now."),
+            std::string::npos);
   // Without a folder the pictures are embedded.
   EXPECT_NE(ToHtml(scene.report, scene.map, items, std::nullopt, "").find("src='data:image/png;base64,"),
             std::string::npos);

@@ -114,9 +114,9 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   EXPECT_NE(LoadBytes(flipped).find("corrupt map (checksum of section"), std::string::npos);
   EXPECT_NE(LoadBytes("%PDF-1.4 something else").find("not a patrolmap map file"), std::string::npos);
   std::string newer = bytes_;
-  const std::uint32_t version = 9;
+  const std::uint32_t version = 10;
   std::memcpy(newer.data() + 8, &version, 4);
-  EXPECT_NE(LoadBytes(newer).find("version 9 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(newer).find("version 10 is newer"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
   // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
   TopoMap unsorted = TwoFlights();
@@ -261,7 +261,7 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
   std::memcpy(bytes.data() + tag + 4, &old_length, 8);
   std::memcpy(bytes.data() + 8, &version, sizeof(version));
   testing::RecomputeMapChecksums(&bytes);
-  DowngradeFeatures(&bytes);
+  if (version < 8) DowngradeFeatures(&bytes);  // keypoint records before format 8
   return bytes;
 }
 
@@ -270,8 +270,9 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
 TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
   testing::TempDir dir;
   // The evicted-voxel count (8 bytes), the depth source ("stereo": a 4-byte length and 6 characters) and the
-  // route frames (none: a 4-byte count) and whether the log was timed (1 byte).
-  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 23);
+  // route frames (none: a 4-byte count), whether the log was timed (1 byte) and the pose source (empty: its
+  // 4-byte length).
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 27);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -282,7 +283,7 @@ TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
 
 TEST(MapFile, VersionFourPatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 15);
+  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 19);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v4.pmap", &map).ok()) << LoadMap(dir / "v4.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -365,7 +366,7 @@ TEST(MapFile, DamagedRouteFramesAreNamed) {
 // A version-5 map (before the route frames) loads without them.
 TEST(MapFile, VersionFivePatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 5);
+  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 9);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v5.pmap", &map).ok()) << LoadMap(dir / "v5.pmap", &map).message();
   EXPECT_EQ(map.Patrol("b")->depth_source, "stereo");
@@ -379,7 +380,7 @@ TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
   PatrolRecord record = *untimed.Patrol("b");
   record.timed = false;
   untimed.SetPatrol(record);
-  std::ofstream(dir / "v6.pmap", std::ios::binary) << OlderPatrolSection(untimed, dir / "m.pmap", 6, 1);
+  std::ofstream(dir / "v6.pmap", std::ios::binary) << OlderPatrolSection(untimed, dir / "m.pmap", 6, 5);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v6.pmap", &map).ok()) << LoadMap(dir / "v6.pmap", &map).message();
   EXPECT_TRUE(map.Patrol("b")->timed);
@@ -387,11 +388,11 @@ TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
   EXPECT_FALSE(map.Patrol("b")->timed);
 }
 
-// A version-7 map (keypoint records) loads with the positions of its features, and saves as version 8.
+// A version-7 map (keypoint records) loads with the positions of its features, and saves as the current version.
 TEST(MapFile, VersionSevenKeypointRecordsLoadAsPositions) {
   testing::TempDir dir;
   const TopoMap original = TwoFlights();
-  std::ofstream(dir / "v7.pmap", std::ios::binary) << OlderPatrolSection(original, dir / "m.pmap", 7, 0);
+  std::ofstream(dir / "v7.pmap", std::ios::binary) << OlderPatrolSection(original, dir / "m.pmap", 7, 4);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v7.pmap", &map).ok()) << LoadMap(dir / "v7.pmap", &map).message();
   ASSERT_EQ(map.node_count(), original.node_count());
@@ -401,6 +402,26 @@ TEST(MapFile, VersionSevenKeypointRecordsLoadAsPositions) {
   }
   ASSERT_TRUE(SaveMap(map, dir / "again.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "again.pmap"), testing::ReadText(dir / "m.pmap"));
+}
+
+// Where the camera poses came from is kept (format 9); a version-8 map has no source, and an unknown one is refused.
+TEST(MapFile, ThePoseSourceRoundTripsAndAnUnknownOneIsRefused) {
+  testing::TempDir dir;
+  TopoMap map = TwoFlights();
+  PatrolRecord record = *map.Patrol("b");
+  record.pose_source = kPosesFromGps;
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  EXPECT_EQ(loaded.Patrol("b")->pose_source, "gps_attitude");
+  std::ofstream(dir / "v8.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 8, 16);
+  ASSERT_TRUE(LoadMap(dir / "v8.pmap", &loaded).ok()) << LoadMap(dir / "v8.pmap", &loaded).message();
+  EXPECT_EQ(loaded.Patrol("b")->pose_source, "");
+  record.pose_source = "gyroscope";
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("pose source of b"), std::string::npos);
 }
 
 // Feature positions must be finite, and descriptors one of the stored kinds (vocab/descriptors.h).

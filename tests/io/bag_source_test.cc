@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include "io/wire_writer.h"
+#include "patrolmap/core/patrol_data.h"
 #include "patrolmap/io/bag.h"
 #include "patrolmap/io/readers.h"
 #include "test_util.h"
@@ -327,6 +328,7 @@ TEST_F(BagSourceTest, PosesFromGpsAndTheImusAttitude) {
   const std::vector<Frame> frames = ReadAll({}, &info);
   ASSERT_EQ(frames.size(), 3u);
   EXPECT_TRUE(info.has_poses);
+  EXPECT_EQ(info.pose_source, kPosesFromGps);
   // Frame 1 at 1.1 s: halfway between the fixes at 1.05 s (k = 1) and 1.15 s (k = 2).
   ASSERT_TRUE(frames[1].pose.has_value());
   const double metres_per_degree = M_PI / 180.0 * 6378137.0;  // the frame's origin: 47.0, 8.0 degrees

@@ -293,6 +293,7 @@ TEST(Euroc, PosesFromGpsAndTheImusAttitude) {
   std::unique_ptr<FrameSource> source;
   ASSERT_TRUE(OpenLog(log, {}, &source).ok());
   EXPECT_TRUE(source->info().has_poses);
+  EXPECT_EQ(source->info().pose_source, kPosesFromGps);
   EXPECT_NE(capture.text().find("camera poses from gps0/ and imu0/'s attitude at 3 of 3 frames"), std::string::npos)
       << capture.text();
   Status end;
@@ -312,6 +313,7 @@ TEST(Euroc, PosesFromGpsAndTheImusAttitude) {
   WriteText(log + "/state_groundtruth_estimate0/data.csv",
             "#t,px,py,pz,qw,qx,qy,qz,vx,vy,vz\n1000000000,1,2,3,1,0,0,0,0,0,0\n1100000000,1,2,3,1,0,0,0,0,0,0\n");
   ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_EQ(source->info().pose_source, kPosesFromStateEstimate);
   const std::vector<Frame> estimated = ReadAll(source.get(), &end);
   ASSERT_TRUE(estimated[1].pose.has_value());
   EXPECT_TRUE(estimated[1].pose->position.isApprox(Eigen::Vector3d(1, 2, 3)));

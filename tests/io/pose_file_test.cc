@@ -8,6 +8,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "io/fixtures.h"
+#include "patrolmap/core/patrol_data.h"
 #include "patrolmap/io/readers.h"
 #include "test_util.h"
 
@@ -73,6 +74,7 @@ TEST(PoseFile, ALogTakesItsCameraPosesFromTheFile) {
   EXPECT_FALSE(source->info().has_poses);
   ASSERT_TRUE(source->UsePoseFile(dir / "poses.txt").ok());
   EXPECT_TRUE(source->info().has_poses);
+  EXPECT_EQ(source->info().pose_source, kPosesFromFile);
   Frame frame;
   ASSERT_TRUE(source->Next(false, &frame).ok());
   ASSERT_TRUE(source->Next(false, &frame).ok());

@@ -39,6 +39,7 @@ struct ChangeReport {
   std::vector<ObjectChange> objects;
   bool geometry_compared = false;  // both patrols had depth and poses
   GeometryChange geometry;
+  std::string pose_prior, pose_current;  // where each patrol's camera poses came from (PatrolRecord::pose_source)
   double seconds_appearance = 0.0, seconds_objects = 0.0, seconds_geometry = 0.0;
 
   int ChangedPlaces() const;

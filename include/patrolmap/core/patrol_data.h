@@ -95,6 +95,17 @@ struct RouteFrame {
   std::vector<unsigned char> jpeg;
 };
 
+// Where a patrol's camera poses came from (LogInfo and PatrolRecord::pose_source); empty without poses, and in
+// maps written before format 9.
+inline constexpr char kPosesFromStateEstimate[] = "state_estimate";  // state_groundtruth_estimate0/
+inline constexpr char kPosesFromTopic[] = "pose_topic";              // a bag's pose or odometry topic
+inline constexpr char kPosesFromFile[] = "pose_file";                // --poses FILE
+inline constexpr char kPosesFromGps[] = "gps_attitude";              // GPS fixes and the IMU's attitude
+inline bool KnownPoseSource(const std::string& source) {
+  return source.empty() || source == kPosesFromStateEstimate || source == kPosesFromTopic || source == kPosesFromFile ||
+         source == kPosesFromGps;
+}
+
 // What a patrol (one flight of a map) keeps for change detection.
 struct PatrolRecord {
   std::string flight;
@@ -105,6 +116,7 @@ struct PatrolRecord {
   std::vector<MapObject> objects;
   EvidenceGridData grid;          // voxel_size 0 when the log had no depth
   std::string depth_source;       // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
+  std::string pose_source;        // where its camera poses came from (kPosesFrom...; map format 9 on)
   std::vector<RouteFrame> route;  // in time order; key frames among them (map format 6 on)
   // Whether the log had timestamps (false: 'recent' nodes are counted in images; map format 7 on, true before),
   // so a merge recognises its nodes' places as the mapping run did.

@@ -44,6 +44,7 @@ struct LogInfo {
   bool has_speed = false;
   // Change detection's tables (EuRoC): their samples come with the frames (Frame::poses, detections, depth).
   bool has_poses = false;
+  std::string pose_source;  // where they come from (kPosesFrom... of core/patrol_data.h); empty without
   bool has_detections = false;
   bool has_depth = false;   // depth0/ images
   bool has_stereo = false;  // stereo pairs (cam0 + cam1 with their calibration)

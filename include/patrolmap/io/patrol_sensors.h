@@ -37,6 +37,7 @@ struct PatrolSensors {
   std::string flight_id;
   std::optional<CameraIntrinsics> camera;
   std::vector<CameraPoseSample> poses;        // world_from_camera, ascending time
+  std::string pose_source;                    // kPosesFromStateEstimate or kPosesFromGps; empty without poses
   std::vector<ObjectObservation> detections;  // ascending time
   std::vector<DepthEntry> depth;              // ascending time
   std::vector<DepthEntry> stereo;             // cam0 and cam1 images of the same time (EuRoC reader), ascending
