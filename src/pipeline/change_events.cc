@@ -8,6 +8,7 @@
 #include <cstring>
 #include <optional>
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include "patrolmap/change/appearance.h"
@@ -191,14 +192,28 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   const PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), false);
   const change::EvidenceGrid* grid = recorder.grid();
   std::vector<Event> candidates;
+  change::GeometryChange geometry;
+  const bool compared = prior_record_->grid.voxel_size > 0 && grid != nullptr &&
+                        change::DiffGrids(prior_record_->grid, *grid, config_.change.geometry, &geometry);
+  if (geometry.poses_disagree) {
+    // The objects are placed by the same poses (pipeline/change.cc): nothing is sent while they disagree.
+    if (!warned_poses_) {
+      spdlog::warn(
+          "{}: its surfaces differ from {}'s in {:.0f} % of the voxels both observed: the camera poses "
+          "disagree (GPS without RTK, or another world frame), so no geometry or object change is sent "
+          "while they do",
+          now.flight, prior_flight_, 100.0 * geometry.DifferingShare());
+      warned_poses_ = true;
+    }
+    seen_before_.clear();
+    return;
+  }
   if (prior_record_->has_objects && now.has_objects) {
     for (const change::ObjectChange& change : change::DiffObjects(*prior_record_, now, config_.change.objects)) {
       if (Reported(change.state)) candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }
-  change::GeometryChange geometry;
-  if (prior_record_->grid.voxel_size > 0 && grid != nullptr &&
-      change::DiffGrids(prior_record_->grid, *grid, config_.change.geometry, &geometry)) {
+  if (compared) {
     for (const change::GeometryRegion& region : geometry.regions) {
       candidates.push_back(GeometryEvent(region, timestamp_ns));
     }

@@ -77,6 +77,7 @@ class ChangeMonitor {
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;
   bool started_ = false;
+  bool warned_poses_ = false;          // that the poses disagree (change thread)
   std::set<std::string> seen_before_;  // ids the previous check found (change thread)
   mutable std::mutex mutex_;           // the file, sent_ and status_ (two stage threads write)
   std::set<std::string> sent_;
