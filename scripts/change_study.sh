@@ -10,8 +10,9 @@
 # NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images;
 # EXTRA_CONFIG=FILE appends FILE's keys (not flow: or depth:) to the study's configuration; POSES=gps maps with
-# camera poses from GPS and the IMU's attitude (state_groundtruth_estimate0/ moved aside while mapping; GPS_NOISE
-# and ATTITUDE_NOISE set the simulator's noise, the origin lies on the grid so eval scores in the same frame).
+# camera poses from GPS and the IMU's attitude (state_groundtruth_estimate0/ moved aside while mapping; GPS_NOISE,
+# GPS_BIAS and ATTITUDE_NOISE set the simulator's noise, the origin lies on the grid so eval scores in the same frame;
+# GPS_FIRST=2 leaves flight 1 its state estimate).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/change_study}
@@ -28,11 +29,13 @@ printf 'flow:\n  frames:\n    scale: %s\n' "${SCALE:-1.0}" > "$config"
 simulate_extra=()
 [ -n "${STEREO:-}" ] && simulate_extra+=(--stereo "$STEREO")
 if [ "${POSES:-}" = gps ]; then
-  simulate_extra+=(--gps --gps-origin 47.4 8.4 0 --gps-noise "${GPS_NOISE:-1.5}" --attitude-noise "${ATTITUDE_NOISE:-0.5}")
+  simulate_extra+=(--gps --gps-origin 47.4 8.4 0 --gps-noise "${GPS_NOISE:-1.5}" --attitude-noise "${ATTITUDE_NOISE:-0.5}" \
+    --gps-bias "${GPS_BIAS:-0}")
 fi
 hide_state() {  # folder suffix: POSES=gps moves the state estimate aside while mapping, back for eval
   [ "${POSES:-}" = gps ] || return 0
   for flight in "$1"/logs/flight_*; do
+    [ "${flight##*_}" -ge "${GPS_FIRST:-1}" ] || continue  # GPS_FIRST=2: flight 1 keeps its state estimate
     [ -d "$flight/state_groundtruth_estimate0$2" ] && mv "$flight/state_groundtruth_estimate0$2" "$flight/state_groundtruth_estimate0$3"
   done
   return 0

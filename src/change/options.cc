@@ -122,6 +122,8 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckObjects(objects, &check);
   CheckGrid(grid, &check);
   CheckGeometry(geometry, &check);
+  check.InRange("change.alignment.max_shift_m", alignment.max_shift_m, 0.0, 100.0)
+      .InRange("change.alignment.min_gain", alignment.min_gain, 0.0, 10.0);
   CheckGeometryObjects(geometry_objects, &check);
   CheckRouteFrames(route_frames, &check);
   CheckRoute(route, &check);

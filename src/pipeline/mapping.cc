@@ -6,6 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "patrolmap/change/grid_alignment.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
@@ -122,16 +123,45 @@ Status MapSource(const MappingRequest& request, const std::string& spec, const C
   return WriteFlightOutputs(request, info, run.result, outcome->places);
 }
 
-// The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes.
+// The latest patrol of `map` that has an evidence grid; none without.
+const PatrolRecord* LatestGrid(const graph::TopoMap& map) {
+  const std::vector<std::string> flights = map.Flights();
+  for (auto flight = flights.rbegin(); flight != flights.rend(); ++flight) {
+    const PatrolRecord* record = map.Patrol(*flight);
+    if (record != nullptr && record->grid.voxel_size > 0.0 && !record->grid.voxels.empty()) return record;
+  }
+  return nullptr;
+}
+
+// Moves a new patrol onto the map's latest one with a grid, when a whole-voxel shift overlaps their surfaces
+// clearly better (change/grid_alignment.h): the poses of two flights can share an offset.
+void AlignToMap(const graph::TopoMap& map, const change::GridAlignmentOptions& options, PatrolRecord* record) {
+  const PatrolRecord* reference = LatestGrid(map);
+  if (reference == nullptr || record->grid.voxels.empty()) return;
+  const change::GridShift shift = change::FindGridShift(reference->grid, record->grid, options);
+  if (!shift.applied) return;
+  change::ShiftRecord(shift.voxels, record);
+  const Eigen::Vector3d metres = shift.voxels.cast<double>() * record->grid.voxel_size;
+  spdlog::info("{}: moved by ({:.2f}, {:.2f}, {:.2f}) m onto {}'s surfaces: {} of its occupied voxels meet {}'s, "
+               "{} before",
+               record->flight, metres.x(), metres.y(), metres.z(), reference->flight, shift.overlap,
+               reference->flight, shift.overlap_unshifted);
+}
+
+// The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes,
+// each aligned to the map's patrol before it.
 graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecognizer& recognizer,
-                           const graph::TopoMap::VocabularyTag& tag, MappingOutcome* outcome) {
+                           const graph::TopoMap::VocabularyTag& tag, const change::GridAlignmentOptions& alignment,
+                           MappingOutcome* outcome) {
   graph::TopoMap map = BuildTopoMap(outcome->places, recognizer, &prior);
   map.set_vocabulary(tag);
   for (FlightRun& run : outcome->flights) {
     PatrolRecord& record = run.result.record;
     const bool has_nodes = std::any_of(outcome->places.nodes.begin(), outcome->places.nodes.end(),
                                        [&record](const MapNode& node) { return node.flight == record.flight; });
-    if (has_nodes) map.SetPatrol(std::move(record));
+    if (!has_nodes) continue;
+    AlignToMap(map, alignment, &record);
+    map.SetPatrol(std::move(record));
   }
   return map;
 }
@@ -160,7 +190,8 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   for (const std::string& source : request.sources) {
     PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, &recognizer, monitor.get(), outcome));
   }
-  graph::TopoMap map = AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), outcome);
+  graph::TopoMap map =
+      AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change.alignment, outcome);
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(
         ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared));

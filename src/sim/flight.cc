@@ -161,8 +161,11 @@ std::string GpsTable(const SimulatedFlight& flight, const LogOptions& options) {
   out.precision(10);
   out << "#timestamp [ns],latitude [deg],longitude [deg],altitude [m]\n";
   const double lat0 = options.gps_origin_latitude * M_PI / 180.0;
+  cv::RNG bias_rng(static_cast<std::uint64_t>(flight.lighting.noise_seed) * 101u + 3u);
+  const Eigen::Vector3d bias(bias_rng.gaussian(options.gps_bias_m), bias_rng.gaussian(options.gps_bias_m),
+                             bias_rng.gaussian(options.gps_bias_m));
   for (double t = 0.0; t <= flight.duration_s; t += 1.0 / kRateHz) {
-    const Eigen::Vector3d p = flight.trajectory(t).position;
+    const Eigen::Vector3d p = flight.trajectory(t).position + bias;
     const double north = p.y() + rng.gaussian(kSigma), east = p.x() + rng.gaussian(kSigma);
     out << SecondsToNs(t) << "," << options.gps_origin_latitude + north / kEarthRadius * 180.0 / M_PI << ","
         << options.gps_origin_longitude + east / (kEarthRadius * std::cos(lat0)) * 180.0 / M_PI << ","

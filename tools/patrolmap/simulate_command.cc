@@ -170,6 +170,11 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
                   "standard deviation of each GPS fix's east and north, twice that up [m]")
       ->check(FiniteRange(0.0, 100.0))
       ->capture_default_str();
+  app->add_option("--gps-bias", arguments->log.gps_bias_m,
+                  "standard deviation of an offset of all of a flight's fixes, drawn once per flight and axis "
+                  "(the day's GNSS error) [m]")
+      ->check(FiniteRange(0.0, 100.0))
+      ->capture_default_str();
   app->add_option("--attitude-noise", arguments->log.attitude_noise_deg,
                   "standard deviation of the attitude's error about each axis, fixed per flight [deg]")
       ->check(FiniteRange(0.0, 30.0))

@@ -160,6 +160,12 @@ struct RouteFrameOptions {
   double memory_mb = 16.0;  // a patrol's frames at most [MB] (in memory and in the map file)
 };
 
+// Aligning a new patrol's grid to the earlier patrol's before they are compared (grid_alignment.h).
+struct GridAlignmentOptions {
+  double max_shift_m = 2.0;  // the largest shift searched along each axis [m]; 0 = no alignment
+  double min_gain = 0.2;     // the shift must overlap this share more occupied voxels than no shift
+};
+
 struct ChangeOptions {
   AppearanceOptions appearance;
   ObjectMapOptions object_map;
@@ -167,6 +173,7 @@ struct ChangeOptions {
   EvidenceGridOptions grid;
   GeometryDiffOptions geometry;
   GeometryObjectOptions geometry_objects;
+  GridAlignmentOptions alignment;
   RouteFrameOptions route_frames;
   RouteCompareOptions route;
   // False with a message naming the first invalid option.

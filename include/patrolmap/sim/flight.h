@@ -46,6 +46,7 @@ struct LogOptions {
   double stereo_baseline_m = 0.0;   // > 0: cam1/, a second camera this far to the right of cam0 (a stereo pair)
   bool gps = false;                 // gps0/data.csv at 10 Hz, and the IMU's attitude in imu0/data.csv
   double gps_noise_m = 1.5;         // standard deviation of each fix's east and north (twice that up) [m]
+  double gps_bias_m = 0.0;          // ... of an offset drawn once per flight (each axis), shared by its fixes [m]
   double attitude_noise_deg = 0.5;  // standard deviation of the attitude's error about each axis, fixed per flight
   double exposure_s = 0.0;          // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
   bool truth_only = false;          // write only groundtruth/key_locations.csv (after a change of its definition)

@@ -1,0 +1,30 @@
+// Aligns a new patrol to the map's earlier one before they are compared: the whole-voxel shift that puts the
+// most of its occupied voxels onto occupied voxels of the earlier patrol's grid (paper 003 registers missions
+// onto each other before it looks for changes). A shift common to the whole flight (the day's GNSS bias, a pose
+// source's other origin) moves every surface and would make everything differ; changes move a few voxels only.
+// Searched coarse (cells of 4 voxels) then fine, within max_shift_m along each axis. The shift is taken when it
+// overlaps at least min_gain more voxels than no shift does; otherwise none (poses that agree keep theirs).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/patrol_data.h"
+
+namespace patrolmap::change {
+
+struct GridShift {
+  Eigen::Vector3i voxels = Eigen::Vector3i::Zero();  // to add to the current grid's voxel indices
+  long long overlap = 0;            // occupied current voxels on occupied prior ones, after the shift
+  long long overlap_unshifted = 0;  // ... without it
+  bool applied = false;             // the shift beats no shift by min_gain
+};
+
+// The shift of `current` onto `prior` (both must have the same voxel size; none otherwise).
+GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
+                        const GridAlignmentOptions& options);
+
+// `record` moved by `shift_m` (a whole number of its grid's voxels): grid, objects, views and route poses.
+void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,106 @@
+#include "patrolmap/change/grid_alignment.h"
+
+#include <cmath>
+#include <unordered_set>
+#include <vector>
+
+#include "patrolmap/change/evidence_grid.h"
+
+namespace patrolmap::change {
+namespace {
+
+constexpr int kCoarse = 4;  // voxels per coarse cell along each axis
+
+int FloorDiv(int value, int by) { return value >= 0 ? value / by : -((-value + by - 1) / by); }
+
+std::vector<Eigen::Vector3i> OccupiedVoxels(const EvidenceGridData& grid) {
+  std::vector<Eigen::Vector3i> occupied;
+  for (const VoxelEvidence& v : grid.voxels) {
+    if (IsOccupied(&v)) occupied.emplace_back(v.x, v.y, v.z);
+  }
+  return occupied;
+}
+
+std::vector<Eigen::Vector3i> Coarse(const std::vector<Eigen::Vector3i>& voxels) {
+  std::unordered_set<std::uint64_t> seen;
+  std::vector<Eigen::Vector3i> cells;
+  for (const Eigen::Vector3i& v : voxels) {
+    const Eigen::Vector3i cell(FloorDiv(v.x(), kCoarse), FloorDiv(v.y(), kCoarse), FloorDiv(v.z(), kCoarse));
+    if (seen.insert(VoxelKey(cell)).second) cells.push_back(cell);
+  }
+  return cells;
+}
+
+std::unordered_set<std::uint64_t> KeySet(const std::vector<Eigen::Vector3i>& voxels) {
+  std::unordered_set<std::uint64_t> keys;
+  keys.reserve(voxels.size());
+  for (const Eigen::Vector3i& v : voxels) keys.insert(VoxelKey(v));
+  return keys;
+}
+
+long long Overlap(const std::vector<Eigen::Vector3i>& current, const std::unordered_set<std::uint64_t>& prior,
+                  const Eigen::Vector3i& shift) {
+  long long count = 0;
+  for (const Eigen::Vector3i& v : current) count += prior.count(VoxelKey(v + shift));
+  return count;
+}
+
+// The shift within ±reach of `centre` (each axis) with the largest overlap; the nearest to `centre` on ties.
+Eigen::Vector3i BestShift(const std::vector<Eigen::Vector3i>& current, const std::unordered_set<std::uint64_t>& prior,
+                          const Eigen::Vector3i& centre, int reach, long long* best_overlap) {
+  Eigen::Vector3i best = centre;
+  *best_overlap = Overlap(current, prior, centre);
+  for (int dx = -reach; dx <= reach; ++dx) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dz = -reach; dz <= reach; ++dz) {
+        const Eigen::Vector3i shift = centre + Eigen::Vector3i(dx, dy, dz);
+        const long long overlap = Overlap(current, prior, shift);
+        if (overlap > *best_overlap) *best_overlap = overlap, best = shift;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
+                        const GridAlignmentOptions& options) {
+  GridShift result;
+  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size || options.max_shift_m <= 0.0) return result;
+  const std::vector<Eigen::Vector3i> before = OccupiedVoxels(prior), after = OccupiedVoxels(current);
+  if (before.empty() || after.empty()) return result;
+  const std::unordered_set<std::uint64_t> before_keys = KeySet(before);
+  result.overlap_unshifted = Overlap(after, before_keys, Eigen::Vector3i::Zero());
+  const int reach = static_cast<int>(std::ceil(options.max_shift_m / prior.voxel_size));
+  long long coarse_overlap = 0;
+  const Eigen::Vector3i coarse = BestShift(Coarse(after), KeySet(Coarse(before)), Eigen::Vector3i::Zero(),
+                                           (reach + kCoarse - 1) / kCoarse, &coarse_overlap);
+  Eigen::Vector3i fine = BestShift(after, before_keys, coarse * kCoarse, kCoarse, &result.overlap);
+  if (fine.cwiseAbs().maxCoeff() > reach) fine = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
+  result.voxels = fine;
+  result.applied = fine != Eigen::Vector3i::Zero() &&
+                   static_cast<double>(result.overlap) >
+                       (1.0 + options.min_gain) * static_cast<double>(result.overlap_unshifted);
+  if (!result.applied) result.voxels = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
+  return result;
+}
+
+void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record) {
+  const double size = record->grid.voxel_size;
+  const Eigen::Vector3d shift = shift_voxels.cast<double>() * size;
+  const Eigen::Vector3f shift_f = shift.cast<float>();
+  for (VoxelEvidence& v : record->grid.voxels) {  // a translation keeps the (x, y, z) order
+    v.x += shift_voxels.x(), v.y += shift_voxels.y(), v.z += shift_voxels.z();
+  }
+  for (MapObject& object : record->objects) {
+    object.centroid += shift, object.box_min += shift, object.box_max += shift;
+    for (Eigen::Vector3f& point : object.points) point += shift_f;
+  }
+  for (CameraPoseSample& view : record->views) view.position += shift;
+  for (RouteFrame& frame : record->route) {
+    if (frame.pose) frame.pose->position += shift;
+  }
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,70 @@
+#include "patrolmap/change/grid_alignment.h"
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+namespace patrolmap::change {
+namespace {
+
+// A ground plane, a wall along it and a box: occupied voxels with free air in front, in ascending order.
+EvidenceGridData Scene(const Eigen::Vector3i& offset, bool with_box) {
+  EvidenceGridData grid;
+  grid.voxel_size = 0.2;
+  const auto add = [&](int x, int y, int z, bool occupied) {
+    grid.voxels.push_back({x + offset.x(), y + offset.y(), z + offset.z(), static_cast<std::uint16_t>(occupied ? 6 : 0),
+                           static_cast<std::uint16_t>(occupied ? 0 : 6)});
+  };
+  for (int x = 0; x < 60; ++x) {
+    for (int y = 0; y < 40; ++y) {
+      for (int z = 0; z < 12; ++z) {
+        const bool wall = y == 30 && x % 7 != 3;  // a wall with gaps (windows): a shift along it is seen too
+        const bool box = with_box && x >= 10 && x < 15 && y >= 10 && y < 15 && z >= 1 && z < 5;
+        add(x, y, z, z == 0 || wall || box);
+      }
+    }
+  }
+  std::sort(grid.voxels.begin(), grid.voxels.end(), VoxelBefore);
+  return grid;
+}
+
+TEST(GridAlignment, AFlightShiftedByWholeVoxelsIsMovedBack) {
+  const EvidenceGridData prior = Scene(Eigen::Vector3i::Zero(), false);
+  const EvidenceGridData current = Scene(Eigen::Vector3i(4, -3, 1), true);  // 0.8, -0.6, 0.2 m off, a new box
+  const GridShift shift = FindGridShift(prior, current, GridAlignmentOptions{});
+  ASSERT_TRUE(shift.applied);
+  EXPECT_EQ(shift.voxels, Eigen::Vector3i(-4, 3, -1));
+  EXPECT_GT(shift.overlap, 2 * shift.overlap_unshifted);
+  PatrolRecord record;
+  record.grid = current;
+  MapObject object;
+  object.centroid = Eigen::Vector3d(1, 1, 1);
+  object.points = {Eigen::Vector3f(1, 1, 1)};
+  record.objects = {object};
+  record.views = {CameraPoseSample{0, Eigen::Vector3d(5, 5, 2), Eigen::Quaterniond::Identity()}};
+  ShiftRecord(shift.voxels, &record);
+  EXPECT_TRUE(std::is_sorted(record.grid.voxels.begin(), record.grid.voxels.end(), VoxelBefore));
+  EXPECT_EQ(record.grid.voxels.front().x, 0);
+  EXPECT_TRUE(record.objects[0].centroid.isApprox(Eigen::Vector3d(0.2, 1.6, 0.8)));
+  EXPECT_TRUE(record.objects[0].points[0].isApprox(Eigen::Vector3f(0.2f, 1.6f, 0.8f)));
+  EXPECT_TRUE(record.views[0].position.isApprox(Eigen::Vector3d(4.2, 5.6, 1.8)));
+}
+
+// Flights whose poses agree keep them, however much changed; beyond max_shift_m nothing is searched.
+TEST(GridAlignment, PosesThatAgreeAndShiftsOutOfReachAreLeftAlone) {
+  const EvidenceGridData prior = Scene(Eigen::Vector3i::Zero(), false);
+  const GridShift same = FindGridShift(prior, Scene(Eigen::Vector3i::Zero(), true), GridAlignmentOptions{});
+  EXPECT_FALSE(same.applied);
+  EXPECT_EQ(same.voxels, Eigen::Vector3i::Zero());
+  GridAlignmentOptions near;
+  near.max_shift_m = 0.4;  // two voxels
+  EXPECT_FALSE(FindGridShift(prior, Scene(Eigen::Vector3i(5, 0, 0), false), near).applied);
+  near.max_shift_m = 0.0;
+  EXPECT_FALSE(FindGridShift(prior, Scene(Eigen::Vector3i(1, 0, 0), false), near).applied);
+  EvidenceGridData other = prior;
+  other.voxel_size = 0.25;
+  EXPECT_FALSE(FindGridShift(prior, other, GridAlignmentOptions{}).applied);
+}
+
+}  // namespace
+}  // namespace patrolmap::change
