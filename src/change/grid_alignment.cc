@@ -79,9 +79,9 @@ GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& c
   Eigen::Vector3i fine = BestShift(after, before_keys, coarse * kCoarse, kCoarse, &result.overlap);
   if (fine.cwiseAbs().maxCoeff() > reach) fine = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
   result.voxels = fine;
-  result.applied = fine != Eigen::Vector3i::Zero() &&
-                   static_cast<double>(result.overlap) >
-                       (1.0 + options.min_gain) * static_cast<double>(result.overlap_unshifted);
+  result.applied =
+      fine != Eigen::Vector3i::Zero() &&
+      static_cast<double>(result.overlap) > (1.0 + options.min_gain) * static_cast<double>(result.overlap_unshifted);
   if (!result.applied) result.voxels = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
   return result;
 }

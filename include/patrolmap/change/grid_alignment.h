@@ -15,9 +15,9 @@ namespace patrolmap::change {
 
 struct GridShift {
   Eigen::Vector3i voxels = Eigen::Vector3i::Zero();  // to add to the current grid's voxel indices
-  long long overlap = 0;            // occupied current voxels on occupied prior ones, after the shift
-  long long overlap_unshifted = 0;  // ... without it
-  bool applied = false;             // the shift beats no shift by min_gain
+  long long overlap = 0;                             // occupied current voxels on occupied prior ones, after the shift
+  long long overlap_unshifted = 0;                   // ... without it
+  bool applied = false;                              // the shift beats no shift by min_gain
 };
 
 // The shift of `current` onto `prior` (both must have the same voxel size; none otherwise).
