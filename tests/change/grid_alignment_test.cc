@@ -66,5 +66,30 @@ TEST(GridAlignment, PosesThatAgreeAndShiftsOutOfReachAreLeftAlone) {
   EXPECT_FALSE(FindGridShift(prior, other, GridAlignmentOptions{}).applied);
 }
 
+// A ground (2400 voxels) the same in both, and a wall (480) two voxels further in the current grid: moving the
+// wall back costs 120 ground voxels, so the shift overlaps 15 % more than none. Taken only with min_gain below that.
+TEST(GridAlignment, AShiftThatGainsLessThanMinGainIsNotTaken) {
+  const auto grid = [](int wall_y) {
+    EvidenceGridData g;
+    g.voxel_size = 0.2;
+    for (int x = 0; x < 60; ++x) {
+      for (int y = 0; y < 40; ++y) g.voxels.push_back({x, y, 0, 6, 0});
+      for (int z = 1; z <= 8; ++z) g.voxels.push_back({x, wall_y, z, 6, 0});
+    }
+    std::sort(g.voxels.begin(), g.voxels.end(), VoxelBefore);
+    return g;
+  };
+  const EvidenceGridData prior = grid(30), current = grid(32);
+  GridShift shift = FindGridShift(prior, current, GridAlignmentOptions{});
+  EXPECT_FALSE(shift.applied);
+  EXPECT_EQ(shift.overlap, 2400);
+  GridAlignmentOptions eager;
+  eager.min_gain = 0.1;
+  shift = FindGridShift(prior, current, eager);
+  ASSERT_TRUE(shift.applied);
+  EXPECT_EQ(shift.voxels, Eigen::Vector3i(0, -2, 0));
+  EXPECT_EQ(shift.overlap, 2280 + 480);
+}
+
 }  // namespace
 }  // namespace patrolmap::change
