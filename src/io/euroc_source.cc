@@ -42,11 +42,9 @@ Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples, st
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample->gyro));
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample->accel));
     if (fields.size() < 11) return Status::Ok();
-    double q[4];
-    for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[7 + i], "q_WS (attitude)", &q[i]));
-    const Eigen::Quaterniond world_from_imu(q[0], q[1], q[2], q[3]);
-    if (!(std::abs(world_from_imu.norm() - 1.0) <= 1e-3)) return csv.Error("q_WS (attitude) is not a unit quaternion");
-    attitude->push_back({sample->timestamp_ns, world_from_imu.normalized()});
+    AttitudeSample turn{sample->timestamp_ns, Eigen::Quaterniond::Identity()};
+    PATROLMAP_RETURN_IF_ERROR(ParseUnitQuaternion(csv, fields, 7, "q_WS (attitude)", &turn.world_from_imu));
+    attitude->push_back(turn);
     return Status::Ok();
   };
   return ReadTimedTable(path, 7, parse, samples);
@@ -259,6 +257,12 @@ Status ReadGpsTable(const std::string& path, std::vector<GpsSample>* samples) {
   return ReadTimedTable(path, 4, parse, samples);
 }
 
+std::vector<TimestampNs> FrameTimes(const std::vector<ImageEntry>& entries) {
+  std::vector<TimestampNs> times(entries.size());
+  std::transform(entries.begin(), entries.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
+  return times;
+}
+
 // Without a state estimate: camera poses from the GPS fixes and the IMU's attitude, at the frames' times.
 void PosesFromFixes(const std::string& log, const LogInfo& info, const std::vector<GpsSample>& gps,
                     const std::vector<AttitudeSample>& attitude, const std::vector<ImageEntry>& entries,
@@ -270,9 +274,8 @@ void PosesFromFixes(const std::string& log, const LogInfo& info, const std::vect
         log);
     return;
   }
-  std::vector<TimestampNs> times(entries.size());
-  std::transform(entries.begin(), entries.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
-  sensors->poses = PosesFromGps(gps, attitude, Eigen::Quaterniond(info.camera_from_imu->transpose()), times);
+  sensors->poses =
+      PosesFromGps(gps, attitude, Eigen::Quaterniond(info.camera_from_imu->transpose()), FrameTimes(entries));
   if (sensors->poses.empty()) {
     spdlog::warn("{}: gps0/ and imu0/'s attitude give no camera pose: their times do not cover cam0's", log);
     return;
@@ -305,9 +308,7 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &attitude, &speeds));
   if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
   if (!(info.frame_rate_hz > 0.0 && std::isfinite(info.frame_rate_hz))) {
-    std::vector<TimestampNs> times(entries.size());
-    std::transform(entries.begin(), entries.end(), times.begin(), [](const ImageEntry& e) { return e.timestamp_ns; });
-    info.frame_rate_hz = MedianRate(times);
+    info.frame_rate_hz = MedianRate(FrameTimes(entries));
   }
   info.timing = "cam0/data.csv";
   if (!imu.empty() && !info.camera_from_imu) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/types.h"
@@ -69,6 +70,18 @@ inline Status ParseVector(const CsvReader& csv, const std::vector<std::string_vi
   for (int axis = 0; axis < 3; ++axis) {
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + axis], column, &(*vector)[axis]));
   }
+  return Status::Ok();
+}
+
+// Four columns from `first` on as a quaternion w, x, y, z, which must have unit length (within 1e-3); returned
+// normalised.
+inline Status ParseUnitQuaternion(const CsvReader& csv, const std::vector<std::string_view>& fields, std::size_t first,
+                                  const char* column, Eigen::Quaterniond* quaternion) {
+  double q[4];
+  for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[first + i], column, &q[i]));
+  const Eigen::Quaterniond parsed(q[0], q[1], q[2], q[3]);
+  if (!(std::abs(parsed.norm() - 1.0) <= 1e-3)) return csv.Error(std::string(column) + " is not a unit quaternion");
+  *quaternion = parsed.normalized();
   return Status::Ok();
 }
 

@@ -21,11 +21,9 @@ Status ReadPoseTable(const std::string& path, const Eigen::Matrix3d& body_from_c
   const auto parse = [&camera_rotation](const CsvReader& csv, const std::vector<std::string_view>& fields,
                                         CameraPoseSample* pose) {
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "p_RS_R [m]", &pose->position));
-    double q[4];
-    for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[4 + i], "q_RS", &q[i]));
-    const Eigen::Quaterniond body(q[0], q[1], q[2], q[3]);
-    if (!(std::abs(body.norm() - 1.0) <= 1e-3)) return csv.Error("q_RS is not a unit quaternion");
-    pose->rotation = (body.normalized() * camera_rotation).normalized();
+    Eigen::Quaterniond body;
+    PATROLMAP_RETURN_IF_ERROR(ParseUnitQuaternion(csv, fields, 4, "q_RS", &body));
+    pose->rotation = (body * camera_rotation).normalized();
     return Status::Ok();
   };
   return ReadTimedTable(path, 8, parse, poses);
