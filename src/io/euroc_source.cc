@@ -41,7 +41,10 @@ Status ReadImuTable(const std::string& path, std::vector<ImuSample>* samples, st
   const auto parse = [attitude](const CsvReader& csv, const std::vector<std::string_view>& fields, ImuSample* sample) {
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 1, "w_RS_S [rad s^-1]", &sample->gyro));
     PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 4, "a_RS_S [m s^-2]", &sample->accel));
-    if (fields.size() < 11) return Status::Ok();
+    if (fields.size() == 7) return Status::Ok();
+    if (fields.size() < 11) {  // a row cut short, or an attitude missing columns: not taken for none
+      return csv.Error("expected 7 columns, or 11 with the attitude, found " + std::to_string(fields.size()));
+    }
     AttitudeSample turn{sample->timestamp_ns, Eigen::Quaterniond::Identity()};
     PATROLMAP_RETURN_IF_ERROR(ParseUnitQuaternion(csv, fields, 7, "q_WS (attitude)", &turn.world_from_imu));
     attitude->push_back(turn);

@@ -327,6 +327,10 @@ TEST(Euroc, PosesFromGpsAndTheImusAttitude) {
   WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az,qw,qx,qy,qz\n1000000000,0,0,0,0,0,9.8,1,0,0,0.5\n");
   EXPECT_NE(OpenLog(log, {}, &source).message().find("imu0/data.csv:2: q_WS (attitude) is not a unit quaternion"),
             std::string::npos);
+  WriteText(log + "/imu0/data.csv", "#t,wx,wy,wz,ax,ay,az,qw,qx,qy,qz\n1000000000,0,0,0,0,0,9.8,1,0\n");
+  EXPECT_NE(
+      OpenLog(log, {}, &source).message().find("imu0/data.csv:2: expected 7 columns, or 11 with the attitude, found 9"),
+      std::string::npos);
 }
 
 // cam0 and cam1 0.11 m apart (EuRoC's layout): cam1's images at cam0's times make stereo pairs.
