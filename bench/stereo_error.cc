@@ -8,7 +8,8 @@
 //     A rectified pair with its 8-bit true disparity (0 = unknown), matched with the defaults and that range.
 //
 // Prints the pixels compared, the share off by more than 3 px, and the mean and rms of the rest; for a log also
-// the mean per metre of true depth and per grey level of the left image's 7x7 standard deviation.
+// the mean per metre of true depth, per grey level of the left image's 7x7 standard deviation and per tenth of the
+// true disparity's fraction.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -28,6 +29,10 @@ namespace {
 using namespace patrolmap;
 
 constexpr double kGrossPx = 3.0;
+// The error per tenth of the true disparity's fraction (SGBM's sub-pixel fit pulls disparities towards whole
+// pixels) is counted only beyond this depth [m]: off the ground right under the camera, whose few depths fill
+// a few tenths alone.
+constexpr float kFractionBeyondM = 7.0f;
 
 struct Mean {
   double sum = 0.0, squares = 0.0;
@@ -38,7 +43,7 @@ struct Mean {
 struct Errors {
   Mean all;
   long gross = 0;
-  std::map<int, Mean> by_depth, by_texture;
+  std::map<int, Mean> by_depth, by_texture, by_fraction;
 };
 
 int Fail(const std::string& message) {
@@ -61,6 +66,9 @@ void Print(const Errors& e, bool bins) {
   for (const auto& [grey, m] : e.by_texture)
     std::printf("left 7x7 std %2d%s: mean %+.3f px (%ld pixels)\n", grey, grey == 20 ? "+" : "", m.sum / m.count,
                 m.count);
+  for (const auto& [tenth, m] : e.by_fraction)
+    std::printf("true disparity's fraction 0.%d: mean %+.3f px, rms %.3f px (%ld pixels)\n", tenth, m.sum / m.count,
+                std::sqrt(m.squares / m.count), m.count);
 }
 
 // The left image's local standard deviation over 7x7 pixels.
@@ -122,6 +130,9 @@ int Log(const std::string& log, int step) {
         errors.all.Add(e);
         errors.by_depth[static_cast<int>(z_true)].Add(e);
         errors.by_texture[std::min(20, static_cast<int>(deviation.at<float>(y, x)))].Add(e);
+        const double d_true = fb / z_true;
+        if (z_true >= kFractionBeyondM)
+          errors.by_fraction[static_cast<int>(10.0 * (d_true - std::floor(d_true)))].Add(e);
       }
     }
   }

@@ -61,7 +61,7 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   KeyKinds kinds;
   Config defaults;
   VisitConfig(&defaults, &kinds);
-  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 133u);  // every numeric key (the rest are switches)
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 134u);  // every numeric key (the rest are switches)
   const auto refused = [&](const std::string& key, const std::string& value) {
     testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
     Config config;
@@ -592,6 +592,21 @@ TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
       EXPECT_EQ(step.right_path.empty(), choice == depth::DepthSource::kImages) << step.depth_path;
     }
   }
+}
+
+TEST(ChangeMonitor, AnOptionOutOfRangeIsRefusedNamingItsFlag) {
+  ChangeEventOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.min_observations = 0;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("--events-min-observations"), std::string::npos) << error;
+  testing::TempDir dir;
+  graph::TopoMap prior;
+  std::unique_ptr<ChangeMonitor> monitor;
+  const Status status = ChangeMonitor::Open(&prior, "before", Config(), options, dir / "events.jsonl", &monitor);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("--events-min-observations"), std::string::npos) << status.message();
 }
 
 TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {

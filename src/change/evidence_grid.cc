@@ -114,8 +114,15 @@ VoxelLookup LookupIn(const EvidenceGridData& grid) {
   };
 }
 
-VoxelLookup LookupIn(const EvidenceGrid& grid) {
-  return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) { return grid.Lookup(index, voxel); };
+VoxelLookup LookupIn(const EvidenceGrid& grid, const Eigen::Vector3i& shift) {
+  if (shift == Eigen::Vector3i::Zero()) {
+    return [&grid](const Eigen::Vector3i& index, VoxelEvidence* voxel) { return grid.Lookup(index, voxel); };
+  }
+  return [&grid, shift](const Eigen::Vector3i& index, VoxelEvidence* voxel) {
+    if (!grid.Lookup(index - shift, voxel)) return false;
+    voxel->x += shift.x(), voxel->y += shift.y(), voxel->z += shift.z();
+    return true;
+  };
 }
 
 Eigen::Vector3i VoxelIndex(const Eigen::Vector3d& point, double voxel_size) {
@@ -179,6 +186,15 @@ bool EvidenceGrid::Lookup(const Eigen::Vector3i& index, VoxelEvidence* voxel) co
   if (slot == nullptr) return false;
   *voxel = {index.x(), index.y(), index.z(), slot->hits, slot->passes};
   return true;
+}
+
+std::vector<Eigen::Vector3i> EvidenceGrid::OccupiedVoxels() const {
+  std::vector<Eigen::Vector3i> occupied;
+  for (const Slot& slot : slots_) {
+    const VoxelEvidence counts{0, 0, 0, slot.hits, slot.passes};
+    if (slot.key != 0 && IsOccupied(&counts)) occupied.push_back(UnpackKey(slot.key));
+  }
+  return occupied;
 }
 
 // Puts a slot's key into the (not full) table; its counts are the caller's to copy.
@@ -408,16 +424,16 @@ bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, co
 }
 
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGrid& after, const GeometryDiffOptions& options,
-               GeometryChange* change) {
+               GeometryChange* change, const Eigen::Vector3i& after_shift) {
   *change = GeometryChange();
   if (before.voxel_size <= 0.0 || before.voxel_size != after.voxel_size()) return false;
   change->evicted_current = after.evicted_voxels();
-  const VoxelLookup find_after = LookupIn(after);
+  const VoxelLookup find_after = LookupIn(after, after_shift);
   // The prior's voxels in their (sorted) order, each looked up in the live grid: the merge's order.
   const auto for_each_common = [&](const auto& visit) {
     VoxelEvidence current;
     for (const VoxelEvidence& prior : before.voxels) {
-      if (after.Lookup(Eigen::Vector3i(prior.x, prior.y, prior.z), &current)) visit(prior, current);
+      if (after.Lookup(Eigen::Vector3i(prior.x, prior.y, prior.z) - after_shift, &current)) visit(prior, current);
     }
   };
   DiffVoxels(before, find_after, for_each_common, options, change);

@@ -62,17 +62,14 @@ Eigen::Vector3i BestShift(const std::vector<Eigen::Vector3i>& current, const std
   return best;
 }
 
-}  // namespace
-
-GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
-                        const GridAlignmentOptions& options) {
+// The shift of the occupied voxels `after` onto `before`, of `voxel_size`.
+GridShift FindShift(const std::vector<Eigen::Vector3i>& before, const std::vector<Eigen::Vector3i>& after,
+                    double voxel_size, const GridAlignmentOptions& options) {
   GridShift result;
-  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size || options.max_shift_m <= 0.0) return result;
-  const std::vector<Eigen::Vector3i> before = OccupiedVoxels(prior), after = OccupiedVoxels(current);
   if (before.empty() || after.empty()) return result;
   const std::unordered_set<std::uint64_t> before_keys = KeySet(before);
   result.overlap_unshifted = Overlap(after, before_keys, Eigen::Vector3i::Zero());
-  const int reach = static_cast<int>(std::ceil(options.max_shift_m / prior.voxel_size));
+  const int reach = static_cast<int>(std::ceil(options.max_shift_m / voxel_size));
   long long coarse_overlap = 0;
   const Eigen::Vector3i coarse = BestShift(Coarse(after), KeySet(Coarse(before)), Eigen::Vector3i::Zero(),
                                            (reach + kCoarse - 1) / kCoarse, &coarse_overlap);
@@ -86,13 +83,30 @@ GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& c
   return result;
 }
 
+}  // namespace
+
+GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
+                        const GridAlignmentOptions& options) {
+  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size || options.max_shift_m <= 0.0) return {};
+  return FindShift(OccupiedVoxels(prior), OccupiedVoxels(current), prior.voxel_size, options);
+}
+
+GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGrid& current,
+                        const GridAlignmentOptions& options) {
+  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size() || options.max_shift_m <= 0.0) return {};
+  return FindShift(OccupiedVoxels(prior), current.OccupiedVoxels(), prior.voxel_size, options);
+}
+
 void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record) {
   const double size = record->grid.voxel_size;
-  const Eigen::Vector3d shift = shift_voxels.cast<double>() * size;
-  const Eigen::Vector3f shift_f = shift.cast<float>();
   for (VoxelEvidence& v : record->grid.voxels) {  // a translation keeps the (x, y, z) order
     v.x += shift_voxels.x(), v.y += shift_voxels.y(), v.z += shift_voxels.z();
   }
+  MoveRecordPoses(shift_voxels.cast<double>() * size, record);
+}
+
+void MoveRecordPoses(const Eigen::Vector3d& shift, PatrolRecord* record) {
+  const Eigen::Vector3f shift_f = shift.cast<float>();
   for (MapObject& object : record->objects) {
     object.centroid += shift, object.box_min += shift, object.box_max += shift;
     for (Eigen::Vector3f& point : object.points) point += shift_f;

@@ -123,7 +123,8 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckGrid(grid, &check);
   CheckGeometry(geometry, &check);
   check.InRange("change.alignment.max_shift_m", alignment.max_shift_m, 0.0, 100.0)
-      .InRange("change.alignment.min_gain", alignment.min_gain, 0.0, 10.0);
+      .InRange("change.alignment.min_gain", alignment.min_gain, 0.0, 10.0)
+      .InRange("change.alignment.min_differing_share", alignment.min_differing_share, 0.0, 1.0);
   CheckGeometryObjects(geometry_objects, &check);
   CheckRouteFrames(route_frames, &check);
   CheckRoute(route, &check);

@@ -13,6 +13,7 @@
 
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/geometry_objects.h"
+#include "patrolmap/change/grid_alignment.h"
 #include "patrolmap/change/object_diff.h"
 #include "patrolmap/core/option_check.h"
 
@@ -103,6 +104,7 @@ bool ChangeEventOptions::IsValid(std::string* error) const {
   return OptionCheck(error)
       .AboveAtMost("events interval (--events-interval-s)", interval_s, 0.0, 3600.0)
       .InRange("events settle time (--events-settle-s)", settle_s, 0.0, 3600.0)
+      .InRange("events' rays per voxel (--events-min-observations)", min_observations, 1, 65535)
       .ok();
 }
 
@@ -125,7 +127,10 @@ ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& pri
       prior_record_(prior->Patrol(prior_flight)),
       config_(config),
       options_(options),
-      fd_(fd) {}
+      fd_(fd) {
+  check_geometry_ = config.change.geometry;
+  check_geometry_.min_observations = options.min_observations;
+}
 
 ChangeMonitor::~ChangeMonitor() { ::close(fd_); }
 
@@ -189,12 +194,19 @@ void ChangeMonitor::OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder&
 void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder) {
   // The grid is compared where it is built: a copy of it each check (1.2 million voxels after an hour, 19 MB,
   // sorted) was the onboard run's memory peak.
-  const PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), false);
+  PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), false);
   const change::EvidenceGrid* grid = recorder.grid();
   std::vector<Event> candidates;
   change::GeometryChange geometry;
   const bool compared = prior_record_->grid.voxel_size > 0 && grid != nullptr &&
-                        change::DiffGrids(prior_record_->grid, *grid, config_.change.geometry, &geometry);
+                        change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
+  // More differs than right poses give while no shift is taken, or the poses disagree again: a shift is searched.
+  const bool search =
+      geometry.poses_disagree ||
+      (shift_ == Eigen::Vector3i::Zero() && geometry.DifferingShare() > config_.change.alignment.min_differing_share);
+  if (compared && search && Realign(now.flight, *grid)) {
+    change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
+  }
   if (geometry.poses_disagree) {
     // The objects are placed by the same poses (pipeline/change.cc): nothing is sent while they disagree.
     if (!warned_poses_) {
@@ -208,6 +220,7 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
     seen_before_.clear();
     return;
   }
+  if (shift_ != Eigen::Vector3i::Zero()) change::MoveRecordPoses(shift_.cast<double>() * grid->voxel_size(), &now);
   if (prior_record_->has_objects && now.has_objects) {
     for (const change::ObjectChange& change : change::DiffObjects(*prior_record_, now, config_.change.objects)) {
       if (Reported(change.state)) candidates.push_back(ObjectEvent(change, timestamp_ns));
@@ -219,7 +232,7 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
     }
     // Objects no detector named: clusters of the changed space (as the report finds them).
     for (const change::ObjectChange& change :
-         change::GeometryObjects(geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid),
+         change::GeometryObjects(geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid, shift_),
                                  prior_record_->objects, now.objects, config_.change.geometry_objects)) {
       candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
@@ -232,6 +245,18 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
     if (seen_before_.count(event.id) != 0) Send(event, false);
   }
   seen_before_ = std::move(seen);
+}
+
+bool ChangeMonitor::Realign(const std::string& flight, const change::EvidenceGrid& grid) {
+  const change::GridShift found = change::FindGridShift(prior_record_->grid, grid, config_.change.alignment);
+  if (!found.applied || found.voxels == shift_) return false;
+  shift_ = found.voxels;
+  const Eigen::Vector3d metres = shift_.cast<double>() * grid.voxel_size();
+  spdlog::info(
+      "{}: compared moved by ({:.2f}, {:.2f}, {:.2f}) m onto {}'s surfaces while flying: {} of its occupied voxels "
+      "meet {}'s, {} before",
+      flight, metres.x(), metres.y(), metres.z(), prior_flight_, found.overlap, prior_flight_, found.overlap_unshifted);
+  return true;
 }
 
 Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "patrolmap/change/evidence_grid.h"
+
 namespace patrolmap::change {
 namespace {
 
@@ -89,6 +91,44 @@ TEST(GridAlignment, AShiftThatGainsLessThanMinGainIsNotTaken) {
   ASSERT_TRUE(shift.applied);
   EXPECT_EQ(shift.voxels, Eigen::Vector3i(0, -2, 0));
   EXPECT_EQ(shift.overlap, 2280 + 480);
+}
+
+// The onboard case: the current flight's grid is still being built and is read in place. Its shift is found as
+// from a copy, and comparing through the shift finds the new box where the prior map has it, while without it
+// the poses disagree.
+TEST(GridAlignment, AGridStillBeingBuiltIsComparedThroughItsShift) {
+  const EvidenceGridData prior = Scene(Eigen::Vector3i::Zero(), false);
+  const Eigen::Vector3i offset(4, -3, 1);
+  const EvidenceGridData copy = Scene(offset, true);
+  EvidenceGridOptions options;
+  options.voxel_size_m = copy.voxel_size;
+  EvidenceGrid live(options);
+  for (const VoxelEvidence& v : copy.voxels) {  // a ray that starts and ends in the voxel counts it once
+    const Eigen::Vector3d centre = Eigen::Vector3d(v.x, v.y, v.z) * copy.voxel_size;
+    for (int i = 0; i < 6; ++i) live.TraceRay(centre, centre, v.hits > 0);
+  }
+  const GridShift from_copy = FindGridShift(prior, copy, GridAlignmentOptions{});
+  const GridShift in_place = FindGridShift(prior, live, GridAlignmentOptions{});
+  ASSERT_TRUE(in_place.applied);
+  EXPECT_EQ(in_place.voxels, -offset);
+  EXPECT_EQ(in_place.overlap, from_copy.overlap);
+  EXPECT_EQ(in_place.overlap_unshifted, from_copy.overlap_unshifted);
+
+  GeometryDiffOptions diff;
+  GeometryChange unshifted, shifted;
+  ASSERT_TRUE(DiffGrids(prior, live, diff, &unshifted));
+  EXPECT_TRUE(unshifted.poses_disagree);
+  ASSERT_TRUE(DiffGrids(prior, live, diff, &shifted, in_place.voxels));
+  EXPECT_FALSE(shifted.poses_disagree);
+  ASSERT_EQ(shifted.regions.size(), 1u);
+  // The box fills x 10-14, y 10-14, z 1-4 of the prior's frame (2.0-2.8 m, 2.0-2.8 m, 0.2-0.8 m).
+  EXPECT_NEAR(shifted.regions[0].centroid.x(), 2.4, 0.05);
+  EXPECT_NEAR(shifted.regions[0].centroid.y(), 2.4, 0.05);
+  EXPECT_EQ(shifted.regions[0].appeared, shifted.regions[0].voxels);
+  VoxelEvidence voxel;
+  EXPECT_TRUE(LookupIn(live, in_place.voxels)(Eigen::Vector3i(12, 12, 2), &voxel));
+  EXPECT_EQ(voxel.x, 12);
+  EXPECT_EQ(voxel.hits, 6);
 }
 
 }  // namespace

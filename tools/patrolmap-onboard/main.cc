@@ -94,8 +94,9 @@ int main(int argc, char** argv) {
                  "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "
                  "matrix per image); replaces the log's state estimate")
       ->check(CLI::ExistingFile);
-  app.add_option("--topic", arguments.request.topics,
-                 "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose, depth, right); repeatable")
+  app.add_option(
+         "--topic", arguments.request.topics,
+         "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose, depth, right); repeatable")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--fast", arguments.fast, "replay a log as fast as it can be processed, not at its own rate");
@@ -121,6 +122,11 @@ int main(int argc, char** argv) {
                  "with --map: the last views an object check leaves out (their detections may still come) [s]")
       ->capture_default_str()
       ->check(patrolmap::tools::FiniteRange(0.0, 3600.0));
+  app.add_option("--events-min-observations", arguments.events.min_observations,
+                 "with --map: rays per voxel in each patrol for a check while flying to compare it (the report "
+                 "after the flight uses change.geometry.min_observations)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65535));
   app.add_flag("-q,--quiet", quiet, "only print errors");
   app.footer(
       "With --map, the flight is compared with the map's last flight as it goes: each change found is appended to "

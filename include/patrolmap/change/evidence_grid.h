@@ -45,6 +45,8 @@ class EvidenceGrid {
   double voxel_size() const { return options_.voxel_size_m; }
   // The voxel at `index`, when the grid holds it (into `voxel`).
   bool Lookup(const Eigen::Vector3i& index, VoxelEvidence* voxel) const;
+  // The indices of its occupied voxels (IsOccupied), in no order.
+  std::vector<Eigen::Vector3i> OccupiedVoxels() const;
   EvidenceGridData ToData() const;
   // ToData(), and the table's memory given back (the grid is as a new one afterwards, its eviction count
   // kept): the end of a patrol.
@@ -86,7 +88,9 @@ const VoxelEvidence* FindVoxel(const EvidenceGridData& grid, const Eigen::Vector
 // Reads one patrol's evidence grid: true and the voxel at `index` when the grid holds it.
 using VoxelLookup = std::function<bool(const Eigen::Vector3i& index, VoxelEvidence* voxel)>;
 VoxelLookup LookupIn(const EvidenceGridData& grid);  // the grid must outlive the lookup
-VoxelLookup LookupIn(const EvidenceGrid& grid);      // a grid still being built (onboard), read in place
+// A grid still being built (onboard), read in place; its voxel i answers for index i + shift (a patrol aligned
+// onto the map's by whole voxels, change/grid_alignment.h).
+VoxelLookup LookupIn(const EvidenceGrid& grid, const Eigen::Vector3i& shift = Eigen::Vector3i::Zero());
 
 struct GeometryRegion {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -118,8 +122,9 @@ struct GeometryChange {
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change);
 // The same against a grid still being built, read in place (no copy of its voxels): the onboard checks while
-// flying. Equal to DiffGrids(before, after.ToData(), ...).
+// flying. Its voxel i is compared at index i + after_shift (LookupIn). Equal to DiffGrids(before, after.ToData()
+// shifted, ...).
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGrid& after, const GeometryDiffOptions& options,
-               GeometryChange* change);
+               GeometryChange* change, const Eigen::Vector3i& after_shift = Eigen::Vector3i::Zero());
 
 }  // namespace patrolmap::change

@@ -20,11 +20,18 @@ struct GridShift {
   bool applied = false;                              // the shift beats no shift by min_gain
 };
 
+class EvidenceGrid;
+
 // The shift of `current` onto `prior` (both must have the same voxel size; none otherwise).
 GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
                         const GridAlignmentOptions& options);
+// The same for a grid still being built, read in place (onboard, while flying).
+GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGrid& current,
+                        const GridAlignmentOptions& options);
 
-// `record` moved by `shift_m` (a whole number of its grid's voxels): grid, objects, views and route poses.
+// `record` moved by `shift_voxels` whole voxels of its grid: grid, objects, views and route poses.
 void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record);
+// `record`'s objects, views and route poses moved by `shift_m` (its grid, if any, stays).
+void MoveRecordPoses(const Eigen::Vector3d& shift_m, PatrolRecord* record);
 
 }  // namespace patrolmap::change

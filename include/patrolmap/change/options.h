@@ -164,6 +164,9 @@ struct RouteFrameOptions {
 struct GridAlignmentOptions {
   double max_shift_m = 2.0;  // the largest shift searched along each axis [m]; 0 = no alignment
   double min_gain = 0.2;     // the shift must overlap this share more occupied voxels than no shift
+  // While flying (onboard), a shift is searched at a check whose share of differing surface voxels exceeds this,
+  // until one is taken (again when the poses then disagree). Right poses measured at most 0.05.
+  double min_differing_share = 0.05;
 };
 
 struct ChangeOptions {

@@ -34,6 +34,10 @@ namespace patrolmap::pipeline {
 struct ChangeEventOptions {
   double interval_s = 5.0;  // flight time between checks of the object map and the grid [s]
   double settle_s = 5.0;    // the last views left out of the check for removed objects [s]
+  // Rays each patrol must have cast through or into a voxel for a check while flying to compare it (the report
+  // after the flight uses change.geometry.min_observations): near the camera the grid is still growing, and a
+  // facade so far seen only at a grazing angle is passed by rays that end on it further along.
+  int min_observations = 12;
   bool IsValid(std::string* error) const;
 };
 
@@ -65,6 +69,9 @@ class ChangeMonitor {
                 const ChangeEventOptions& options, int fd);
   void Send(const Event& event, bool final_event);
   void CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
+  // While the poses disagree: the whole-voxel shift of the live grid onto the prior's (change/grid_alignment.h),
+  // as `patrol` moves a finished flight onto the map. True when a new shift was taken.
+  bool Realign(const std::string& flight, const change::EvidenceGrid& grid);
 
   const graph::TopoMap* prior_;
   std::string prior_flight_;
@@ -77,9 +84,13 @@ class ChangeMonitor {
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;
   bool started_ = false;
-  bool warned_poses_ = false;          // that the poses disagree (change thread)
-  std::set<std::string> seen_before_;  // ids the previous check found (change thread)
-  mutable std::mutex mutex_;           // the file, sent_ and status_ (two stage threads write)
+  bool warned_poses_ = false;  // that the poses disagree (change thread)
+  // The live grid's voxel i is compared at i + shift_, its objects moved with it: events are placed in the map's
+  // frame, as the report after the flight places them (change thread).
+  Eigen::Vector3i shift_ = Eigen::Vector3i::Zero();
+  change::GeometryDiffOptions check_geometry_;  // config.change.geometry with options.min_observations
+  std::set<std::string> seen_before_;           // ids the previous check found (change thread)
+  mutable std::mutex mutex_;                    // the file, sent_ and status_ (two stage threads write)
   std::set<std::string> sent_;
   int events_ = 0;
   Status status_;

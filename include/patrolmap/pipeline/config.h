@@ -140,6 +140,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.max_differing_share", &change.geometry.max_differing_share);
   visitor->Field("change.alignment.max_shift_m", &change.alignment.max_shift_m);
   visitor->Field("change.alignment.min_gain", &change.alignment.min_gain);
+  visitor->Field("change.alignment.min_differing_share", &change.alignment.min_differing_share);
   visitor->Field("change.geometry_objects.enabled", &change.geometry_objects.enabled);
   visitor->Field("change.geometry_objects.cluster_gap_voxels", &change.geometry_objects.cluster_gap_voxels);
   visitor->Field("change.geometry_objects.min_voxels", &change.geometry_objects.min_voxels);
