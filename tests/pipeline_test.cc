@@ -662,6 +662,63 @@ TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
   EXPECT_EQ(text.back(), '\n');
 }
 
+// A wall 5 m ahead in both flights and, in the second, a box 4 m ahead in front of it. Every check while flying
+// compares the grid so far; one that asks more rays per voxel than any voxel has compares nothing and sends no
+// geometry event, while the default floor sends the box.
+TEST(ChangeMonitor, ChecksWhileFlyingCompareOnlyVoxelsSeenByTheirRays) {
+  const CameraIntrinsics camera{40.0, 40.0, 31.5, 23.5, 64, 48};
+  const CameraPoseSample pose{0, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
+  const cv::Mat wall(48, 64, CV_32FC1, cv::Scalar(5.0f));
+  cv::Mat with_box = wall.clone();
+  with_box(cv::Rect(40, 16, 16, 16)).setTo(4.0f);
+  Config config;
+  change::EvidenceGrid prior_grid(config.change.grid);
+  for (int i = 0; i < 25; ++i) prior_grid.Integrate(wall, camera, pose);
+  graph::TopoMap prior;
+  PatrolRecord before;
+  before.flight = "before";
+  before.camera = camera;
+  before.grid = prior_grid.ToData();
+  before.depth_source = "images";
+  prior.SetPatrol(before);
+  const auto events_with = [&](int min_observations) {
+    testing::TempDir dir;
+    ChangeEventOptions options;
+    options.interval_s = 1.0;
+    options.settle_s = 0.0;
+    options.min_observations = min_observations;
+    std::unique_ptr<ChangeMonitor> monitor;
+    EXPECT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
+    io::LogInfo info;
+    info.camera = camera;
+    info.has_poses = info.has_depth = true;
+    PatrolRecorder recorder(config, info);
+    std::vector<ChangeWork> work;
+    for (int i = 0; i <= 25; ++i) {  // depth every 0.1 s; checks at 1 s and 2 s
+      Frame frame;
+      frame.timestamp_ns = SecondsToNs(0.1 * i);
+      frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(100));
+      frame.pose = CameraPoseSample{frame.timestamp_ns, pose.position, pose.rotation};
+      frame.poses = {*frame.pose};
+      DepthSample depth;
+      depth.timestamp_ns = frame.timestamp_ns;
+      depth.image = with_box;
+      depth.pose = frame.pose;
+      frame.depth = {depth};
+      work.clear();
+      recorder.Collect(frame, &work);
+      for (const ChangeWork& step : work) {
+        recorder.Apply(step);
+        monitor->OnChangeStep(step.timestamp_ns, recorder);
+      }
+    }
+    return testing::ReadText(dir / "events.jsonl");
+  };
+  const std::string floor_of_three = events_with(3);
+  EXPECT_NE(floor_of_three.find("\"type\":\"geometry\""), std::string::npos) << floor_of_three;
+  EXPECT_EQ(events_with(65535), "");
+}
+
 // Maps `log` through the per-frame pass into `result` (after the nodes it holds).
 FlightRun MapThroughPass(const std::filesystem::path& log, const Config& config, const FlightPassOptions& options,
                          place::PlaceRecognizer* recognizer, MapResult* result) {
