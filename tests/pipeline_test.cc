@@ -594,6 +594,24 @@ TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
   }
 }
 
+// Checks every second of flight, nothing left out as unsettled: the ChangeMonitor tests' options.
+ChangeEventOptions ChecksEverySecond() {
+  ChangeEventOptions options;
+  options.interval_s = 1.0;
+  options.settle_s = 0.0;
+  return options;
+}
+
+// Frame `i` of a 64x48 camera standing at the origin, 0.1 s apart.
+Frame StillFrame(int i) {
+  Frame frame;
+  frame.timestamp_ns = SecondsToNs(0.1 * i);
+  frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(100));
+  frame.pose = CameraPoseSample{frame.timestamp_ns, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
+  frame.poses = {*frame.pose};
+  return frame;
+}
+
 TEST(ChangeMonitor, AnOptionOutOfRangeIsRefusedNamingItsFlag) {
   ChangeEventOptions options;
   std::string error;
@@ -619,9 +637,7 @@ TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
   before.has_objects = true;  // ... and none seen
   prior.SetPatrol(before);
   Config config;
-  ChangeEventOptions options;
-  options.interval_s = 1.0;
-  options.settle_s = 0.0;
+  const ChangeEventOptions options = ChecksEverySecond();
   std::unique_ptr<ChangeMonitor> monitor;
   ASSERT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
   io::LogInfo info;
@@ -631,11 +647,7 @@ TEST(ChangeMonitor, ANewObjectIsSentWhenTwoChecksInARowFindIt) {
   std::vector<ChangeWork> work;
   int events_after_first_check = -1;
   for (int i = 0; i <= 25; ++i) {  // frames every 0.1 s; checks at 1 s and 2 s
-    Frame frame;
-    frame.timestamp_ns = SecondsToNs(0.1 * i);
-    frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(100));
-    frame.pose = CameraPoseSample{frame.timestamp_ns, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
-    frame.poses = {*frame.pose};
+    Frame frame = StillFrame(i);
     if (i < 5) {  // a crate 5 m ahead
       ObjectObservation crate{frame.timestamp_ns, "crate", 0.9, cv::Rect2d(22, 14, 20, 20), Eigen::Vector3d(0, 0, 5)};
       frame.detections = {crate};
@@ -683,9 +695,7 @@ TEST(ChangeMonitor, ChecksWhileFlyingCompareOnlyVoxelsSeenByTheirRays) {
   prior.SetPatrol(before);
   const auto events_with = [&](int min_observations) {
     testing::TempDir dir;
-    ChangeEventOptions options;
-    options.interval_s = 1.0;
-    options.settle_s = 0.0;
+    ChangeEventOptions options = ChecksEverySecond();
     options.min_observations = min_observations;
     std::unique_ptr<ChangeMonitor> monitor;
     EXPECT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
@@ -695,11 +705,7 @@ TEST(ChangeMonitor, ChecksWhileFlyingCompareOnlyVoxelsSeenByTheirRays) {
     PatrolRecorder recorder(config, info);
     std::vector<ChangeWork> work;
     for (int i = 0; i <= 25; ++i) {  // depth every 0.1 s; checks at 1 s and 2 s
-      Frame frame;
-      frame.timestamp_ns = SecondsToNs(0.1 * i);
-      frame.image = cv::Mat(48, 64, CV_8UC1, cv::Scalar(100));
-      frame.pose = CameraPoseSample{frame.timestamp_ns, pose.position, pose.rotation};
-      frame.poses = {*frame.pose};
+      Frame frame = StillFrame(i);
       DepthSample depth;
       depth.timestamp_ns = frame.timestamp_ns;
       depth.image = with_box;

@@ -1,6 +1,8 @@
 #include "patrolmap/change/grid_alignment.h"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <unordered_set>
 #include <vector>
 
@@ -62,39 +64,59 @@ Eigen::Vector3i BestShift(const std::vector<Eigen::Vector3i>& current, const std
   return best;
 }
 
-// The shift of the occupied voxels `after` onto `before`, of `voxel_size`.
-GridShift FindShift(const std::vector<Eigen::Vector3i>& before, const std::vector<Eigen::Vector3i>& after,
-                    double voxel_size, const GridAlignmentOptions& options) {
+}  // namespace
+
+ShiftSearch::ShiftSearch(const EvidenceGridData& prior, const GridAlignmentOptions& options)
+    : voxel_size_(prior.voxel_size), options_(options) {
+  if (voxel_size_ <= 0.0 || options_.max_shift_m <= 0.0) return;
+  const std::vector<Eigen::Vector3i> occupied = OccupiedVoxels(prior);
+  fine_ = KeySet(occupied);
+  coarse_ = KeySet(Coarse(occupied));
+}
+
+GridShift ShiftSearch::Find(const EvidenceGridData& current) const {
+  return current.voxel_size == voxel_size_ ? Find(OccupiedVoxels(current)) : GridShift();
+}
+
+GridShift ShiftSearch::Find(const EvidenceGrid& current) const {
+  return current.voxel_size() == voxel_size_ ? Find(current.OccupiedVoxels()) : GridShift();
+}
+
+GridShift ShiftSearch::Find(const std::vector<Eigen::Vector3i>& after) const {
   GridShift result;
-  if (before.empty() || after.empty()) return result;
-  const std::unordered_set<std::uint64_t> before_keys = KeySet(before);
-  result.overlap_unshifted = Overlap(after, before_keys, Eigen::Vector3i::Zero());
-  const int reach = static_cast<int>(std::ceil(options.max_shift_m / voxel_size));
+  if (fine_.empty() || after.empty()) return result;
+  result.overlap_unshifted = Overlap(after, fine_, Eigen::Vector3i::Zero());
+  const int reach = static_cast<int>(std::ceil(options_.max_shift_m / voxel_size_));
   long long coarse_overlap = 0;
-  const Eigen::Vector3i coarse = BestShift(Coarse(after), KeySet(Coarse(before)), Eigen::Vector3i::Zero(),
-                                           (reach + kCoarse - 1) / kCoarse, &coarse_overlap);
-  Eigen::Vector3i fine = BestShift(after, before_keys, coarse * kCoarse, kCoarse, &result.overlap);
+  const Eigen::Vector3i coarse =
+      BestShift(Coarse(after), coarse_, Eigen::Vector3i::Zero(), (reach + kCoarse - 1) / kCoarse, &coarse_overlap);
+  Eigen::Vector3i fine = BestShift(after, fine_, coarse * kCoarse, kCoarse, &result.overlap);
   if (fine.cwiseAbs().maxCoeff() > reach) fine = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
   result.voxels = fine;
   result.applied =
       fine != Eigen::Vector3i::Zero() &&
-      static_cast<double>(result.overlap) > (1.0 + options.min_gain) * static_cast<double>(result.overlap_unshifted);
+      static_cast<double>(result.overlap) > (1.0 + options_.min_gain) * static_cast<double>(result.overlap_unshifted);
   if (!result.applied) result.voxels = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
   return result;
 }
 
-}  // namespace
-
 GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
                         const GridAlignmentOptions& options) {
-  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size || options.max_shift_m <= 0.0) return {};
-  return FindShift(OccupiedVoxels(prior), OccupiedVoxels(current), prior.voxel_size, options);
+  return ShiftSearch(prior, options).Find(current);
 }
 
 GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGrid& current,
                         const GridAlignmentOptions& options) {
-  if (prior.voxel_size <= 0.0 || prior.voxel_size != current.voxel_size() || options.max_shift_m <= 0.0) return {};
-  return FindShift(OccupiedVoxels(prior), current.OccupiedVoxels(), prior.voxel_size, options);
+  return ShiftSearch(prior, options).Find(current);
+}
+
+std::string DescribeShift(const GridShift& shift, double voxel_size, const std::string& reference) {
+  const Eigen::Vector3d m = shift.voxels.cast<double>() * voxel_size;
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "moved by (%.2f, %.2f, %.2f) m onto %s's surfaces: %lld of its occupied voxels meet ", m.x(), m.y(),
+                m.z(), reference.c_str(), shift.overlap);
+  return text + reference + "'s, " + std::to_string(shift.overlap_unshifted) + " before";
 }
 
 void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record) {

@@ -248,14 +248,11 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
 }
 
 bool ChangeMonitor::Realign(const std::string& flight, const change::EvidenceGrid& grid) {
-  const change::GridShift found = change::FindGridShift(prior_record_->grid, grid, config_.change.alignment);
+  if (!shift_search_) shift_search_.emplace(prior_record_->grid, config_.change.alignment);
+  const change::GridShift found = shift_search_->Find(grid);
   if (!found.applied || found.voxels == shift_) return false;
   shift_ = found.voxels;
-  const Eigen::Vector3d metres = shift_.cast<double>() * grid.voxel_size();
-  spdlog::info(
-      "{}: compared moved by ({:.2f}, {:.2f}, {:.2f}) m onto {}'s surfaces while flying: {} of its occupied voxels "
-      "meet {}'s, {} before",
-      flight, metres.x(), metres.y(), metres.z(), prior_flight_, found.overlap, prior_flight_, found.overlap_unshifted);
+  spdlog::info("{}: compared while flying, {}", flight, change::DescribeShift(found, grid.voxel_size(), prior_flight_));
   return true;
 }
 

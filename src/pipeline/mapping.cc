@@ -141,12 +141,7 @@ void AlignToMap(const graph::TopoMap& map, const change::GridAlignmentOptions& o
   const change::GridShift shift = change::FindGridShift(reference->grid, record->grid, options);
   if (!shift.applied) return;
   change::ShiftRecord(shift.voxels, record);
-  const Eigen::Vector3d metres = shift.voxels.cast<double>() * record->grid.voxel_size;
-  spdlog::info(
-      "{}: moved by ({:.2f}, {:.2f}, {:.2f}) m onto {}'s surfaces: {} of its occupied voxels meet {}'s, "
-      "{} before",
-      record->flight, metres.x(), metres.y(), metres.z(), reference->flight, shift.overlap, reference->flight,
-      shift.overlap_unshifted);
+  spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference->flight));
 }
 
 // The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes,

@@ -6,6 +6,11 @@
 // overlaps at least min_gain more voxels than no shift does; otherwise none (poses that agree keep theirs).
 #pragma once
 
+#include <cstdint>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "patrolmap/change/options.h"
@@ -22,12 +27,32 @@ struct GridShift {
 
 class EvidenceGrid;
 
+// The search against one prior grid, whose occupied voxels (fine and in coarse cells) are gathered once: the
+// onboard checks search again as the current grid grows.
+class ShiftSearch {
+ public:
+  ShiftSearch(const EvidenceGridData& prior, const GridAlignmentOptions& options);
+  // The shift of `current` onto the prior (none when their voxel sizes differ).
+  GridShift Find(const EvidenceGridData& current) const;
+  GridShift Find(const EvidenceGrid& current) const;  // a grid still being built, read in place
+
+ private:
+  GridShift Find(const std::vector<Eigen::Vector3i>& current_occupied) const;
+
+  double voxel_size_;
+  GridAlignmentOptions options_;
+  std::unordered_set<std::uint64_t> fine_, coarse_;  // the prior's occupied voxel keys; empty: no search
+};
+
 // The shift of `current` onto `prior` (both must have the same voxel size; none otherwise).
 GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGridData& current,
                         const GridAlignmentOptions& options);
 // The same for a grid still being built, read in place (onboard, while flying).
 GridShift FindGridShift(const EvidenceGridData& prior, const EvidenceGrid& current,
                         const GridAlignmentOptions& options);
+
+// "moved by (x, y, z) m onto REFERENCE's surfaces: ... of its occupied voxels meet REFERENCE's, ... before".
+std::string DescribeShift(const GridShift& shift, double voxel_size, const std::string& reference);
 
 // `record` moved by `shift_voxels` whole voxels of its grid: grid, objects, views and route poses.
 void ShiftRecord(const Eigen::Vector3i& shift_voxels, PatrolRecord* record);

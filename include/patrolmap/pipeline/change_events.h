@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "patrolmap/change/grid_alignment.h"
 #include "patrolmap/change/report.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/graph/topo_map.h"
@@ -88,9 +89,10 @@ class ChangeMonitor {
   // The live grid's voxel i is compared at i + shift_, its objects moved with it: events are placed in the map's
   // frame, as the report after the flight places them (change thread).
   Eigen::Vector3i shift_ = Eigen::Vector3i::Zero();
-  change::GeometryDiffOptions check_geometry_;  // config.change.geometry with options.min_observations
-  std::set<std::string> seen_before_;           // ids the previous check found (change thread)
-  mutable std::mutex mutex_;                    // the file, sent_ and status_ (two stage threads write)
+  std::optional<change::ShiftSearch> shift_search_;  // the prior grid's, made at the first search
+  change::GeometryDiffOptions check_geometry_;       // config.change.geometry with options.min_observations
+  std::set<std::string> seen_before_;                // ids the previous check found (change thread)
+  mutable std::mutex mutex_;                         // the file, sent_ and status_ (two stage threads write)
   std::set<std::string> sent_;
   int events_ = 0;
   Status status_;
