@@ -6,7 +6,8 @@
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
 # Environment: ROUTES, SEEDS (or SERIES="route:seed ..."), OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before;
 # STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
-# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series;
+# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series (inner-loop
+# seed 1 unless LIGHTING_ROUTE and LIGHTING_SEED say otherwise);
 # NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images;
 # EXTRA_CONFIG=FILE appends FILE's keys (not flow: or depth:) to the study's configuration; POSES=gps maps with
@@ -87,7 +88,7 @@ else
     done
   done
 fi
-[ "${LIGHTING:-1}" = 0 ] || run_series "lighting-only" inner-loop 1 --remove-fraction 0 --move-fraction 0 --added 0
+[ "${LIGHTING:-1}" = 0 ] || run_series "lighting-only" "${LIGHTING_ROUTE:-inner-loop}" "${LIGHTING_SEED:-1}" --remove-fraction 0 --move-fraction 0 --added 0
 /usr/bin/python3 - "$out" <<'PY'
 import json, sys
 out = sys.argv[1]

@@ -92,7 +92,8 @@ GridShift ShiftSearch::Find(const std::vector<Eigen::Vector3i>& after) const {
       BestShift(Coarse(after), coarse_, Eigen::Vector3i::Zero(), (reach + kCoarse - 1) / kCoarse, &coarse_overlap);
   Eigen::Vector3i fine = BestShift(after, fine_, coarse * kCoarse, kCoarse, &result.overlap);
   if (fine.cwiseAbs().maxCoeff() > reach) fine = Eigen::Vector3i::Zero(), result.overlap = result.overlap_unshifted;
-  result.voxels = fine;
+  result.voxels = result.best = fine;
+  result.best_overlap = result.overlap;
   result.applied =
       fine != Eigen::Vector3i::Zero() &&
       static_cast<double>(result.overlap) > (1.0 + options_.min_gain) * static_cast<double>(result.overlap_unshifted);

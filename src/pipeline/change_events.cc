@@ -204,19 +204,13 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   const bool search =
       geometry.poses_disagree ||
       (shift_ == Eigen::Vector3i::Zero() && geometry.DifferingShare() > config_.change.alignment.min_differing_share);
-  if (compared && search && Realign(now.flight, *grid)) {
-    change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
+  change::GridShift found;
+  if (compared && search) {
+    const Eigen::Vector3i before = shift_;
+    found = Realign(now.flight, *grid);
+    if (shift_ != before) change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
   }
-  if (geometry.poses_disagree) {
-    // The objects are placed by the same poses (pipeline/change.cc): nothing is sent while they disagree.
-    if (!warned_poses_) {
-      spdlog::warn(
-          "{}: its surfaces differ from {}'s in {:.0f} % of the voxels both observed: the camera poses "
-          "disagree (GPS without RTK, or another world frame), so no geometry or object change is sent "
-          "while they do",
-          now.flight, prior_flight_, 100.0 * geometry.DifferingShare());
-      warned_poses_ = true;
-    }
+  if (HoldBack(now.flight, geometry, found)) {
     seen_before_.clear();
     return;
   }
@@ -247,12 +241,42 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   seen_before_ = std::move(seen);
 }
 
-bool ChangeMonitor::Realign(const std::string& flight, const change::EvidenceGrid& grid) {
+change::GridShift ChangeMonitor::Realign(const std::string& flight, const change::EvidenceGrid& grid) {
   if (!shift_search_) shift_search_.emplace(prior_record_->grid, config_.change.alignment);
   const change::GridShift found = shift_search_->Find(grid);
-  if (!found.applied || found.voxels == shift_) return false;
-  shift_ = found.voxels;
-  spdlog::info("{}: compared while flying, {}", flight, change::DescribeShift(found, grid.voxel_size(), prior_flight_));
+  if (found.applied && found.voxels != shift_) {
+    shift_ = found.voxels;
+    spdlog::info("{}: compared while flying, {}", flight,
+                 change::DescribeShift(found, grid.voxel_size(), prior_flight_));
+  }
+  return found;
+}
+
+bool ChangeMonitor::HoldBack(const std::string& flight, const change::GeometryChange& geometry,
+                             const change::GridShift& search) {
+  if (geometry.poses_disagree) {
+    // The objects are placed by the same poses (pipeline/change.cc): nothing is sent while they disagree.
+    if (!warned_poses_) {
+      spdlog::warn(
+          "{}: its surfaces differ from {}'s in {:.0f} % of the voxels both observed: the camera poses "
+          "disagree (GPS without RTK, or another world frame), so no geometry or object change is sent "
+          "while they do",
+          flight, prior_flight_, 100.0 * geometry.DifferingShare());
+      warned_poses_ = true;
+    }
+    return true;
+  }
+  if (!search.Undecided()) return false;
+  // What differs may be a shift the grid built so far cannot yet tell (a few facades over much flat ground).
+  if (!warned_undecided_) {
+    const Eigen::Vector3d m = search.best.cast<double>() * prior_record_->grid.voxel_size;
+    spdlog::info(
+        "{}: moved by ({:.2f}, {:.2f}, {:.2f}) m its surfaces meet {}'s better than where they are, but not yet by "
+        "change.alignment.min_gain: no geometry or object change is sent until the shift is taken or no longer fits "
+        "better",
+        flight, m.x(), m.y(), m.z(), prior_flight_);
+    warned_undecided_ = true;
+  }
   return true;
 }
 

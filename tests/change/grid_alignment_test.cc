@@ -57,6 +57,7 @@ TEST(GridAlignment, PosesThatAgreeAndShiftsOutOfReachAreLeftAlone) {
   const EvidenceGridData prior = Scene(Eigen::Vector3i::Zero(), false);
   const GridShift same = FindGridShift(prior, Scene(Eigen::Vector3i::Zero(), true), GridAlignmentOptions{});
   EXPECT_FALSE(same.applied);
+  EXPECT_FALSE(same.Undecided());
   EXPECT_EQ(same.voxels, Eigen::Vector3i::Zero());
   GridAlignmentOptions near;
   near.max_shift_m = 0.4;  // two voxels
@@ -69,7 +70,8 @@ TEST(GridAlignment, PosesThatAgreeAndShiftsOutOfReachAreLeftAlone) {
 }
 
 // A ground (2400 voxels) the same in both, and a wall (480) two voxels further in the current grid: moving the
-// wall back costs 120 ground voxels, so the shift overlaps 15 % more than none. Taken only with min_gain below that.
+// wall back costs 120 ground voxels, so the shift overlaps 15 % more than none. Taken only with min_gain below that;
+// with the default the alignment is undecided.
 TEST(GridAlignment, AShiftThatGainsLessThanMinGainIsNotTaken) {
   const auto grid = [](int wall_y) {
     EvidenceGridData g;
@@ -85,6 +87,9 @@ TEST(GridAlignment, AShiftThatGainsLessThanMinGainIsNotTaken) {
   GridShift shift = FindGridShift(prior, current, GridAlignmentOptions{});
   EXPECT_FALSE(shift.applied);
   EXPECT_EQ(shift.overlap, 2400);
+  EXPECT_TRUE(shift.Undecided());  // the shift fits better, not by min_gain: the onboard checks wait
+  EXPECT_EQ(shift.best, Eigen::Vector3i(0, -2, 0));
+  EXPECT_EQ(shift.best_overlap, 2280 + 480);
   GridAlignmentOptions eager;
   eager.min_gain = 0.1;
   shift = FindGridShift(prior, current, eager);

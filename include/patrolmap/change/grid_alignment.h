@@ -23,6 +23,11 @@ struct GridShift {
   long long overlap = 0;                             // occupied current voxels on occupied prior ones, after the shift
   long long overlap_unshifted = 0;                   // ... without it
   bool applied = false;                              // the shift beats no shift by min_gain
+  // The shift that overlaps the most, taken or not, and its overlap. Where it is not zero and overlaps more than
+  // no shift, but by less than min_gain, the alignment is undecided (Undecided).
+  Eigen::Vector3i best = Eigen::Vector3i::Zero();
+  long long best_overlap = 0;
+  bool Undecided() const { return !applied && best != Eigen::Vector3i::Zero() && best_overlap > overlap_unshifted; }
 };
 
 class EvidenceGrid;

@@ -71,8 +71,11 @@ class ChangeMonitor {
   void Send(const Event& event, bool final_event);
   void CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
   // While the poses disagree: the whole-voxel shift of the live grid onto the prior's (change/grid_alignment.h),
-  // as `patrol` moves a finished flight onto the map. True when a new shift was taken.
-  bool Realign(const std::string& flight, const change::EvidenceGrid& grid);
+  // as `patrol` moves a finished flight onto the map. Takes the shift found when it is applied; returns the search.
+  change::GridShift Realign(const std::string& flight, const change::EvidenceGrid& grid);
+  // Whether a check must hold its geometry and object changes back: the poses disagree, or the alignment is
+  // undecided (a shift fits better than none, not yet by min_gain). Says why, once each.
+  bool HoldBack(const std::string& flight, const change::GeometryChange& geometry, const change::GridShift& search);
 
   const graph::TopoMap* prior_;
   std::string prior_flight_;
@@ -85,7 +88,8 @@ class ChangeMonitor {
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;
   bool started_ = false;
-  bool warned_poses_ = false;  // that the poses disagree (change thread)
+  bool warned_poses_ = false;      // that the poses disagree (change thread)
+  bool warned_undecided_ = false;  // that the alignment is undecided (change thread)
   // The live grid's voxel i is compared at i + shift_, its objects moved with it: events are placed in the map's
   // frame, as the report after the flight places them (change thread).
   Eigen::Vector3i shift_ = Eigen::Vector3i::Zero();
