@@ -90,6 +90,14 @@ int GroundLevel(const VoxelCluster& seed, const VoxelLookup& grid, double voxel,
   return lowest[lowest.size() / 2];
 }
 
+// Whether no voxel of `cluster` rises more than ground_clearance_voxels above the ground around it: a sheet of
+// ground seen a voxel higher or lower in one patrol (what a pose correction leaves), not an object standing there.
+bool LiesOnTheGround(const VoxelCluster& cluster, const VoxelLookup& grid, double voxel,
+                     const GeometryObjectOptions& options) {
+  const int ground = GroundLevel(cluster, grid, voxel, options.ground_search_m);
+  return VoxelIndex(cluster.box.max(), voxel).z() <= ground + options.ground_clearance_voxels;
+}
+
 // The whole object a seed of changed voxels belongs to, as its patrol's grid holds it (paper 003 projects the
 // changed voxels back into the mission's map and segments the object there): the occupied voxels above the
 // ground connected to the seed. The seed itself when that grows past max_size_m (a wall, a kerb).
@@ -187,6 +195,7 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
   std::vector<VoxelCluster> seeds;
   for (VoxelCluster& cluster : ClusterChangedVoxels(change, appeared, options.cluster_gap_voxels)) {
     if (!IsObjectSized(cluster, options)) continue;
+    if (grid && LiesOnTheGround(cluster, grid, change.voxel_size, options)) continue;
     seeds.push_back(grid && options.complete_objects ? CompleteObject(cluster, grid, change.voxel_size, options)
                                                      : std::move(cluster));
   }

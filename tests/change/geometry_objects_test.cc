@@ -266,5 +266,37 @@ TEST(GeometryObjects, AnObjectMovedLessThanItsLengthIsCompletedFromEachGrid) {
   EXPECT_GT(std::abs(objects[0].before->x() - 2.0), 1.0);
 }
 
+// A 2 x 2 m patch of ground seen one voxel higher in the second patrol (what a pose correction to within half a voxel
+// can leave) and a new crate. The patch's voxels change, above and below, but lie on the ground: no object. The
+// crate, three voxels tall, is the one new object.
+TEST(GeometryObjects, ASheetOfGroundSeenAVoxelHigherIsNoObject) {
+  const auto grid = [](bool after) {
+    EvidenceGridData g;
+    g.voxel_size = kVoxel;
+    for (int x = -10; x <= 40; ++x) {
+      for (int y = -10; y <= 20; ++y) {
+        for (int z = 0; z <= 10; ++z) {
+          const bool patch = after && x >= 0 && x < 10 && y >= 0 && y < 10;
+          const bool crate = after && x >= 25 && x < 28 && y >= 0 && y < 3 && z >= 1 && z <= 3;
+          const bool occupied = z == (patch ? 1 : 0) || crate;
+          g.voxels.push_back(
+              {x, y, z, static_cast<std::uint16_t>(occupied ? 8 : 0), static_cast<std::uint16_t>(occupied ? 0 : 8)});
+        }
+      }
+    }
+    return g;
+  };
+  const EvidenceGridData before = grid(false), after = grid(true);
+  GeometryDiffOptions diff;
+  diff.max_differing_share = 1.0;
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(before, after, diff, &change));
+  const std::vector<ObjectChange> objects =
+      GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, GeometryObjectOptions{});
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].state, ObjectState::kNew);
+  EXPECT_NEAR(objects[0].after->x(), 5.2, 1e-6);  // the crate, x 5.0-5.4 m
+}
+
 }  // namespace
 }  // namespace patrolmap::change
