@@ -10,6 +10,10 @@ namespace {
 constexpr int kBits = 21;
 constexpr std::int64_t kOffset = 1 << 20;
 constexpr std::uint64_t kUsed = 1ull << 63;
+// The ground around a flat region (IsGroundSheet): columns this far around it, searched this far below it [m]; as
+// the class-agnostic objects look for theirs (geometry_objects.cc).
+constexpr double kGroundRingM = 1.0;
+constexpr double kGroundDepthM = 3.0;
 
 Eigen::Vector3i UnpackKey(std::uint64_t key) {
   const auto part = [key](int shift) {
@@ -348,6 +352,33 @@ bool OccupiedNeighbour(const FindVoxelIn& find, const Eigen::Vector3i& index, in
   return false;
 }
 
+// Whether a region one voxel layer thick (voxel-centre box `low`-`high`) lies on the ground: the median, over the
+// columns of a ring `reach` voxels wide around it, of each column's lowest voxel holding a return (searched from
+// 3 m below the region up to one voxel above it) is at most one voxel below the region. Such a region is the ground
+// seen a voxel higher or lower (what correcting GPS poses to the nearest whole voxel leaves); a new roof or a lid
+// seen from above has the ground around it lower. Both patrols' grids count.
+template <typename FindBefore, typename FindAfter>
+bool IsGroundSheet(const Eigen::Vector3i& low, const Eigen::Vector3i& high, const FindBefore& find_before,
+                   const FindAfter& find_after, int reach, int depth) {
+  std::vector<int> lowest;
+  VoxelEvidence voxel;
+  for (int y = low.y() - reach; y <= high.y() + reach; ++y) {
+    for (int x = low.x() - reach; x <= high.x() + reach; ++x) {
+      if (x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y()) continue;
+      for (int z = low.z() - depth; z <= low.z() + 1; ++z) {
+        const Eigen::Vector3i index(x, y, z);
+        if ((find_before(index, &voxel) && voxel.hits > 0) || (find_after(index, &voxel) && voxel.hits > 0)) {
+          lowest.push_back(z);
+          break;
+        }
+      }
+    }
+  }
+  if (lowest.empty()) return false;
+  std::nth_element(lowest.begin(), lowest.begin() + lowest.size() / 2, lowest.end());
+  return lowest[lowest.size() / 2] >= low.z() - 1;
+}
+
 // DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
 // `for_each_common` visits in `before`'s order.
 template <typename FindAfter, typename ForEachCommon>
@@ -394,6 +425,13 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
     const Eigen::Vector3d extent = region.data.box_max - region.data.box_min + Eigen::Vector3d::Constant(size);
     if (std::max(extent.x(), extent.y()) < options.min_region_width_m - 1e-9) continue;
+    if (options.drop_ground_sheets && extent.z() < 1.5 * size) {
+      const Eigen::Vector3i low = (region.data.box_min / size).array().round().cast<int>();
+      const Eigen::Vector3i high = (region.data.box_max / size).array().round().cast<int>();
+      const int reach = static_cast<int>(std::ceil(kGroundRingM / size)),
+                depth = static_cast<int>(std::ceil(kGroundDepthM / size));
+      if (IsGroundSheet(low, high, find_before, find_after, reach, depth)) continue;
+    }
     region.data.score = region.score_sum / region.data.voxels;
     change->regions.push_back(region.data);
     members.insert(members.end(), region.members.begin(), region.members.end());

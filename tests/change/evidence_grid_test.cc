@@ -238,6 +238,34 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   EXPECT_EQ(change.compared_voxels, 48 + 10 + 1);
 }
 
+// A 1 x 1 m patch of ground seen a voxel higher in the second patrol (what correcting GPS poses to the nearest
+// whole voxel leaves) and a new flat lid 1 m up: both change one layer of voxels, but only the patch lies on the
+// ground around it. It is no region; the lid is (with drop_ground_sheets off, both are).
+TEST(GeometryChange, TheGroundSeenAVoxelHigherIsNoRegionALidAboveItIs) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  for (int x = -10; x < 25; ++x) {
+    for (int y = -10; y < 15; ++y) {
+      const bool patch = x >= 0 && x < 5 && y >= 0 && y < 5, lid = x >= 12 && x < 17 && y >= 0 && y < 5;
+      before.push_back({{x, y, 0}, {8, 0}});  // the ground
+      if (!patch) after.push_back({{x, y, 0}, {8, 0}});
+      for (int z = 1; z <= 8; ++z) {
+        before.push_back({{x, y, z}, {0, 10}});  // air
+        const bool occupied = (patch && z == 1) || (lid && z == 5);
+        after.push_back({{x, y, z}, occupied ? std::make_pair(8, 0) : std::make_pair(0, 10)});
+      }
+    }
+  }
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), SceneOfChanges(), &change));
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_EQ(change.regions[0].appeared, 25);
+  EXPECT_NEAR(change.regions[0].centroid.z(), 1.0, 1e-9);
+  GeometryDiffOptions keep = SceneOfChanges();
+  keep.drop_ground_sheets = false;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), keep, &change));
+  EXPECT_EQ(change.regions.size(), 2u);
+}
+
 TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
   std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
   const auto removed_box = [&](int x0, int length) {
