@@ -613,6 +613,35 @@ Frame StillFrame(int i) {
   return frame;
 }
 
+// The events a ChangeMonitor against flight "before" of `prior` sends while a camera standing at the origin sees
+// `depth` every 0.1 s for 2.5 s (checks as `options` say).
+std::string EventsOfAStillCamera(const graph::TopoMap& prior, const CameraIntrinsics& camera, const cv::Mat& depth,
+                                 const Config& config, const ChangeEventOptions& options) {
+  testing::TempDir dir;
+  std::unique_ptr<ChangeMonitor> monitor;
+  EXPECT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
+  io::LogInfo info;
+  info.camera = camera;
+  info.has_poses = info.has_depth = true;
+  PatrolRecorder recorder(config, info);
+  std::vector<ChangeWork> work;
+  for (int i = 0; i <= 25; ++i) {
+    Frame frame = StillFrame(i);
+    DepthSample sample;
+    sample.timestamp_ns = frame.timestamp_ns;
+    sample.image = depth;
+    sample.pose = frame.pose;
+    frame.depth = {sample};
+    work.clear();
+    recorder.Collect(frame, &work);
+    for (const ChangeWork& step : work) {
+      recorder.Apply(step);
+      monitor->OnChangeStep(step.timestamp_ns, recorder);
+    }
+  }
+  return testing::ReadText(dir / "events.jsonl");
+}
+
 TEST(ChangeMonitor, AnOptionOutOfRangeIsRefusedNamingItsFlag) {
   ChangeEventOptions options;
   std::string error;
@@ -695,31 +724,9 @@ TEST(ChangeMonitor, ChecksWhileFlyingCompareOnlyVoxelsSeenByTheirRays) {
   before.depth_source = "images";
   prior.SetPatrol(before);
   const auto events_with = [&](int min_observations) {
-    testing::TempDir dir;
-    ChangeEventOptions options = ChecksEverySecond();
+    ChangeEventOptions options = ChecksEverySecond();  // checks at 1 s and 2 s
     options.min_observations = min_observations;
-    std::unique_ptr<ChangeMonitor> monitor;
-    EXPECT_TRUE(ChangeMonitor::Open(&prior, "before", config, options, dir / "events.jsonl", &monitor).ok());
-    io::LogInfo info;
-    info.camera = camera;
-    info.has_poses = info.has_depth = true;
-    PatrolRecorder recorder(config, info);
-    std::vector<ChangeWork> work;
-    for (int i = 0; i <= 25; ++i) {  // depth every 0.1 s; checks at 1 s and 2 s
-      Frame frame = StillFrame(i);
-      DepthSample depth;
-      depth.timestamp_ns = frame.timestamp_ns;
-      depth.image = with_box;
-      depth.pose = frame.pose;
-      frame.depth = {depth};
-      work.clear();
-      recorder.Collect(frame, &work);
-      for (const ChangeWork& step : work) {
-        recorder.Apply(step);
-        monitor->OnChangeStep(step.timestamp_ns, recorder);
-      }
-    }
-    return testing::ReadText(dir / "events.jsonl");
+    return EventsOfAStillCamera(prior, camera, with_box, config, options);
   };
   const std::string floor_of_three = events_with(3);
   EXPECT_NE(floor_of_three.find("\"type\":\"geometry\""), std::string::npos) << floor_of_three;
@@ -759,30 +766,7 @@ TEST(ChangeMonitor, NothingIsSentWhileAShiftFitsBetterButNotYetByMinGain) {
   before.depth_source = "images";
   prior.SetPatrol(before);
   const auto events_with = [&](const Config& config) {
-    testing::TempDir dir;
-    std::unique_ptr<ChangeMonitor> monitor;
-    EXPECT_TRUE(
-        ChangeMonitor::Open(&prior, "before", config, ChecksEverySecond(), dir / "events.jsonl", &monitor).ok());
-    io::LogInfo info;
-    info.camera = camera;
-    info.has_poses = info.has_depth = true;
-    PatrolRecorder recorder(config, info);
-    std::vector<ChangeWork> work;
-    for (int i = 0; i <= 25; ++i) {  // depth every 0.1 s; checks at 1 s and 2 s
-      Frame frame = StillFrame(i);
-      DepthSample depth;
-      depth.timestamp_ns = frame.timestamp_ns;
-      depth.image = scene;
-      depth.pose = frame.pose;
-      frame.depth = {depth};
-      work.clear();
-      recorder.Collect(frame, &work);
-      for (const ChangeWork& step : work) {
-        recorder.Apply(step);
-        monitor->OnChangeStep(step.timestamp_ns, recorder);
-      }
-    }
-    return testing::ReadText(dir / "events.jsonl");
+    return EventsOfAStillCamera(prior, camera, scene, config, ChecksEverySecond());
   };
   change::EvidenceGrid current_grid(config.change.grid);  // the second flight's, as a check at its end sees it
   for (int i = 0; i < 25; ++i) current_grid.Integrate(scene, camera, CameraPoseSample{});

@@ -450,6 +450,12 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
 
 }  // namespace
 
+GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
+                                   const std::string& current_source) {
+  options.drop_ground_sheets &= prior_source == kPosesFromGps || current_source == kPosesFromGps;
+  return options;
+}
+
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change) {
   *change = GeometryChange();

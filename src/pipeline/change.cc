@@ -66,8 +66,10 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   report->pose_current = current_record->pose_source;
 
   start = std::chrono::steady_clock::now();
-  report->geometry_compared =
-      change::DiffGrids(prior_record->grid, current_record->grid, options.geometry, &report->geometry);
+  report->geometry_compared = change::DiffGrids(
+      prior_record->grid, current_record->grid,
+      change::ForPoseSources(options.geometry, prior_record->pose_source, current_record->pose_source),
+      &report->geometry);
   report->geometry.depth_prior = prior_record->depth_source;
   report->geometry.depth_current = current_record->depth_source;
   if (report->geometry.poses_disagree) {

@@ -198,8 +198,10 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   const change::EvidenceGrid* grid = recorder.grid();
   std::vector<Event> candidates;
   change::GeometryChange geometry;
+  const change::GeometryDiffOptions diff =
+      change::ForPoseSources(check_geometry_, prior_record_->pose_source, now.pose_source);
   const bool compared = prior_record_->grid.voxel_size > 0 && grid != nullptr &&
-                        change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
+                        change::DiffGrids(prior_record_->grid, *grid, diff, &geometry, shift_);
   // More differs than right poses give while no shift is taken, or the poses disagree again: a shift is searched.
   const bool search =
       geometry.poses_disagree ||
@@ -208,7 +210,7 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   if (compared && search) {
     const Eigen::Vector3i before = shift_;
     found = Realign(now.flight, *grid);
-    if (shift_ != before) change::DiffGrids(prior_record_->grid, *grid, check_geometry_, &geometry, shift_);
+    if (shift_ != before) change::DiffGrids(prior_record_->grid, *grid, diff, &geometry, shift_);
   }
   if (HoldBack(now.flight, geometry, found)) {
     seen_before_.clear();

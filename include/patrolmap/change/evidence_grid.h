@@ -119,6 +119,12 @@ struct GeometryChange {
 };
 
 // Fails (returns false) when the grids have different voxel sizes or none.
+// `options` for two patrols whose camera poses came from `prior_source` and `current_source` (PatrolRecord::
+// pose_source): sheets of ground are dropped (drop_ground_sheets) only where one came from GPS, whose frame is east,
+// north, up and whose alignment leaves them; other sources may not have z up (a KITTI pose file has y down).
+GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
+                                   const std::string& current_source);
+
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change);
 // The same against a grid still being built, read in place (no copy of its voxels): the onboard checks while

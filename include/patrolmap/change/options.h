@@ -146,7 +146,8 @@ struct GeometryDiffOptions {
   double min_region_width_m = 0.4;     // ... and so are narrower ones (a lone column of voxels at an edge)
   // ... and so are regions one voxel layer thick that lie on the ground around them (within one voxel): the ground
   // seen a voxel higher or lower (what correcting GPS poses to the nearest whole voxel leaves), not a change. A new
-  // roof or lid seen from above, with the ground lower around it, stays.
+  // roof or lid seen from above, with the ground lower around it, stays. Only where a patrol's poses came from GPS
+  // (ForPoseSources), whose frame has z up.
   bool drop_ground_sheets = true;
   // When more than this share of the surface voxels both patrols observed differ, the patrols' poses disagree
   // (GPS without RTK, another world frame): nothing is reported, and the report says why. 1 = never.
