@@ -456,6 +456,12 @@ GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::strin
   return options;
 }
 
+GeometryObjectOptions ForPoseSources(GeometryObjectOptions options, const std::string& prior_source,
+                                     const std::string& current_source) {
+  options.drop_ground_sheets &= prior_source == kPosesFromGps || current_source == kPosesFromGps;
+  return options;
+}
+
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change) {
   *change = GeometryChange();

@@ -195,7 +195,7 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
   std::vector<VoxelCluster> seeds;
   for (VoxelCluster& cluster : ClusterChangedVoxels(change, appeared, options.cluster_gap_voxels)) {
     if (!IsObjectSized(cluster, options)) continue;
-    if (grid && LiesOnTheGround(cluster, grid, change.voxel_size, options)) continue;
+    if (grid && options.drop_ground_sheets && LiesOnTheGround(cluster, grid, change.voxel_size, options)) continue;
     seeds.push_back(grid && options.complete_objects ? CompleteObject(cluster, grid, change.voxel_size, options)
                                                      : std::move(cluster));
   }

@@ -84,9 +84,10 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   }
   if (report->geometry_compared && options.geometry_objects.enabled) {
     // Objects no detector named: clusters of changed space (paper 003); detected objects take precedence.
-    report->objects = change::GeometryObjects(report->geometry, change::LookupIn(prior_record->grid),
-                                              change::LookupIn(current_record->grid), prior_record->objects,
-                                              current_record->objects, options.geometry_objects);
+    report->objects = change::GeometryObjects(
+        report->geometry, change::LookupIn(prior_record->grid), change::LookupIn(current_record->grid),
+        prior_record->objects, current_record->objects,
+        change::ForPoseSources(options.geometry_objects, prior_record->pose_source, current_record->pose_source));
     report->objects_compared = true;
   }
   report->seconds_geometry = SecondsSince(start);

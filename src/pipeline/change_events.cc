@@ -227,9 +227,10 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
       candidates.push_back(GeometryEvent(region, timestamp_ns));
     }
     // Objects no detector named: clusters of the changed space (as the report finds them).
-    for (const change::ObjectChange& change :
-         change::GeometryObjects(geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid, shift_),
-                                 prior_record_->objects, now.objects, config_.change.geometry_objects)) {
+    for (const change::ObjectChange& change : change::GeometryObjects(
+             geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid, shift_), prior_record_->objects,
+             now.objects,
+             change::ForPoseSources(config_.change.geometry_objects, prior_record_->pose_source, now.pose_source))) {
       candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }

@@ -124,6 +124,9 @@ struct GeometryChange {
 // north, up and whose alignment leaves them; other sources may not have z up (a KITTI pose file has y down).
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source);
+// The same for the class-agnostic objects (GeometryObjectOptions::drop_ground_sheets).
+GeometryObjectOptions ForPoseSources(GeometryObjectOptions options, const std::string& prior_source,
+                                     const std::string& current_source);
 
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change);

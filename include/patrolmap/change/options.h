@@ -101,10 +101,14 @@ struct GeometryObjectOptions {
   double ground_search_m = 1.0;
   double min_surface_occupancy = 0.3;  // ... through voxels with two returns and at least this occupancy
   int ground_clearance_voxels = 1;  // ... and the growth stays this many voxels above it (rough ground, stereo noise)
-  double footprint_gap_m = 0.4;     // clusters whose footprints come this close are one object (a side and a top
-                                    // seen apart) [m]
-  double max_size_m = 12.0;         // clusters longer than this horizontally are structure, not an object
-  double max_move_m = 8.0;          // moved: a vanished and an appeared cluster at most this far apart [m]
+  // A cluster none of whose voxels rises more than ground_clearance_voxels above the ground around it is a sheet of
+  // ground seen a voxel off, no object. Only where a patrol's poses came from GPS, whose frame has z up
+  // (ForPoseSources, evidence_grid.h).
+  bool drop_ground_sheets = true;
+  double footprint_gap_m = 0.4;        // clusters whose footprints come this close are one object (a side and a top
+                                       // seen apart) [m]
+  double max_size_m = 12.0;            // clusters longer than this horizontally are structure, not an object
+  double max_move_m = 8.0;             // moved: a vanished and an appeared cluster at most this far apart [m]
   double max_top_difference_m = 0.15;  // ... whose tops differ by at most this (at 0.2 m voxels: the same top) [m]
   double min_shape_overlap = 0.5;      // ... and each of which, moved onto the other by the registration, has at
   double shape_tolerance_m = 0.3;      // least this share of its voxels within this distance of the other's [m]

@@ -146,6 +146,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.cluster_gap_voxels", &change.geometry_objects.cluster_gap_voxels);
   visitor->Field("change.geometry_objects.min_voxels", &change.geometry_objects.min_voxels);
   visitor->Field("change.geometry_objects.complete_objects", &change.geometry_objects.complete_objects);
+  visitor->Field("change.geometry_objects.drop_ground_sheets", &change.geometry_objects.drop_ground_sheets);
   visitor->Field("change.geometry_objects.ground_search_m", &change.geometry_objects.ground_search_m);
   visitor->Field("change.geometry_objects.min_surface_occupancy", &change.geometry_objects.min_surface_occupancy);
   visitor->Field("change.geometry_objects.ground_clearance_voxels", &change.geometry_objects.ground_clearance_voxels);
