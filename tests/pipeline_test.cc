@@ -613,6 +613,18 @@ Frame StillFrame(int i) {
   return frame;
 }
 
+// A map whose flight "before" holds `grid` (from depth0/ images), as a ChangeMonitor's prior.
+graph::TopoMap MapOfAGrid(const CameraIntrinsics& camera, const change::EvidenceGrid& grid) {
+  graph::TopoMap map;
+  PatrolRecord before;
+  before.flight = "before";
+  before.camera = camera;
+  before.grid = grid.ToData();
+  before.depth_source = "images";
+  map.SetPatrol(before);
+  return map;
+}
+
 // The events a ChangeMonitor against flight "before" of `prior` sends while a camera standing at the origin sees
 // `depth` every 0.1 s for 2.5 s (checks as `options` say).
 std::string EventsOfAStillCamera(const graph::TopoMap& prior, const CameraIntrinsics& camera, const cv::Mat& depth,
@@ -716,13 +728,7 @@ TEST(ChangeMonitor, ChecksWhileFlyingCompareOnlyVoxelsSeenByTheirRays) {
   Config config;
   change::EvidenceGrid prior_grid(config.change.grid);
   for (int i = 0; i < 25; ++i) prior_grid.Integrate(wall, camera, pose);
-  graph::TopoMap prior;
-  PatrolRecord before;
-  before.flight = "before";
-  before.camera = camera;
-  before.grid = prior_grid.ToData();
-  before.depth_source = "images";
-  prior.SetPatrol(before);
+  const graph::TopoMap prior = MapOfAGrid(camera, prior_grid);
   const auto events_with = [&](int min_observations) {
     ChangeEventOptions options = ChecksEverySecond();  // checks at 1 s and 2 s
     options.min_observations = min_observations;
@@ -758,19 +764,14 @@ TEST(ChangeMonitor, NothingIsSentWhileAShiftFitsBetterButNotYetByMinGain) {
     const CameraPoseSample off{0, Eigen::Vector3d(x + 1.0, 0.0, 0.0), Eigen::Quaterniond::Identity()};
     for (int i = 0; i < 10; ++i) prior_grid.Integrate(view, camera, off);
   }
-  graph::TopoMap prior;
-  PatrolRecord before;
-  before.flight = "before";
-  before.camera = camera;
-  before.grid = prior_grid.ToData();
-  before.depth_source = "images";
-  prior.SetPatrol(before);
+  const graph::TopoMap prior = MapOfAGrid(camera, prior_grid);
   const auto events_with = [&](const Config& config) {
     return EventsOfAStillCamera(prior, camera, scene, config, ChecksEverySecond());
   };
   change::EvidenceGrid current_grid(config.change.grid);  // the second flight's, as a check at its end sees it
   for (int i = 0; i < 25; ++i) current_grid.Integrate(scene, camera, CameraPoseSample{});
-  const change::GridShift search = change::FindGridShift(before.grid, current_grid, config.change.alignment);
+  const change::GridShift search =
+      change::FindGridShift(prior.Patrol("before")->grid, current_grid, config.change.alignment);
   EXPECT_TRUE(search.Undecided()) << search.best_overlap << " vs " << search.overlap_unshifted;
   EXPECT_EQ(search.best, Eigen::Vector3i(5, 0, 0));
   EXPECT_EQ(events_with(config), "");
