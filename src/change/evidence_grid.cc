@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace patrolmap::change {
 namespace {
@@ -10,10 +11,10 @@ namespace {
 constexpr int kBits = 21;
 constexpr std::int64_t kOffset = 1 << 20;
 constexpr std::uint64_t kUsed = 1ull << 63;
-// The ground around a flat region (IsGroundSheet): columns this far around it, searched this far below it [m]; as
-// the class-agnostic objects look for theirs (geometry_objects.cc).
+// The ground around a flat region (IsGroundSheet) is looked for in the columns this far around it [m], as the
+// class-agnostic objects look for theirs (GeometryObjectOptions::ground_search_m's default).
 constexpr double kGroundRingM = 1.0;
-constexpr double kGroundDepthM = 3.0;
+constexpr double kGroundDepthM = 3.0;  // GroundAround looks this far below a box's foot [m]
 
 Eigen::Vector3i UnpackKey(std::uint64_t key) {
   const auto part = [key](int shift) {
@@ -352,31 +353,18 @@ bool OccupiedNeighbour(const FindVoxelIn& find, const Eigen::Vector3i& index, in
   return false;
 }
 
-// Whether a region one voxel layer thick (voxel-centre box `low`-`high`) lies on the ground: the median, over the
-// columns of a ring `reach` voxels wide around it, of each column's lowest voxel holding a return (searched from
-// 3 m below the region up to one voxel above it) is at most one voxel below the region. Such a region is the ground
-// seen a voxel higher or lower (what correcting GPS poses to the nearest whole voxel leaves); a new roof or a lid
-// seen from above has the ground around it lower. Both patrols' grids count.
+// Whether a region one voxel layer thick (voxel-centre box `low`-`high`) lies on the ground: the ground around it
+// (GroundAround over both patrols' grids, searched up to one voxel above the region) is at most one voxel below it.
+// Such a region is the ground seen a voxel higher or lower (what correcting GPS poses to the nearest whole voxel
+// leaves); a new roof or a lid seen from above has the ground around it lower.
 template <typename FindBefore, typename FindAfter>
 bool IsGroundSheet(const Eigen::Vector3i& low, const Eigen::Vector3i& high, const FindBefore& find_before,
-                   const FindAfter& find_after, int reach, int depth) {
-  std::vector<int> lowest;
-  VoxelEvidence voxel;
-  for (int y = low.y() - reach; y <= high.y() + reach; ++y) {
-    for (int x = low.x() - reach; x <= high.x() + reach; ++x) {
-      if (x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y()) continue;
-      for (int z = low.z() - depth; z <= low.z() + 1; ++z) {
-        const Eigen::Vector3i index(x, y, z);
-        if ((find_before(index, &voxel) && voxel.hits > 0) || (find_after(index, &voxel) && voxel.hits > 0)) {
-          lowest.push_back(z);
-          break;
-        }
-      }
-    }
-  }
-  if (lowest.empty()) return false;
-  std::nth_element(lowest.begin(), lowest.begin() + lowest.size() / 2, lowest.end());
-  return lowest[lowest.size() / 2] >= low.z() - 1;
+                   const FindAfter& find_after, double voxel) {
+  const VoxelLookup either = [&](const Eigen::Vector3i& index, VoxelEvidence* evidence) {
+    return (find_before(index, evidence) && evidence->hits > 0) || (find_after(index, evidence) && evidence->hits > 0);
+  };
+  const std::optional<int> ground = GroundAround(low, high, voxel, kGroundRingM, 1, either);
+  return ground && *ground >= low.z() - 1;
 }
 
 // DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
@@ -428,9 +416,7 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     if (options.drop_ground_sheets && extent.z() < 1.5 * size) {
       const Eigen::Vector3i low = (region.data.box_min / size).array().round().cast<int>();
       const Eigen::Vector3i high = (region.data.box_max / size).array().round().cast<int>();
-      const int reach = static_cast<int>(std::ceil(kGroundRingM / size)),
-                depth = static_cast<int>(std::ceil(kGroundDepthM / size));
-      if (IsGroundSheet(low, high, find_before, find_after, reach, depth)) continue;
+      if (IsGroundSheet(low, high, find_before, find_after, size)) continue;
     }
     region.data.score = region.score_sum / region.data.voxels;
     change->regions.push_back(region.data);
@@ -450,15 +436,42 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
 
 }  // namespace
 
+std::optional<int> GroundAround(const Eigen::Vector3i& low, const Eigen::Vector3i& high, double voxel, double ring_m,
+                                int above, const VoxelLookup& grid) {
+  const int reach = static_cast<int>(std::ceil(ring_m / voxel));
+  const int below = static_cast<int>(std::ceil(kGroundDepthM / voxel));
+  std::vector<int> lowest;
+  VoxelEvidence evidence;
+  for (int y = low.y() - reach; y <= high.y() + reach; ++y) {
+    for (int x = low.x() - reach; x <= high.x() + reach; ++x) {
+      if (x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y()) continue;  // under the box
+      for (int z = low.z() - below; z <= low.z() + above; ++z) {
+        // Any return: the ground seen at a grazing angle has more rays passing its voxel than ending in it.
+        if (grid(Eigen::Vector3i(x, y, z), &evidence) && evidence.hits > 0) {
+          lowest.push_back(z);
+          break;
+        }
+      }
+    }
+  }
+  if (lowest.empty()) return std::nullopt;
+  std::nth_element(lowest.begin(), lowest.begin() + lowest.size() / 2, lowest.end());
+  return lowest[lowest.size() / 2];
+}
+
+bool PosesHaveZUp(const std::string& prior_source, const std::string& current_source) {
+  return prior_source == kPosesFromGps || current_source == kPosesFromGps;
+}
+
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source) {
-  options.drop_ground_sheets &= prior_source == kPosesFromGps || current_source == kPosesFromGps;
+  options.drop_ground_sheets &= PosesHaveZUp(prior_source, current_source);
   return options;
 }
 
 GeometryObjectOptions ForPoseSources(GeometryObjectOptions options, const std::string& prior_source,
                                      const std::string& current_source) {
-  options.drop_ground_sheets &= prior_source == kPosesFromGps || current_source == kPosesFromGps;
+  options.drop_ground_sheets &= PosesHaveZUp(prior_source, current_source);
   return options;
 }
 

@@ -12,8 +12,6 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kGroundSearchDepthM = 3.0;  // the ground is looked for this far below a cluster's lowest voxel
-
 // The connected component of voxel `seed` among `voxels` (indices into change.changed_voxels), neighbours at most
 // `gap` voxels apart along each axis; marks its members in `taken`.
 VoxelCluster GrowCluster(const GeometryChange& change, const std::unordered_map<std::uint64_t, std::size_t>& voxels,
@@ -64,30 +62,11 @@ bool IsSurface(const VoxelEvidence& voxel, double min_occupancy) {
   return voxel.hits >= 2 && voxel.hits >= min_occupancy * (voxel.hits + voxel.passes);
 }
 
-// The ground's voxel level around `seed` in the patrol's grid: the median, over the columns of the ring around the
-// seed's footprint `search_m` wide, of each column's lowest occupied voxel from 3 m below the seed's foot up to it
-// that holds a return. The seed's foot less one when no column has one.
+// The ground's voxel level around `seed` in the patrol's grid (GroundAround, up to the seed's foot); the seed's foot
+// less one when no column around it holds a return.
 int GroundLevel(const VoxelCluster& seed, const VoxelLookup& grid, double voxel, double search_m) {
-  const int reach = static_cast<int>(std::ceil(search_m / voxel));
   const Eigen::Vector3i low = VoxelIndex(seed.box.min(), voxel), high = VoxelIndex(seed.box.max(), voxel);
-  const int below = static_cast<int>(std::ceil(kGroundSearchDepthM / voxel));
-  std::vector<int> lowest;
-  VoxelEvidence evidence;
-  for (int y = low.y() - reach; y <= high.y() + reach; ++y) {
-    for (int x = low.x() - reach; x <= high.x() + reach; ++x) {
-      if (x >= low.x() && x <= high.x() && y >= low.y() && y <= high.y()) continue;  // under the object
-      for (int z = low.z() - below; z <= low.z(); ++z) {
-        // Any return: the ground seen at a grazing angle has more rays passing its voxel than ending in it.
-        if (grid(Eigen::Vector3i(x, y, z), &evidence) && evidence.hits > 0) {
-          lowest.push_back(z);
-          break;
-        }
-      }
-    }
-  }
-  if (lowest.empty()) return low.z() - 1;
-  std::nth_element(lowest.begin(), lowest.begin() + lowest.size() / 2, lowest.end());
-  return lowest[lowest.size() / 2];
+  return GroundAround(low, high, voxel, search_m, 0, grid).value_or(low.z() - 1);
 }
 
 // Whether no voxel of `cluster` rises more than ground_clearance_voxels above the ground around it: a sheet of

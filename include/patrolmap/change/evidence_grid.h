@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -122,11 +123,21 @@ struct GeometryChange {
 // `options` for two patrols whose camera poses came from `prior_source` and `current_source` (PatrolRecord::
 // pose_source): sheets of ground are dropped (drop_ground_sheets) only where one came from GPS, whose frame is east,
 // north, up and whose alignment leaves them; other sources may not have z up (a KITTI pose file has y down).
+// Whether poses from `prior_source` and `current_source` share a frame with z up (one came from GPS: east, north,
+// up), where the ground rules (drop_ground_sheets) apply.
+bool PosesHaveZUp(const std::string& prior_source, const std::string& current_source);
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source);
 // The same for the class-agnostic objects (GeometryObjectOptions::drop_ground_sheets).
 GeometryObjectOptions ForPoseSources(GeometryObjectOptions options, const std::string& prior_source,
                                      const std::string& current_source);
+
+// The ground's voxel level around a box of voxels `low`-`high` (indices, z up): the median, over the columns of a
+// ring `ring_m` wide around the box, of each column's lowest voxel that holds a return in `grid`, searched from 3 m
+// below the box's foot up to `above` voxels above it. None when no column holds one. Sheets of ground (DiffGrids)
+// and the class-agnostic objects (GeometryObjects) both stand on it.
+std::optional<int> GroundAround(const Eigen::Vector3i& low, const Eigen::Vector3i& high, double voxel, double ring_m,
+                                int above, const VoxelLookup& grid);
 
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change);
