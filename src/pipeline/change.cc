@@ -75,10 +75,11 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   if (report->geometry.poses_disagree) {
     // Objects are placed by the same poses: their comparison would be as wrong.
     spdlog::warn(
-        "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed (more than "
+        "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed ({} of {}; more than "
         "change.geometry.max_differing_share, {:.0f} %): the two flights' camera poses disagree (GPS without "
         "RTK, or another world frame), so no geometry or object change is reported",
-        prior, current, 100.0 * report->geometry.DifferingShare(), 100.0 * options.geometry.max_differing_share);
+        prior, current, 100.0 * report->geometry.DifferingShare(), report->geometry.differing_voxels,
+        report->geometry.surface_voxels, 100.0 * options.geometry.max_differing_share);
     report->seconds_geometry = SecondsSince(start);
     return Status::Ok();
   }
