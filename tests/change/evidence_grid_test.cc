@@ -266,6 +266,40 @@ TEST(GeometryChange, TheGroundSeenAVoxelHigherIsNoRegionALidAboveItIs) {
   EXPECT_EQ(change.regions.size(), 2u);
 }
 
+// A sheet may also lie under the ground around it: the floor of a 1 x 1 m pit, seen a voxel lower in the second
+// patrol, with the ground around it a voxel above the floor in both. Its ground is searched up to one voxel above
+// it, so it is no region either (with drop_ground_sheets off it is one).
+TEST(GeometryChange, APitFloorSeenAVoxelLowerIsNoRegion) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  for (int x = -10; x < 15; ++x) {
+    for (int y = -10; y < 15; ++y) {
+      const bool pit = x >= 0 && x < 5 && y >= 0 && y < 5;
+      if (pit) {
+        before.push_back({{x, y, 0}, {8, 0}});  // the floor
+        before.push_back({{x, y, 1}, {0, 10}});
+        after.push_back({{x, y, -1}, {8, 0}});  // the floor a voxel lower
+        after.push_back({{x, y, 0}, {0, 10}});
+        after.push_back({{x, y, 1}, {0, 10}});
+      } else {
+        before.push_back({{x, y, 1}, {8, 0}});  // the ground
+        after.push_back({{x, y, 1}, {8, 0}});
+      }
+      for (int z = 2; z <= 8; ++z) {
+        before.push_back({{x, y, z}, {0, 10}});  // air
+        after.push_back({{x, y, z}, {0, 10}});
+      }
+    }
+  }
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), SceneOfChanges(), &change));
+  EXPECT_TRUE(change.regions.empty());
+  GeometryDiffOptions keep = SceneOfChanges();
+  keep.drop_ground_sheets = false;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), keep, &change));
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_EQ(change.regions[0].vanished, 25);
+}
+
 TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
   std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
   const auto removed_box = [&](int x0, int length) {
