@@ -119,13 +119,11 @@ struct GeometryChange {
   std::vector<GeometryRegion> regions;          // largest first
 };
 
-// Fails (returns false) when the grids have different voxel sizes or none.
-// `options` for two patrols whose camera poses came from `prior_source` and `current_source` (PatrolRecord::
-// pose_source): sheets of ground are dropped (drop_ground_sheets) only where one came from GPS, whose frame is east,
-// north, up and whose alignment leaves them; other sources may not have z up (a KITTI pose file has y down).
-// Whether poses from `prior_source` and `current_source` share a frame with z up (one came from GPS: east, north,
-// up), where the ground rules (drop_ground_sheets) apply.
+// Whether two patrols whose camera poses came from `prior_source` and `current_source` (PatrolRecord::pose_source)
+// share a frame with z up: one came from GPS (east, north, up), whose alignment leaves sheets of ground. Other
+// sources may not have z up (a KITTI pose file has y down).
 bool PosesHaveZUp(const std::string& prior_source, const std::string& current_source);
+// `options` for two such patrols: sheets of ground are dropped (drop_ground_sheets) only where PosesHaveZUp.
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source);
 // The same for the class-agnostic objects (GeometryObjectOptions::drop_ground_sheets).
@@ -139,6 +137,7 @@ GeometryObjectOptions ForPoseSources(GeometryObjectOptions options, const std::s
 std::optional<int> GroundAround(const Eigen::Vector3i& low, const Eigen::Vector3i& high, double voxel, double ring_m,
                                 int above, const VoxelLookup& grid);
 
+// Fails (returns false) when the grids have different voxel sizes or none.
 bool DiffGrids(const EvidenceGridData& before, const EvidenceGridData& after, const GeometryDiffOptions& options,
                GeometryChange* change);
 // The same against a grid still being built, read in place (no copy of its voxels): the onboard checks while
