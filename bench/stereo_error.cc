@@ -1,15 +1,15 @@
 // Stereo matching error against true depth (BENCHMARKS.md, "Stereo depth", session 17).
 //
-//   stereo_error LOG [STEP]
+//   stereo_error [--cancel-locking] LOG [STEP]
 //     A log with cam0/, cam1/ (and their sensor.yaml) and depth0/ of the same times, such as a simulated one
 //     (`patrolmap simulate --stereo 0.5 --depth`): every STEP-th pair (default 60) is matched with the default
 //     stereo options and each depth compared with depth0/'s, as disparity f * b / z.
-//   stereo_error --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES
+//   stereo_error [--cancel-locking] --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES
 //     A rectified pair with its 8-bit true disparity (0 = unknown), matched with the defaults and that range.
 //
 // Prints the pixels compared, the share off by more than 3 px, and the mean and rms of the rest; for a log also
 // the mean per metre of true depth, per grey level of the left image's 7x7 standard deviation and per tenth of the
-// true disparity's fraction.
+// true disparity's fraction. --cancel-locking matches with depth.stereo.cancel_pixel_locking on.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -81,7 +81,7 @@ cv::Mat LocalDeviation(const cv::Mat& left) {
   return deviation;
 }
 
-int Log(const std::string& log, int step) {
+int Log(const std::string& log, int step, const depth::StereoOptions& options) {
   std::unique_ptr<io::FrameSource> source;
   Status status = io::OpenEuroc(log, &source);
   if (!status.ok()) return Fail(status.message());
@@ -101,7 +101,7 @@ int Log(const std::string& log, int step) {
   if (!status.end_of_stream()) return Fail(status.message());
   if (truth.empty()) return Fail(log + ": no depth0/ images to compare with");
   std::unique_ptr<depth::StereoDepth> stereo;
-  status = depth::StereoDepth::Create(*source->info().stereo, depth::StereoOptions(), &stereo);
+  status = depth::StereoDepth::Create(*source->info().stereo, options, &stereo);
   if (!status.ok()) return Fail(status.message());
   const double fb = stereo->focal_px() * stereo->baseline_m();
   Errors errors;
@@ -141,13 +141,12 @@ int Log(const std::string& log, int step) {
 }
 
 int Middlebury(const std::string& left_path, const std::string& right_path, const std::string& truth_path,
-               int num_disparities) {
+               int num_disparities, depth::StereoOptions options) {
   const cv::Mat left = cv::imread(left_path, cv::IMREAD_GRAYSCALE);
   const cv::Mat right = cv::imread(right_path, cv::IMREAD_GRAYSCALE);
   const cv::Mat truth = cv::imread(truth_path, cv::IMREAD_GRAYSCALE);
   if (left.empty() || right.empty() || truth.empty()) return Fail("one of the three images is missing or unreadable");
   if (left.size() != right.size() || left.size() != truth.size()) return Fail("the three images differ in size");
-  depth::StereoOptions options;
   options.num_disparities = num_disparities;
   std::string why;
   if (!options.IsValid(&why)) return Fail(why);
@@ -175,15 +174,20 @@ int Middlebury(const std::string& left_path, const std::string& right_path, cons
 
 int main(int argc, char** argv) {
   const std::string usage =
-      "usage: stereo_error LOG [STEP]\n"
-      "       stereo_error --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES\n";
+      "usage: stereo_error [--cancel-locking] LOG [STEP]\n"
+      "       stereo_error [--cancel-locking] --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES\n";
+  depth::StereoOptions options;
+  if (argc > 1 && std::string(argv[1]) == "--cancel-locking") {
+    options.cancel_pixel_locking = true;
+    --argc, ++argv;
+  }
   if (argc == 6 && std::string(argv[1]) == "--middlebury") {
-    return Middlebury(argv[2], argv[3], argv[4], std::atoi(argv[5]));
+    return Middlebury(argv[2], argv[3], argv[4], std::atoi(argv[5]), options);
   }
   if (argc == 2 || argc == 3) {
     const int step = argc == 3 ? std::atoi(argv[2]) : 60;
     if (step < 1) return Fail(std::string("STEP must be a whole number of at least 1, not '") + argv[2] + "'");
-    return Log(argv[1], step);
+    return Log(argv[1], step, options);
   }
   std::fputs(usage.c_str(), stderr);
   return 2;

@@ -116,6 +116,66 @@ TEST(StereoMatching, DroppingDepthEdgesRemovesGrossErrors) {
   }
 }
 
+// A fronto-parallel textured pair whose disparity is `disparity` px, fractions included: a smooth random
+// texture drawn 8 times finer and averaged down, so each view is the same band-limited picture, shifted.
+void ShiftedPair(double disparity, cv::Mat* left, cv::Mat* right) {
+  constexpr int kFine = 8, kWidth = 240, kHeight = 160, kMargin = 40;
+  cv::RNG rng(7);
+  cv::Mat fine((kHeight + 2) * kFine, (kWidth + kMargin) * kFine, CV_32F);
+  rng.fill(fine, cv::RNG::UNIFORM, 0.0, 255.0);
+  cv::GaussianBlur(fine, fine, cv::Size(), 2.0 * kFine);
+  cv::normalize(fine, fine, 0.0, 255.0, cv::NORM_MINMAX);
+  const int shift = static_cast<int>(std::lround(disparity * kFine));
+  const auto view = [&](int offset, cv::Mat* image) {
+    cv::Mat small;
+    cv::resize(fine(cv::Rect(offset, 0, kWidth * kFine, kHeight * kFine)), small, cv::Size(kWidth, kHeight), 0, 0,
+               cv::INTER_AREA);
+    small.convertTo(*image, CV_8U);
+  };
+  view(0, left);
+  view(shift, right);
+}
+
+// The mean error of the disparities found on a shifted pair, and how many were found.
+double MeanError(const cv::Mat& left, const cv::Mat& right, double truth, const StereoOptions& options, int* found) {
+  cv::Mat disparity;
+  ComputeDisparity(left, right, options, &disparity);
+  double sum = 0.0;
+  *found = 0;
+  for (int y = 0; y < disparity.rows; ++y) {
+    for (int x = 64; x < disparity.cols; ++x) {  // SGBM's first columns see what the right view does not
+      const float d = disparity.at<float>(y, x);
+      if (d < 0) continue;
+      sum += d - truth;
+      ++*found;
+    }
+  }
+  return *found > 0 ? sum / *found : 0.0;
+}
+
+// SGBM's sub-pixel fit pulls disparities towards whole pixels; matching with the right view shifted by a quarter
+// pixel both ways and averaging cancels most of that pull, at every fraction.
+TEST(StereoMatching, CancellingPixelLockingTakesTheBiasOutOfFractionalDisparities) {
+  StereoOptions options;
+  double worst_plain = 0.0, worst_cancelled = 0.0;
+  for (int eighth = 0; eighth < 8; ++eighth) {
+    const double truth = 20.0 + eighth / 8.0;
+    cv::Mat left, right;
+    ShiftedPair(truth, &left, &right);
+    int found_plain = 0, found_cancelled = 0;
+    options.cancel_pixel_locking = false;
+    const double plain = MeanError(left, right, truth, options, &found_plain);
+    options.cancel_pixel_locking = true;
+    const double cancelled = MeanError(left, right, truth, options, &found_cancelled);
+    std::printf("disparity %.3f: mean error %+.3f px plain (%d), %+.3f px cancelled (%d)\n", truth, plain, found_plain,
+                cancelled, found_cancelled);
+    worst_plain = std::max(worst_plain, std::abs(plain));
+    worst_cancelled = std::max(worst_cancelled, std::abs(cancelled));
+    EXPECT_GT(found_cancelled, 0.8 * found_plain) << truth;
+  }
+  EXPECT_LT(worst_cancelled, 0.5 * worst_plain);
+}
+
 // A textured wall 8 m in front of a side-by-side pair (f = 400 px, b = 0.5 m): disparity 25 px.
 struct WallPair {
   StereoCalibration calibration;

@@ -12,7 +12,7 @@ namespace patrolmap::depth {
 // Buffers of one matching, reused from frame to frame.
 struct MatchBuffers {
   cv::Mat padded_left, padded_right, padded_disparity, flipped_left, flipped_right, right_view, local_max, local_min,
-      unknown;
+      unknown, shifted_right, second;
 };
 
 namespace {
@@ -41,6 +41,39 @@ void MatchPadded(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& ri
   cv::copyMakeBorder(right, buffers->padded_right, 0, 0, pad, 0, cv::BORDER_REPLICATE);
   matcher->compute(buffers->padded_left, buffers->padded_right, buffers->padded_disparity);
   buffers->padded_disparity.colRange(pad, buffers->padded_disparity.cols).copyTo(*disparity);
+}
+
+// The right image sampled `shift` pixels further along its rows: its disparities against the left one grow by
+// `shift`.
+void ShiftRows(const cv::Mat& right, double shift, cv::Mat* shifted) {
+  const cv::Matx23d m(1, 0, shift, 0, 1, 0);
+  cv::warpAffine(right, *shifted, m, right.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+}
+
+// SGBM's sub-pixel fit pulls a disparity towards whole pixels, by an amount that depends on its fraction and
+// changes sign half a pixel on. The pair is matched with the right image shifted by +1/4 and -1/4 px: the two
+// disparities lie half a pixel apart, so their pulls are about opposite, and their mean keeps what is left of
+// it. Where the two disagree by more than max_lr_difference (beyond the half pixel) the disparity is unknown.
+void MatchCancelled(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
+                    MatchBuffers* buffers, cv::Mat* disparity) {
+  constexpr double kQuarter = 0.25;
+  const int scale = cv::StereoMatcher::DISP_SCALE;
+  ShiftRows(right, kQuarter, &buffers->shifted_right);
+  MatchPadded(matcher, left, buffers->shifted_right, options.num_disparities, buffers, disparity);
+  ShiftRows(right, -kQuarter, &buffers->shifted_right);
+  MatchPadded(matcher, left, buffers->shifted_right, options.num_disparities, buffers, &buffers->second);
+  const int apart = static_cast<int>(std::lround(2 * kQuarter * scale));
+  const double tolerance = options.max_lr_difference * scale;
+  for (int y = 0; y < disparity->rows; ++y) {
+    std::int16_t* plus = disparity->ptr<std::int16_t>(y);
+    const std::int16_t* minus = buffers->second.ptr<std::int16_t>(y);
+    for (int x = 0; x < disparity->cols; ++x) {
+      const bool both = plus[x] > apart && minus[x] > 0;
+      plus[x] = both && std::abs(plus[x] - minus[x] - apart) <= tolerance
+                    ? static_cast<std::int16_t>((plus[x] + minus[x] + 1) / 2)
+                    : -1;
+    }
+  }
 }
 
 // Keeps a left disparity only where the right view's (matched with the pair mirrored), at the pixel it points to,
@@ -93,7 +126,11 @@ void DropDepthEdges(int radius, double jump_px, MatchBuffers* buffers, cv::Mat* 
 // (CheckLeftRight) and with depth edges dropped (DropDepthEdges) as the options ask.
 void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
                MatchBuffers* buffers, cv::Mat* disparity) {
-  MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
+  if (options.cancel_pixel_locking) {
+    MatchCancelled(matcher, left, right, options, buffers, disparity);
+  } else {
+    MatchPadded(matcher, left, right, options.num_disparities, buffers, disparity);
+  }
   if (options.lr_check) CheckLeftRight(matcher, left, right, options, buffers, disparity);
   DropDepthEdges(options.edge_radius_px, options.edge_jump_px, buffers, disparity);
 }

@@ -31,7 +31,12 @@ struct StereoOptions {
   // returns into the free space between them. 0: off. BENCHMARKS.md, "Stereo depth".
   int edge_radius_px = 2;
   double edge_jump_px = 2.0;
-  bool full_paths = false;   // 8 path directions (slower) instead of OpenCV's 3-way approximation
+  bool full_paths = false;  // 8 path directions (slower) instead of OpenCV's 3-way approximation
+  // SGBM's sub-pixel fit pulls disparities towards whole pixels. When on, the pair is matched twice, with the
+  // right image shifted by +quarter and -quarter of a pixel, and the two disparities (half a pixel apart in
+  // their fraction, so their pull is opposite) are averaged; where they disagree by more than
+  // max_lr_difference the disparity is left unknown. Costs one more matching per pair. BENCHMARKS.md.
+  bool cancel_pixel_locking = false;
   double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]
