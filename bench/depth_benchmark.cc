@@ -40,6 +40,7 @@ void BM_StereoDepth(benchmark::State& state) {
   depth::StereoOptions options;
   options.lr_check = state.range(1) != 0;
   options.edge_radius_px = static_cast<int>(state.range(2));
+  options.cancel_pixel_locking = state.range(3) != 0;
   std::unique_ptr<depth::StereoDepth> stereo;
   if (!depth::StereoDepth::Create(pair.calibration, options, &stereo).ok()) return state.SkipWithError("calibration");
   cv::Mat depth;
@@ -50,13 +51,15 @@ void BM_StereoDepth(benchmark::State& state) {
   state.counters["known"] = static_cast<double>(cv::countNonZero(depth)) / depth.total();
 }
 BENCHMARK(BM_StereoDepth)
-    ->ArgNames({"width", "lr_check", "edge_radius"})
-    ->Args({376, 1, 0})
-    ->Args({752, 1, 0})
-    ->Args({376, 0, 0})
-    ->Args({752, 0, 0})
-    ->Args({376, 1, 2})
-    ->Args({752, 1, 2})
+    ->ArgNames({"width", "lr_check", "edge_radius", "cancel_locking"})
+    ->Args({376, 1, 0, 0})
+    ->Args({752, 1, 0, 0})
+    ->Args({376, 0, 0, 0})
+    ->Args({752, 0, 0, 0})
+    ->Args({376, 1, 2, 0})
+    ->Args({752, 1, 2, 0})
+    ->Args({376, 1, 2, 1})
+    ->Args({752, 1, 2, 1})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
