@@ -47,13 +47,22 @@ bool IsObjectSized(const VoxelCluster& cluster, const GeometryObjectOptions& opt
          std::max(extent.x(), extent.y()) <= options.max_size_m;
 }
 
-// Whether a detected object's centroid lies in the cluster's box grown by `margin`.
+// Whether a detected object explains the cluster: its centroid lies in the cluster's box grown by `margin`, or at
+// least half of the cluster's voxels lie in the object's box grown by `margin` (stereo often sees a vehicle only by
+// its ends, and an end changes apart from the centre).
 bool HoldsDetection(const VoxelCluster& cluster, const std::vector<MapObject>& detected, double margin) {
   Eigen::AlignedBox3d grown = cluster.box;
   grown.min().array() -= margin;
   grown.max().array() += margin;
-  return std::any_of(detected.begin(), detected.end(),
-                     [&grown](const MapObject& object) { return grown.contains(object.centroid); });
+  for (const MapObject& object : detected) {
+    if (grown.contains(object.centroid)) return true;
+    if (!(object.box_max.array() > object.box_min.array()).all()) continue;  // no extent known
+    const Eigen::AlignedBox3d box(object.box_min.array() - margin, object.box_max.array() + margin);
+    const auto inside = std::count_if(cluster.points.begin(), cluster.points.end(),
+                                      [&box](const Eigen::Vector3f& p) { return box.contains(p.cast<double>()); });
+    if (2 * inside >= static_cast<std::ptrdiff_t>(cluster.points.size())) return true;
+  }
+  return false;
 }
 
 // A voxel on a surface for the growth: two returns at least, and this share of the rays that reached it (uncertain

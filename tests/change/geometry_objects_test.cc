@@ -177,6 +177,27 @@ TEST(GeometryObjects, ADetectedObjectLeavesItsClusterToTheDetector) {
   EXPECT_EQ(GeometryObjects(change, {}, {}, {}, {detected}, GeometryObjectOptions()).size(), 1u);
 }
 
+// Stereo often sees a vehicle only by its ends: a changed end lies 2 m from the vehicle's centroid, but inside its
+// box, and is left to the detector; a crate beside the vehicle, beyond the margin, is not.
+TEST(GeometryObjects, AClusterInsideADetectedObjectsBoxIsLeftToTheDetector) {
+  const std::vector<Eigen::Vector3i> end = BoxSurface({0, 0, 0}, 2, 9, 7);     // 0.4 x 1.8 x 1.4 m at x = 0
+  const std::vector<Eigen::Vector3i> crate = BoxSurface({0, 14, 0}, 5, 5, 5);  // 1 m beside it
+  MapObject vehicle;
+  vehicle.centroid = Eigen::Vector3d(2.0, 0.8, 0.7);
+  vehicle.box_min = Eigen::Vector3d(0.0, 0.0, 0.0);
+  vehicle.box_max = Eigen::Vector3d(4.2, 1.8, 1.5);
+  std::vector<ObjectChange> objects =
+      GeometryObjects(ChangeOf(end, {}), {}, {}, {}, {vehicle}, GeometryObjectOptions());
+  EXPECT_TRUE(objects.empty());
+  objects = GeometryObjects(ChangeOf(crate, {}), {}, {}, {}, {vehicle}, GeometryObjectOptions());
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].state, ObjectState::kNew);
+  // Without the box (an object mapped without depth), only its centroid counts, even for a cluster at the origin.
+  vehicle.box_min = vehicle.box_max = Eigen::Vector3d::Zero();
+  const std::vector<Eigen::Vector3i> corner = BoxSurface({0, 0, 0}, 2, 3, 3);
+  EXPECT_EQ(GeometryObjects(ChangeOf(corner, {}), {}, {}, {}, {vehicle}, GeometryObjectOptions()).size(), 1u);
+}
+
 // From two evidence grids: a crate put down (its surface occupied now, free before) and another taken away.
 TEST(GeometryObjects, DiffGridsSignsEachChangedVoxel) {
   EvidenceGridData before, after;

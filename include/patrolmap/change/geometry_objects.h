@@ -10,8 +10,9 @@
 // least min_shape_overlap of its voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper
 // 003's weighted distance (physical_weight x distance / max_move_m + shape_weight x (1 - overlap)). Unchanged space
 // never makes an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a
-// cluster whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped is left
-// to the detected objects' states.
+// cluster whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at
+// least half of whose voxels lie in that object's box grown by detection_margin_m, is left to the detected objects'
+// states.
 #pragma once
 
 #include <vector>

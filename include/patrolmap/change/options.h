@@ -114,8 +114,9 @@ struct GeometryObjectOptions {
   double shape_tolerance_m = 0.3;      // least this share of its voxels within this distance of the other's [m]
   double physical_weight = 0.6;        // alpha of paper 003's weighted distance (physical, normalised)
   double shape_weight = 0.4;           // beta (1 - the shape overlap)
-  double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol
-                                       // is left to the detector [m]
+  double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol,
+                                       // or half of which lies in that object's box grown by this, is left to the
+                                       // detector [m]
 };
 
 // Evidence grid of one patrol (paper 004).
