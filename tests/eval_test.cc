@@ -265,6 +265,27 @@ TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
   EXPECT_DOUBLE_EQ(score.Iou(), 0.5);
 }
 
+// A voxel touches a turned box when the two share a point: for a crate turned by 45 degrees a 0.2 m voxel reaches
+// 0.141 m towards a face (not 0.1), and the crate's corner reaches into a voxel beside it.
+TEST(ChangeScore, AVoxelTouchesATurnedBoxWhereTheyShareAPoint) {
+  TruthObject crate = Truth(1, "crate", 0, 0, 10);
+  crate.yaw = M_PI / 4;
+  const Eigen::Vector3d normal(std::cos(M_PI / 4), std::sin(M_PI / 4), 0);  // the face's outward normal
+  const Eigen::Vector3d mid(0, 0, 0.5);
+  EXPECT_TRUE(crate.Touches(mid + normal * 0.63, 0.1));  // 0.13 m off the face
+  EXPECT_FALSE(crate.Contains(mid + normal * 0.63, 0.1));
+  EXPECT_FALSE(crate.Touches(mid + normal * 0.65, 0.1));  // 0.15 m off: beyond the voxel's reach
+  const double corner = std::sqrt(0.5);                   // the corner on the x axis
+  EXPECT_TRUE(crate.Touches({corner + 0.09, 0, 0.5}, 0.1));
+  EXPECT_FALSE(crate.Touches({corner + 0.11, 0, 0.5}, 0.1));  // inside the reach along the faces' normals, yet apart
+  EXPECT_FALSE(crate.Touches({0, 0, 1.11}, 0.1));             // above the top
+  // Wholly inside: the voxel's reach from every face.
+  EXPECT_TRUE(crate.Encloses({0, 0, 0.5}, 0.1));
+  EXPECT_TRUE(crate.Encloses(mid + normal * 0.35, 0.1));
+  EXPECT_FALSE(crate.Encloses(mid + normal * 0.37, 0.1));
+  EXPECT_FALSE(crate.Encloses({0, 0, 0.95}, 0.1));
+}
+
 TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
   // A camera at the origin looking along +x (camera z forward = world x, x right = world -y, y down = -z).
   CameraPoseSample pose;

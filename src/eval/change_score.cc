@@ -147,12 +147,40 @@ double Ratio(int numerator, int denominator) {
 
 }  // namespace
 
+namespace {
+
+// `point`'s horizontal offset from the object's centre, along its length and across it.
+Eigen::Vector2d InBoxFrame(const TruthObject& object, const Eigen::Vector3d& point) {
+  const Eigen::Vector2d d = point.head<2>() - object.centre;
+  return {d.x() * std::cos(object.yaw) + d.y() * std::sin(object.yaw),
+          -d.x() * std::sin(object.yaw) + d.y() * std::cos(object.yaw)};
+}
+
+// How far an axis-aligned cube of half side `half` reaches along either horizontal axis of a box turned by `yaw`.
+double CubeReach(double yaw, double half) { return half * (std::abs(std::cos(yaw)) + std::abs(std::sin(yaw))); }
+
+}  // namespace
+
 bool TruthObject::Contains(const Eigen::Vector3d& point, double margin) const {
-  const Eigen::Vector2d d = point.head<2>() - centre;
-  const double along = d.x() * std::cos(yaw) + d.y() * std::sin(yaw);
-  const double across = -d.x() * std::sin(yaw) + d.y() * std::cos(yaw);
-  return std::abs(along) <= length / 2 + margin && std::abs(across) <= width / 2 + margin && point.z() >= -margin &&
+  const Eigen::Vector2d f = InBoxFrame(*this, point);
+  return std::abs(f.x()) <= length / 2 + margin && std::abs(f.y()) <= width / 2 + margin && point.z() >= -margin &&
          point.z() <= height + margin;
+}
+
+bool TruthObject::Touches(const Eigen::Vector3d& cube_centre, double half) const {
+  const Eigen::Vector2d f = InBoxFrame(*this, cube_centre), d = cube_centre.head<2>() - centre;
+  const double reach = CubeReach(yaw, half), c = std::abs(std::cos(yaw)), s = std::abs(std::sin(yaw));
+  return std::abs(f.x()) <= length / 2 + reach && std::abs(f.y()) <= width / 2 + reach &&  // the box's axes
+         std::abs(d.x()) <= half + length / 2 * c + width / 2 * s &&                       // the cube's axes
+         std::abs(d.y()) <= half + length / 2 * s + width / 2 * c && cube_centre.z() >= -half &&
+         cube_centre.z() <= height + half;
+}
+
+bool TruthObject::Encloses(const Eigen::Vector3d& cube_centre, double half) const {
+  const Eigen::Vector2d f = InBoxFrame(*this, cube_centre);
+  const double reach = CubeReach(yaw, half);
+  return std::abs(f.x()) <= length / 2 - reach && std::abs(f.y()) <= width / 2 - reach && cube_centre.z() >= half &&
+         cube_centre.z() <= height - half;
 }
 
 Status ReadTruthObjects(const std::string& log, std::vector<TruthObject>* objects) {
@@ -263,9 +291,15 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     return (holds(before, p, -size / 4) && !holds(after, p, size / 2)) ||
            (holds(after, p, -size / 4) && !holds(before, p, size / 2));
   };
+  const auto touches = [](const std::vector<TruthObject>& objects, const Eigen::Vector3d& p, double half) {
+    return std::any_of(objects.begin(), objects.end(), [&](const TruthObject& o) { return o.Touches(p, half); });
+  };
+  const auto encloses = [](const std::vector<TruthObject>& objects, const Eigen::Vector3d& p, double half) {
+    return std::any_of(objects.begin(), objects.end(), [&](const TruthObject& o) { return o.Encloses(p, half); });
+  };
   const auto band = [&](const Eigen::Vector3d& p) {
-    return holds(before, p, size / 2) != holds(after, p, size / 2) ||
-           holds(before, p, -size / 2) != holds(after, p, -size / 2) || holds(before, p, 0) != holds(after, p, 0);
+    return touches(before, p, size / 2) != touches(after, p, size / 2) ||
+           encloses(before, p, size / 2) != encloses(after, p, size / 2) || holds(before, p, 0) != holds(after, p, 0);
   };
   std::vector<VoxelEvidence> predicted;
   for (const Eigen::Vector3i& v : changed) predicted.push_back({v.x(), v.y(), v.z(), 0, 0});

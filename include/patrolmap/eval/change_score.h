@@ -61,6 +61,10 @@ struct TruthObject {
   int detections = 0;                // how often the flight's detector reported it
   std::vector<TimestampNs> seen_ns;  // ... and when (ascending)
   bool Contains(const Eigen::Vector3d& point, double margin) const;
+  // Whether an axis-aligned cube of half side `half` centred at `cube_centre` meets the box, or lies wholly inside
+  // it; exact for a box turned by any yaw (the test along the separating axes of the two footprints).
+  bool Touches(const Eigen::Vector3d& cube_centre, double half) const;
+  bool Encloses(const Eigen::Vector3d& cube_centre, double half) const;
 };
 
 // Reads groundtruth/objects.csv and counts groundtruth/detections.csv of a simulated log.
