@@ -12,9 +12,6 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kPairDistance = 0.25;  // point-pair test between patrols [m]
-constexpr double kMinPairFraction = 0.5;
-constexpr double kMovedPairDistance = 0.15;  // point-pair test of a moved object's shape [m]
 constexpr double kMinClearance = 1.0;  // voxels this close to an object do not hide it, nor within its half size [m]
 
 bool Occupied(const EvidenceGridData& grid, const Eigen::Vector3d& point) {
@@ -96,14 +93,14 @@ struct Pair {
 };
 
 // Paper 000's point-pair test for a moved object: the share of the current object's points that, shifted
-// by the centroid difference, lie within kPairDistance of the prior object's points. 1 without points.
-double MovedShapeOverlap(const MapObject& prior, const MapObject& current) {
+// by the centroid difference, lie within `distance` of the prior object's points. 1 without points.
+double MovedShapeOverlap(const MapObject& prior, const MapObject& current, double distance) {
   if (prior.points.empty() || current.points.empty()) return 1.0;
   const Eigen::Vector3f shift = (prior.centroid - current.centroid).cast<float>();
   std::vector<Eigen::Vector3f> moved;
   moved.reserve(current.points.size());
   for (const Eigen::Vector3f& point : current.points) moved.push_back(point + shift);
-  return PairFraction(moved, prior.points, kMovedPairDistance);
+  return PairFraction(moved, prior.points, distance);
 }
 
 // A change that involves a prior object (`prior` may be null for new ones) and a current one (may be null).
@@ -227,8 +224,8 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
       // Paper 000's point-pair test, from the object seen less (a partial view lies on the fuller one).
       const bool b_smaller = b.points.size() <= a.points.size();
       if (!a.points.empty() && !b.points.empty() &&
-          PairFraction(b_smaller ? b.points : a.points, b_smaller ? a.points : b.points, kPairDistance) <
-              kMinPairFraction) {
+          PairFraction(b_smaller ? b.points : a.points, b_smaller ? a.points : b.points, options.pair_distance_m) <
+              options.min_pair_fraction) {
         continue;
       }
       close.push_back({static_cast<int>(i), static_cast<int>(j), distance});
@@ -254,7 +251,7 @@ bool MayHaveMoved(const ObjectDiffOptions& options, const Matching& m, std::size
       std::abs(m.prior_top[i] - m.current_top[j]) > options.max_top_difference_m) {
     return false;
   }
-  return MovedShapeOverlap(m.p[i], m.c[j]) >= options.min_shape_overlap;
+  return MovedShapeOverlap(m.p[i], m.c[j], options.moved_pair_distance_m) >= options.min_shape_overlap;
 }
 
 // How well the current patrol saw the place of every unmatched prior object: its covering views there and the

@@ -45,6 +45,8 @@ void CheckObjectMap(const ObjectMapOptions& m, OptionCheck* check) {
 
 void CheckObjects(const ObjectDiffOptions& o, OptionCheck* check) {
   check->AboveAtMost("change.objects.match_distance_m", o.match_distance_m, 0.0, 1000.0)
+      .AboveAtMost("change.objects.pair_distance_m", o.pair_distance_m, 0.0, 1000.0)
+      .InRange("change.objects.min_pair_fraction", o.min_pair_fraction, 0.0, 1.0)
       .InRange("change.objects.max_move_m", o.max_move_m, 0.0, 10000.0)
       .InRange("change.objects.physical_weight", o.physical_weight, 0.0, 1000.0)
       .InRange("change.objects.appearance_weight", o.appearance_weight, 0.0, 1000.0)
@@ -53,6 +55,7 @@ void CheckObjects(const ObjectDiffOptions& o, OptionCheck* check) {
       .InRange("change.objects.min_visible_fraction", o.min_visible_fraction, 0.0, 1.0)
       .AboveAtMost("change.objects.min_expected_detections", o.min_expected_detections, 0.0, 1e6)
       .InRange("change.objects.min_shape_overlap", o.min_shape_overlap, 0.0, 1.0)
+      .AboveAtMost("change.objects.moved_pair_distance_m", o.moved_pair_distance_m, 0.0, 1000.0)
       .InRange("change.objects.max_top_difference_m", o.max_top_difference_m, 0.0, 1000.0);
 }
 
@@ -74,6 +77,7 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
               g.min_occupancy_change > 0.0 && g.min_occupancy_change < 1.0, "must be a number in (0, 1)")
       .InRange("change.geometry.max_free_occupancy", g.max_free_occupancy, 0.0, 1.0)
       .InRange("change.geometry.min_observations", g.min_observations, 1, 1000000)
+      .InRange("change.geometry.min_free_ratio", g.min_free_ratio, 0.0, 1000.0)
       .InRange("change.geometry.surface_tolerance_voxels", g.surface_tolerance_voxels, 0, 10)
       .InRange("change.geometry.join_distance_m", g.join_distance_m, 0.0, 1000.0)
       .InRange("change.geometry.min_region_voxels", g.min_region_voxels, 1, 100000000)

@@ -238,6 +238,34 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   EXPECT_EQ(change.compared_voxels, 48 + 10 + 1);
 }
 
+// Two boxes seen solid in the second patrol. The first patrol saw one as free by many rays (it is new) and the other by
+// a handful only, where the other patrol has over a hundred returns: rays past an occluder, not free space.
+TEST(GeometryChange, AFewRaysThroughASurfaceSeenSolidAreNoFreeSpace) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  for (int x = 0; x < 4; ++x) {
+    for (int y = 0; y < 4; ++y) {
+      for (int z = 1; z < 4; ++z) {
+        before.push_back({{x, y, z}, {0, 30}});  // new box
+        after.push_back({{x, y, z}, {100, 2}});
+        before.push_back({{x + 20, y, z}, {0, 4}});  // a few rays through
+        after.push_back({{x + 20, y, z}, {140, 3}});
+      }
+    }
+  }
+  GeometryDiffOptions options = SceneOfChanges();
+  options.min_free_ratio = 0.0;
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
+  EXPECT_EQ(change.regions.size(), 2u);  // off: both
+  options.min_free_ratio = 0.1;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
+  ASSERT_EQ(change.regions.size(), 1u);  // 4 rays < 0.1 x 140 returns; 30 >= 0.1 x 100
+  EXPECT_NEAR(change.regions[0].centroid.x(), 0.3, 1e-9);
+  ASSERT_TRUE(DiffGrids(GridOf(after), GridOf(before), options, &change));  // the same, vanished
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_EQ(change.regions[0].vanished, 48);
+}
+
 // A 1 x 1 m patch of ground seen a voxel higher in the second patrol (what correcting GPS poses to the nearest
 // whole voxel leaves) and a new flat lid 1 m up: both change one layer of voxels, but only the patch lies on the
 // ground around it. It is no region; the lid is (with drop_ground_sheets off, both are).

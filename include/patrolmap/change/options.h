@@ -72,7 +72,9 @@ struct ObjectMapOptions {
 
 // State of every object between two patrols (papers 000, 001, 003).
 struct ObjectDiffOptions {
-  double match_distance_m = 1.0;       // persistent: centroids this close (then the point-pair test)
+  double match_distance_m = 1.0;       // persistent: centroids this close (then the point-pair test) ...
+  double pair_distance_m = 0.25;       // ... and at least min_pair_fraction of the points of the object seen less
+  double min_pair_fraction = 0.5;      // within this of the other's points (paper 000's point-pair test)
   double max_move_m = 8.0;             // moved: the two positions at most this far apart (farther: removed + new)
   double physical_weight = 0.6;        // alpha of paper 003's weighted normalised distance
   double appearance_weight = 0.4;      // beta
@@ -84,7 +86,8 @@ struct ObjectDiffOptions {
                                        // least this many detections (its prior detections x covering views now /
                                        // covering views in its own patrol); fewer: unobserved
   double min_shape_overlap = 0.85;     // moved: share of the current object's points, shifted onto the prior
-                                       // object, within 0.15 m of its points (1 when either has none)
+                                       // object, within moved_pair_distance_m of its points (1 when either has none)
+  double moved_pair_distance_m = 0.15;
   double max_top_difference_m = 0.05;  // moved: the tops of the two objects (95th percentile of their points'
                                        // height) differ by at most this; objects stand on level ground
 };
@@ -143,12 +146,16 @@ struct GeometryDiffOptions {
   double max_free_occupancy = 0.1;     // ... and in one patrol it must be free (a surface cut by the voxel's
                                        // edge fills it partly, by a share that changes with the view)
   int min_observations = 3;            // rays per voxel in each patrol; fewer: unobserved, never a change
-  int surface_tolerance_voxels = 1;    // no change where the free patrol has an occupied voxel this near
-                                       // (a surface seen a voxel off: edges, corners); 0 = off
-  bool vertical_tolerance = false;     // ... counting voxels above and below too (not only beside)
-  double join_distance_m = 1.0;        // a changed voxel joins a region whose centroid is this close
-  int min_region_voxels = 10;          // smaller regions are dropped as outliers, ...
-  double min_region_width_m = 0.4;     // ... and so are narrower ones (a lone column of voxels at an edge)
+  // No change where the free patrol's rays through a voxel number under this share of the occupied patrol's returns
+  // there: a few rays through a surface the other patrol saw solid are outliers past an occluder (stereo matches
+  // too far on a vehicle's side), not free space. 0 = off.
+  double min_free_ratio = 0.2;
+  int surface_tolerance_voxels = 1;  // no change where the free patrol has an occupied voxel this near
+                                     // (a surface seen a voxel off: edges, corners); 0 = off
+  bool vertical_tolerance = false;   // ... counting voxels above and below too (not only beside)
+  double join_distance_m = 1.0;      // a changed voxel joins a region whose centroid is this close
+  int min_region_voxels = 10;        // smaller regions are dropped as outliers, ...
+  double min_region_width_m = 0.4;   // ... and so are narrower ones (a lone column of voxels at an edge)
   // ... and so are regions one voxel layer thick that lie on the ground around them (within one voxel): the ground
   // seen a voxel higher or lower (what correcting GPS poses to the nearest whole voxel leaves), not a change. A new
   // roof or lid seen from above, with the ground lower around it, stays. Only where a patrol's poses came from GPS

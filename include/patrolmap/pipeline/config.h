@@ -113,6 +113,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.object_map.max_range_m", &change.object_map.max_range_m);
   visitor->Field("change.object_map.max_objects", &change.object_map.max_objects);
   visitor->Field("change.objects.match_distance_m", &change.objects.match_distance_m);
+  visitor->Field("change.objects.pair_distance_m", &change.objects.pair_distance_m);
+  visitor->Field("change.objects.min_pair_fraction", &change.objects.min_pair_fraction);
   visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
   visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);
   visitor->Field("change.objects.appearance_weight", &change.objects.appearance_weight);
@@ -121,6 +123,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.objects.min_visible_fraction", &change.objects.min_visible_fraction);
   visitor->Field("change.objects.min_expected_detections", &change.objects.min_expected_detections);
   visitor->Field("change.objects.min_shape_overlap", &change.objects.min_shape_overlap);
+  visitor->Field("change.objects.moved_pair_distance_m", &change.objects.moved_pair_distance_m);
   visitor->Field("change.objects.max_top_difference_m", &change.objects.max_top_difference_m);
   visitor->Field("change.grid.voxel_size_m", &change.grid.voxel_size_m);
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
@@ -132,6 +135,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.min_occupancy_change", &change.geometry.min_occupancy_change);
   visitor->Field("change.geometry.max_free_occupancy", &change.geometry.max_free_occupancy);
   visitor->Field("change.geometry.min_observations", &change.geometry.min_observations);
+  visitor->Field("change.geometry.min_free_ratio", &change.geometry.min_free_ratio);
   visitor->Field("change.geometry.surface_tolerance_voxels", &change.geometry.surface_tolerance_voxels);
   visitor->Field("change.geometry.vertical_tolerance", &change.geometry.vertical_tolerance);
   visitor->Field("change.geometry.join_distance_m", &change.geometry.join_distance_m);
