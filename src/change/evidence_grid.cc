@@ -390,8 +390,8 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     }
     const Eigen::Vector3i index(a.x, a.y, a.z);
     if (std::abs(delta) <= options.min_occupancy_change || !one_free) return;
-    const VoxelEvidence& free = delta > 0 ? a : b;
-    if (free.hits + free.passes < options.min_free_ratio * (delta > 0 ? b : a).hits) return;
+    const VoxelEvidence &free = delta > 0 ? a : b, &occupied = delta > 0 ? b : a;
+    if (free.hits + free.passes < options.min_free_ratio * occupied.hits) return;
     if (options.surface_tolerance_voxels > 0) {
       const bool explained =
           delta > 0

@@ -145,10 +145,6 @@ double Ratio(int numerator, int denominator) {
   return denominator > 0 ? static_cast<double>(numerator) / denominator : 0.0;
 }
 
-}  // namespace
-
-namespace {
-
 // `point`'s horizontal offset from the object's centre, along its length and across it.
 Eigen::Vector2d InBoxFrame(const TruthObject& object, const Eigen::Vector3d& point) {
   const Eigen::Vector2d d = point.head<2>() - object.centre;
@@ -169,7 +165,7 @@ bool TruthObject::Contains(const Eigen::Vector3d& point, double margin) const {
 
 bool TruthObject::Touches(const Eigen::Vector3d& cube_centre, double half) const {
   const Eigen::Vector2d f = InBoxFrame(*this, cube_centre), d = cube_centre.head<2>() - centre;
-  const double reach = CubeReach(yaw, half), c = std::abs(std::cos(yaw)), s = std::abs(std::sin(yaw));
+  const double c = std::abs(std::cos(yaw)), s = std::abs(std::sin(yaw)), reach = half * (c + s);
   return std::abs(f.x()) <= length / 2 + reach && std::abs(f.y()) <= width / 2 + reach &&  // the box's axes
          std::abs(d.x()) <= half + length / 2 * c + width / 2 * s &&                       // the cube's axes
          std::abs(d.y()) <= half + length / 2 * s + width / 2 * c && cube_centre.z() >= -half &&
