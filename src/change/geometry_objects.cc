@@ -159,12 +159,12 @@ bool FootprintsMeet(const VoxelCluster& a, const VoxelCluster& b, double gap) {
   return true;
 }
 
-// Clusters whose footprints come within `gap` are one object (objects stand on the ground: a side seen apart from the
-// top, or two faces the grid does not connect), the first taking the others' voxels.
-std::vector<VoxelCluster> MergeStacked(std::vector<VoxelCluster> objects, double voxel, double gap) {
+// Objects for which `together(a, b)` holds are one, the first taking the others' voxels.
+template <typename Together>
+std::vector<VoxelCluster> MergeWhere(std::vector<VoxelCluster> objects, double voxel, const Together& together) {
   for (std::size_t a = 0; a < objects.size(); ++a) {
     for (std::size_t b = a + 1; b < objects.size();) {
-      if (!FootprintsMeet(objects[a], objects[b], gap + 1e-6)) {
+      if (!together(objects[a], objects[b])) {
         ++b;
         continue;
       }
@@ -172,10 +172,34 @@ std::vector<VoxelCluster> MergeStacked(std::vector<VoxelCluster> objects, double
       for (const Eigen::Vector3i& v : objects[a].voxels) keys.insert(VoxelKey(v));
       Absorb(objects[b], voxel, &keys, &objects[a]);
       objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(b));
-      b = a + 1;  // the grown footprint may now meet a cluster passed over
+      b = a + 1;  // the grown object may now join one passed over
     }
   }
   return objects;
+}
+
+// A voxel rays passed (at least separating_rays) that holds no surface.
+bool SeenFree(const VoxelEvidence& voxel, const GeometryObjectOptions& options) {
+  return voxel.hits + voxel.passes >= options.separating_rays && !IsSurface(voxel, options.min_surface_occupancy);
+}
+
+// Whether the patrol's grid shows free space between two objects: a voxel on the straight line between their
+// centroids, in neither of them, that rays passed (at least `separating_rays`) and that holds no surface. A vehicle
+// seen by stereo only at its ends (its flat sides give no match) has no ray inside it: unseen, not free.
+bool SeenApart(const VoxelCluster& a, const VoxelCluster& b, const VoxelLookup& grid, double voxel,
+               const GeometryObjectOptions& options) {
+  std::unordered_set<std::uint64_t> members;
+  for (const Eigen::Vector3i& v : a.voxels) members.insert(VoxelKey(v));
+  for (const Eigen::Vector3i& v : b.voxels) members.insert(VoxelKey(v));
+  const Eigen::Vector3d from = a.Centroid(), to = b.Centroid();
+  const int steps = static_cast<int>(std::ceil((to - from).norm() / (voxel / 2)));
+  VoxelEvidence evidence;
+  for (int i = 1; i < steps; ++i) {
+    const Eigen::Vector3i index = VoxelIndex(from + (to - from) * (static_cast<double>(i) / steps), voxel);
+    if (members.count(VoxelKey(index)) > 0 || !grid(index, &evidence)) continue;
+    if (SeenFree(evidence, options)) return true;
+  }
+  return false;
 }
 
 std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appeared, const VoxelLookup& grid,
@@ -189,7 +213,18 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
   }
   std::vector<VoxelCluster> clusters;
   std::vector<VoxelCluster> objects = MergeSharing(std::move(seeds), change.voxel_size);
-  for (VoxelCluster& cluster : MergeStacked(std::move(objects), change.voxel_size, options.footprint_gap_m)) {
+  // Footprints that meet: objects stand on the ground (a side seen apart from the top, two faces the grid does not
+  // connect).
+  objects = MergeWhere(std::move(objects), change.voxel_size, [&options](const VoxelCluster& a, const VoxelCluster& b) {
+    return FootprintsMeet(a, b, options.footprint_gap_m + 1e-6);
+  });
+  // Near, and no free space seen between them: the ends of a vehicle whose sides and top stereo does not see.
+  if (grid && options.unseen_join_m > 0.0) {
+    objects = MergeWhere(std::move(objects), change.voxel_size, [&](const VoxelCluster& a, const VoxelCluster& b) {
+      return FootprintsMeet(a, b, options.unseen_join_m) && !SeenApart(a, b, grid, change.voxel_size, options);
+    });
+  }
+  for (VoxelCluster& cluster : objects) {
     if (IsObjectSized(cluster, options) && !HoldsDetection(cluster, detected, options.detection_margin_m)) {
       clusters.push_back(std::move(cluster));
     }
@@ -228,7 +263,8 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, const G
   const Eigen::Vector3d shift = after.Centroid() - before.Centroid();
   const double distance = shift.head<2>().norm();
   if (distance > options.max_move_m) return false;
-  if (std::abs(after.box.max().z() - before.box.max().z()) > options.max_top_difference_m) return false;
+  const double top_difference = std::abs(after.box.max().z() - before.box.max().z());
+  if (top_difference > std::max(options.max_top_difference_m, options.alike_top_difference_m)) return false;
   // The registration of partial surfaces can flip an axis: keep it only where it fits better than none.
   const Eigen::Matrix3d registered = RegisterRotation(before.points, after.points);
   const double unrotated = ShapeOverlap(before, after, Eigen::Matrix3d::Identity(), options.shape_tolerance_m);
@@ -236,6 +272,8 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, const G
   candidate->overlap = std::max(unrotated, rotated);
   candidate->rotation = rotated > unrotated ? registered : Eigen::Matrix3d::Identity();
   if (candidate->overlap < options.min_shape_overlap) return false;
+  // A top a voxel apart only for shapes that agree closely (the top of a crate whose lid lies on a voxel boundary).
+  if (top_difference > options.max_top_difference_m && candidate->overlap < options.alike_shape_overlap) return false;
   const double normalised = options.max_move_m > 0.0 ? distance / options.max_move_m : 0.0;
   candidate->cost = options.physical_weight * normalised + options.shape_weight * (1.0 - candidate->overlap);
   return true;

@@ -131,6 +131,28 @@ TEST(GeometryObjects, OtherShapesTopsAndFarMovesAreRemovedAndNew) {
   EXPECT_NEAR(moved->weighted_distance, options.physical_weight * 10.0 / 12.0, 1e-6);  // the shapes overlap fully
 }
 
+// A crate moved 4 m whose lid is seen a voxel higher where it is now (a lid on a voxel boundary): the shapes agree
+// closely, so it is one move. Two voxels higher, or with alike shapes not allowed a different top, it is not.
+TEST(GeometryObjects, ATopAVoxelApartIsAMoveOnlyForAlikeShapes) {
+  const std::vector<Eigen::Vector3i> before = BoxSurface({0, 0, 0}, 5, 5, 5);
+  GeometryObjectOptions options;
+  std::vector<ObjectChange> objects =
+      GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 5, 5, 6), before), {}, {}, {}, {}, options);
+  ASSERT_EQ(Count(objects, ObjectState::kMoved), 1);
+  EXPECT_GE(First(objects, ObjectState::kMoved)->confidence, 0.9 * 0.9);  // change 0.9 x an overlap of at least 0.9
+  objects = GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 5, 5, 7), before), {}, {}, {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  // Three voxels longer, the shapes agree less (an overlap of about 0.64): a move with the same top only.
+  objects = GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 8, 5, 5), before), {}, {}, {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 1);
+  objects = GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 8, 5, 6), before), {}, {}, {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  options.alike_top_difference_m = 0.0;
+  objects = GeometryObjects(ChangeOf(BoxSurface({20, 0, 0}, 5, 5, 6), before), {}, {}, {}, {}, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+}
+
 // A crate's near side and its top, seen apart (two voxels between them): one object, not two.
 TEST(GeometryObjects, ClustersStackedInOneFootprintAreOneObject) {
   std::vector<Eigen::Vector3i> appeared;
@@ -240,13 +262,16 @@ TEST(GeometryObjects, DiffGridsSignsEachChangedVoxel) {
 }
 
 // Every voxel of x in [-10, 40], y in [-10, 20], z in [0, 10] observed 8 times: occupied in `solid` boxes and on the
-// ground (z = 0), free elsewhere.
-EvidenceGridData Observed(const std::vector<Eigen::AlignedBox3i>& solid) {
+// ground (z = 0), free elsewhere; those in `unseen` boxes not observed at all.
+EvidenceGridData Observed(const std::vector<Eigen::AlignedBox3i>& solid,
+                          const std::vector<Eigen::AlignedBox3i>& unseen = {}) {
   EvidenceGridData grid;
   grid.voxel_size = kVoxel;
   for (int x = -10; x <= 40; ++x) {
     for (int y = -10; y <= 20; ++y) {
       for (int z = 0; z <= 10; ++z) {
+        const auto holds = [&](const Eigen::AlignedBox3i& box) { return box.contains(Eigen::Vector3i(x, y, z)); };
+        if (std::any_of(unseen.begin(), unseen.end(), holds)) continue;
         bool occupied = z == 0;
         for (const Eigen::AlignedBox3i& box : solid) occupied = occupied || box.contains(Eigen::Vector3i(x, y, z));
         grid.voxels.push_back(
@@ -285,6 +310,43 @@ TEST(GeometryObjects, AnObjectMovedLessThanItsLengthIsCompletedFromEachGrid) {
   objects = GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_GT(std::abs(objects[0].before->x() - 2.0), 1.0);
+}
+
+// A new vehicle (21 x 9 x 7 voxels) that stereo sees only by its two ends: its flat sides and top give no match, so no
+// ray enters it. The two ends are one object, centred on the vehicle. Two crates as far apart with free space seen
+// between them stay two.
+TEST(GeometryObjects, AVehicleSeenOnlyByItsEndsIsOneObject) {
+  const EvidenceGridData before = Observed({});
+  const Eigen::AlignedBox3i front(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(0, 8, 7));
+  const Eigen::AlignedBox3i back(Eigen::Vector3i(20, 0, 1), Eigen::Vector3i(20, 8, 7));
+  const Eigen::AlignedBox3i inside(Eigen::Vector3i(1, 0, 1), Eigen::Vector3i(19, 8, 7));
+  const auto objects_of = [&](const EvidenceGridData& after, const GeometryObjectOptions& options) {
+    GeometryDiffOptions diff;
+    diff.max_differing_share = 1.0;
+    GeometryChange change;
+    EXPECT_TRUE(DiffGrids(before, after, diff, &change));
+    return GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
+  };
+  const EvidenceGridData ends = Observed({front, back}, {inside});
+  std::vector<ObjectChange> objects = objects_of(ends, GeometryObjectOptions{});
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].state, ObjectState::kNew);
+  EXPECT_NEAR(objects[0].after->x(), 2.0, 1e-6);  // x 0..4 m
+  // Free space seen between them: two objects.
+  objects = objects_of(Observed({front, back}), GeometryObjectOptions{});
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 2);
+  // Farther apart than unseen_join_m, or with the join off: two.
+  GeometryObjectOptions options;
+  options.unseen_join_m = 3.7;  // the ends' footprints are 3.8 m apart
+  EXPECT_EQ(Count(objects_of(ends, options), ObjectState::kNew), 2);
+  options.unseen_join_m = 0.0;
+  EXPECT_EQ(Count(objects_of(ends, options), ObjectState::kNew), 2);
+  // A few rays through the inside (fewer than separating_rays) do not part them.
+  EvidenceGridData sparse = Observed({front, back});
+  for (VoxelEvidence& v : sparse.voxels) {
+    if (inside.contains(Eigen::Vector3i(v.x, v.y, v.z))) v.passes = 2;
+  }
+  EXPECT_EQ(Count(objects_of(sparse, GeometryObjectOptions{}), ObjectState::kNew), 1);
 }
 
 // A 2 x 2 m patch of ground seen one voxel higher in the second patrol (what a pose correction to within half a voxel

@@ -3,16 +3,18 @@
 // free (vanished) are grouped apart into clusters of voxels at most cluster_gap_voxels apart. With complete_objects
 // each cluster then grows in its patrol's grid into the object it belongs to (the occupied voxels above the ground
 // connected to it; paper 003 segments the changed space in the mission's map), and clusters that grew into one
-// object merge, and so do clusters whose footprints meet (a side and a top the grid does not connect). A cluster of at
-// least min_voxels and at most max_size_m across is an object: appeared, it is new; vanished, it was removed. A
-// vanished and an appeared cluster are one object moved when they lie within max_move_m, their tops differ by at most
-// max_top_difference_m and each, registered onto the other (centroids aligned, rotation by RegisterRotation), has at
-// least min_shape_overlap of its voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper
-// 003's weighted distance (physical_weight x distance / max_move_m + shape_weight x (1 - overlap)). Unchanged space
-// never makes an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a
-// cluster whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at
-// least half of whose voxels lie in that object's box grown by detection_margin_m, is left to the detected objects'
-// states.
+// object merge, and so do clusters whose footprints meet (a side and a top the grid does not connect) and, with a
+// grid, those within unseen_join_m whose grid shows no free space on the line between them (a vehicle that stereo
+// sees by its ends only: no ray enters it). A cluster of at least min_voxels and at most max_size_m across is an
+// object: appeared, it is new; vanished, it was removed. A vanished and an appeared cluster are one object moved when
+// they lie within max_move_m, their tops differ by at most max_top_difference_m (alike_top_difference_m where the
+// overlap below is at least alike_shape_overlap) and each, registered onto the other (centroids aligned, rotation by
+// RegisterRotation), has at least min_shape_overlap of its voxels within shape_tolerance_m of the other's; pairs are
+// taken greedily by paper 003's weighted distance (physical_weight x distance / max_move_m + shape_weight x
+// (1 - overlap)). Unchanged space never makes an object, so these objects are never persistent or unobserved.
+// Detections (objects0/) take precedence: a cluster whose box, grown by detection_margin_m, holds the centroid of an
+// object its patrol's detector mapped, or at least half of whose voxels lie in that object's box grown by
+// detection_margin_m, is left to the detected objects' states.
 #pragma once
 
 #include <vector>

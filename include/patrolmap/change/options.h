@@ -120,6 +120,15 @@ struct GeometryObjectOptions {
   double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol,
                                        // or half of which lies in that object's box grown by this, is left to the
                                        // detector [m]
+  // Objects whose footprints come this close are one when the patrol's grid shows no free space on the line between
+  // their centroids (a voxel at least separating_rays rays passed, holding no surface): a vehicle whose ends stereo
+  // sees and whose flat sides and top it does not [m]; 0 = off.
+  double unseen_join_m = 4.0;
+  int separating_rays = 3;
+  // Moved: tops may differ by up to alike_top_difference_m when the shapes overlap by at least alike_shape_overlap
+  // (a lid on a voxel boundary is seen in the voxel above or below it) [m].
+  double alike_top_difference_m = 0.25;
+  double alike_shape_overlap = 0.9;
 };
 
 // Evidence grid of one patrol (paper 004).
