@@ -203,11 +203,32 @@ TEST(ChangeScore, ObjectStatesPerStateWithOptionalSightings) {
   EXPECT_DOUBLE_EQ(fresh.Precision(), 0.5);
   EXPECT_NEAR(fresh.F1(), 2.0 / 3.0, 1e-12);
   EXPECT_EQ(score.unobserved, 1);
+  // Each required true change found or missed, each false report, with the report's index.
+  const auto outcome = [&score](const char* state, const char* what) {
+    std::vector<int> reports;
+    for (const ObjectOutcome& o : score.outcomes) {
+      if (o.state == state && o.outcome == what) reports.push_back(o.reported);
+    }
+    return reports;
+  };
+  EXPECT_EQ(outcome("new", "found"), std::vector<int>({4}));
+  EXPECT_EQ(outcome("new", "false"), std::vector<int>({6}));  // the optional object 4's report is neither
+  EXPECT_EQ(outcome("removed", "found"), std::vector<int>({2, 5}));
+  EXPECT_TRUE(outcome("removed", "missed").empty());
+  EXPECT_EQ(score.outcomes.size(), 6u);  // 1 persistent, 1 moved, 2 removed, 1 new found and 1 false
   // A label that disagrees or a position 1 m off is no hit.
   const ObjectChangeScore wrong = ScoreObjectChanges({{"removed", "crate", at(9), {}}, {"new", "crate", {}, at(13.2)}},
                                                      before, after, ChangeScoreOptions{});
   EXPECT_EQ(wrong.by_state.at("removed").true_positives, 0);
   EXPECT_EQ(wrong.by_state.at("new").false_positives, 1);
+  ASSERT_EQ(wrong.outcomes.size(),
+            7u);  // by state: 1 missed; 5 missed, a false new; 3 and 6 missed, a false removal; 2 missed
+  const ObjectOutcome& missed_barrel = wrong.outcomes[3];
+  EXPECT_EQ(missed_barrel.outcome, "missed");
+  EXPECT_EQ(missed_barrel.label, "barrel");
+  EXPECT_EQ(missed_barrel.reported, -1);
+  ASSERT_TRUE(missed_barrel.before.has_value());
+  EXPECT_DOUBLE_EQ(missed_barrel.before->x(), 9.0);
 }
 
 // A class-agnostic object (from changed geometry) matches a true object of any label, and a change the detector

@@ -155,6 +155,26 @@ Eigen::Vector2d InBoxFrame(const TruthObject& object, const Eigen::Vector3d& poi
 // How far an axis-aligned cube of half side `half` reaches along either horizontal axis of a box turned by `yaw`.
 double CubeReach(double yaw, double half) { return half * (std::abs(std::cos(yaw)) + std::abs(std::sin(yaw))); }
 
+// The outcomes of one state: each required true change of it, found (by the report `found_by` names) or missed, and
+// each report of it no true change used.
+void AddOutcomes(const std::string& state, const std::vector<TruthChange>& truth,
+                 const std::vector<ReportedObject>& reported, const std::vector<int>& found_by,
+                 const std::vector<bool>& reported_used, std::vector<ObjectOutcome>* outcomes) {
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    if (truth[t].state != state || !truth[t].required) continue;
+    const char* outcome = found_by[t] >= 0 ? "found" : "missed";
+    outcomes->push_back({state, outcome, truth[t].label, truth[t].before, truth[t].after, found_by[t]});
+  }
+  const auto flat = [](const std::optional<Eigen::Vector3d>& p) {
+    return p ? std::optional<Eigen::Vector2d>(p->head<2>()) : std::nullopt;
+  };
+  for (std::size_t r = 0; r < reported.size(); ++r) {
+    if (reported[r].state != state || reported_used[r]) continue;
+    outcomes->push_back(
+        {state, "false", reported[r].label, flat(reported[r].before), flat(reported[r].after), static_cast<int>(r)});
+  }
+}
+
 }  // namespace
 
 bool TruthObject::Contains(const Eigen::Vector3d& point, double margin) const {
@@ -253,16 +273,19 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
     }
     std::sort(candidates.begin(), candidates.end(),
               [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
-    std::vector<bool> r_used(reported.size()), t_used(truth.size());
+    std::vector<bool> r_used(reported.size());
+    std::vector<int> found_by(truth.size(), -1);  // the report matched to each true change
     Counts& counts = score.by_state[state];
     int optional_matches = 0;
     for (const Candidate& c : candidates) {
-      if (r_used[c.r] || t_used[c.t]) continue;
-      r_used[c.r] = t_used[c.t] = true;
+      if (r_used[c.r] || found_by[c.t] >= 0) continue;
+      r_used[c.r] = true;
+      found_by[c.t] = static_cast<int>(c.r);
       ++(truth[c.t].required ? counts.true_positives : optional_matches);
     }
     counts.false_positives = reported_count - counts.true_positives - optional_matches;
     counts.false_negatives = truth_count - counts.true_positives;
+    AddOutcomes(state, truth, reported, found_by, r_used, &score.outcomes);
   }
   for (const ReportedObject& r : reported) score.unobserved += r.state == "unobserved";
   return score;

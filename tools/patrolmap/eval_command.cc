@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <spdlog/spdlog.h>
@@ -142,6 +143,25 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
     return Status::DataLoss(path + ": malformed objects: " + e.what());
   }
   return Status::Ok();
+}
+
+// Each required true change (found or missed) and each false report; `objects` is the report's list, for the ids.
+nlohmann::json OutcomesJson(const std::vector<eval::ObjectOutcome>& outcomes, const nlohmann::json& objects) {
+  const auto point = [](const std::optional<Eigen::Vector2d>& p) {
+    return p ? nlohmann::json::array({p->x(), p->y()}) : nlohmann::json();
+  };
+  nlohmann::json list = nlohmann::json::array();
+  for (const eval::ObjectOutcome& o : outcomes) {
+    nlohmann::json id;  // null for a missed change
+    if (o.reported >= 0) id = objects[static_cast<std::size_t>(o.reported)].value("id", "");
+    list.push_back({{"state", o.state},
+                    {"outcome", o.outcome},
+                    {"label", o.label},
+                    {"before", point(o.before)},
+                    {"after", point(o.after)},
+                    {"report_id", id}});
+  }
+  return list;
 }
 
 // Geometry of the recomputed report, per voxel.
@@ -346,6 +366,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     const eval::ObjectChangeScore score = eval::ScoreObjectChanges(reported, before, after, arguments.changes);
     for (const auto& [state, counts] : score.by_state) result["objects"][state] = CountsJson(counts);
     result["objects"]["unobserved_reported"] = score.unobserved;
+    result["objects"]["outcomes"] = OutcomesJson(score.outcomes, changes["objects"]);
   }
   if (std::filesystem::exists(arguments.run + "/map.pmap")) {
     pipeline::Config config;

@@ -25,7 +25,7 @@
 // space is no change). A voxel truly changed (core) when it lies mostly in an
 // object box of one flight (its centre a quarter voxel inside) and clear of
 // the other flight's boxes, above the ground voxel; a voxel that touches a box
-// of one flight only partly (centre within half a voxel of its faces) is a
+// of one flight only partly (the cube and the turned box share a point) is a
 // tolerance band, where reporting is a hit and not reporting no miss.
 // Precision = hits / reported, recall = core voxels reported / core voxels.
 //
@@ -43,6 +43,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,9 +85,21 @@ struct Counts {
   double F1() const;
 };
 
+// What became of one required true change, or of one report that matched none (ScoreObjectChanges).
+struct ObjectOutcome {
+  std::string state;                             // persistent, new, removed, moved
+  std::string outcome;                           // found, missed (a true change), false (a report)
+  std::string label;                             // the true object's; a false report's own
+  std::optional<Eigen::Vector2d> before, after;  // where the true object was and is; a false report's positions
+  int reported = -1;  // the report that found it, or the false report: its index in `reported`
+};
+
 struct ObjectChangeScore {
   std::map<std::string, Counts> by_state;  // persistent, new, removed, moved
   int unobserved = 0;                      // reported unobserved (not scored)
+  // Every required true change, found or missed, and every false report, by state (in the order above) and then
+  // in the order of the truth and of the reports.
+  std::vector<ObjectOutcome> outcomes;
 };
 
 struct ChangeScoreOptions {
