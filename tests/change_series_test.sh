@@ -61,6 +61,12 @@ check "moved objects F1" "r['objects']['moved']['f1'] >= 0.79" "$json"
 check "persistent objects F1" "r['objects']['persistent']['f1'] >= 0.9" "$json"
 check "geometry precision" "r['geometry']['precision'] >= 0.9" "$json"
 check "geometry recall" "r['geometry']['recall'] >= 0.8" "$json"
+# Every required true change is listed found or missed and every false report false, as the counts say.
+check "object outcomes agree with the counts" "all(
+  sum(1 for o in r['objects']['outcomes'] if o['state'] == s and o['outcome'] == k) == r['objects'][s][f]
+  for s in ('new', 'removed', 'moved', 'persistent')
+  for k, f in (('found', 'true_positives'), ('missed', 'false_negatives'), ('false', 'false_positives')))
+  and all((o['report_id'] is None) == (o['outcome'] == 'missed') for o in r['objects']['outcomes'])" "$json"
 
 if $py -c "
 import json, sys, jsonschema
@@ -169,6 +175,15 @@ expect_fail "diff: one flight" "needs two flights" -- "$bin" diff "$work/changed
 expect_fail "diff: same flight" "name the same flight" -- \
   "$bin" diff "$work/changed-2/map.pmap" --from l-shape-1-f2 --to l-shape-1-f2 --out "$work/d4"
 expect_fail "diff: missing map" "nothing.pmap: cannot read map" -- "$bin" diff "$work/nothing.pmap" --out "$work/d5"
+# A change report whose object id is not a string: eval names the file and stops.
+mkdir -p "$work/bad-id"
+$py -c "
+import json
+r = json.load(open('$work/changed-2/changes.json'))
+r['objects'][0]['id'] = 17
+json.dump(r, open('$work/bad-id/changes.json', 'w'))"
+expect_fail "eval: malformed object id" "bad-id/changes.json: malformed objects" -- \
+  "$bin" eval "$work/bad-id" --log "$work/changed/flight_2" --log "$work/changed/flight_1" --json
 
 series lighting --remove-fraction 0 --move-fraction 0 --added 0
 json="$work/lighting.json"

@@ -132,6 +132,7 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
     for (const nlohmann::json& o : objects) {
       eval::ReportedObject r{o.at("state").get<std::string>(), o.at("label").get<std::string>(), {}, {}};
       r.class_agnostic = o.value("source", "detections") == "geometry";
+      r.id = o.value("id", "");
       for (const char* key : {"before", "after"}) {
         if (o.at(key).is_null()) continue;
         const Eigen::Vector3d p(o[key][0].get<double>(), o[key][1].get<double>(), o[key][2].get<double>());
@@ -145,15 +146,16 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
   return Status::Ok();
 }
 
-// Each required true change (found or missed) and each false report; `objects` is the report's list, for the ids.
-nlohmann::json OutcomesJson(const std::vector<eval::ObjectOutcome>& outcomes, const nlohmann::json& objects) {
+// Each required true change (found or missed) and each false report, with the id of the report concerned.
+nlohmann::json OutcomesJson(const std::vector<eval::ObjectOutcome>& outcomes,
+                            const std::vector<eval::ReportedObject>& reported) {
   const auto point = [](const std::optional<Eigen::Vector2d>& p) {
     return p ? nlohmann::json::array({p->x(), p->y()}) : nlohmann::json();
   };
   nlohmann::json list = nlohmann::json::array();
   for (const eval::ObjectOutcome& o : outcomes) {
     nlohmann::json id;  // null for a missed change
-    if (o.reported >= 0) id = objects[static_cast<std::size_t>(o.reported)].value("id", "");
+    if (o.reported >= 0) id = reported[static_cast<std::size_t>(o.reported)].id;
     list.push_back({{"state", o.state},
                     {"outcome", o.outcome},
                     {"label", o.label},
@@ -366,7 +368,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     const eval::ObjectChangeScore score = eval::ScoreObjectChanges(reported, before, after, arguments.changes);
     for (const auto& [state, counts] : score.by_state) result["objects"][state] = CountsJson(counts);
     result["objects"]["unobserved_reported"] = score.unobserved;
-    result["objects"]["outcomes"] = OutcomesJson(score.outcomes, changes["objects"]);
+    result["objects"]["outcomes"] = OutcomesJson(score.outcomes, reported);
   }
   if (std::filesystem::exists(arguments.run + "/map.pmap")) {
     pipeline::Config config;

@@ -76,6 +76,7 @@ struct ReportedObject {
   std::string label;
   std::optional<Eigen::Vector3d> before, after;
   bool class_agnostic = false;  // from changed geometry, not a detector: matches a true object of any label
+  std::string id;               // the report's id for the object ("" when it has none)
 };
 
 struct Counts {
