@@ -113,6 +113,24 @@ cv::Mat SmallestDifference(const cv::Mat& a, const cv::Mat& b, int radius) {
   return best;
 }
 
+// Per pixel, the difference (after the gain and offset) and the structure change (1 - BestStructure) between
+// the current image and the registered prior, the current window searched for in the prior within
+// search_radius_px. With both_ways, each is the larger of that and the prior's window searched for in the
+// current image: searched one way only, the background that replaced an object that left is found beside the
+// object in the prior, and the object's outline shrinks to nothing, while an object that came keeps it.
+void ComparePixels(const cv::Mat& current, const cv::Mat& warped, double gain, double offset,
+                   const AppearanceOptions& options, cv::Mat* difference, cv::Mat* structure_change) {
+  const int r = options.search_radius_px;
+  const double sigma = options.structure_sigma_px;
+  const cv::Mat compensated = warped * gain + offset;
+  *difference = SmallestDifference(current, compensated, r);
+  *structure_change = 1.0 - BestStructure(current, warped, r, sigma);
+  if (!options.both_ways) return;
+  *difference = cv::max(*difference, SmallestDifference(compensated, current, r));
+  const cv::Mat prior_way = 1.0 - BestStructure(warped, current, r, sigma);
+  *structure_change = cv::max(*structure_change, prior_way);
+}
+
 // Registers `warped` (the prior image, carried onto the current one by the homography) onto `current`
 // locally: DIS dense flow from the current image to the gain-compensated prior, flows longer than
 // `max_flow_px` left at zero (what the flow cannot explain stays for the comparison), and `warped` resampled
@@ -182,17 +200,19 @@ cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const 
   return cv::boundingRect(mapped) & cv::Rect(0, 0, prior_size.width, prior_size.height);
 }
 
-// The best normalised cross-correlation (free of gain and offset) of the current image's `box` with the
-// registered prior image shifted by up to `across` pixels horizontally and `radius` vertically: near 1 when the
-// region shows what the prior showed a little further on (parallax off the registered plane, or background
-// the prior shows beside a nearer edge that hides it here).
-double ShiftedSimilarity(const cv::Mat& current, const cv::Mat& prior, const cv::Rect& box, int across, int radius) {
-  const cv::Rect image(0, 0, current.cols, current.rows);
+// The best normalised cross-correlation (free of gain and offset) of image `a`'s `box` with image `b` shifted by
+// up to `across` pixels horizontally and `radius` vertically: near 1 when the region of the current image shows
+// what the registered prior showed a little further on (parallax off the registered plane, or background the
+// prior shows beside a nearer edge that hides it here). With both_ways it must hold the other way too: the
+// background that replaced an object that left is found beside the object in the prior, but not the object in
+// the current image.
+double ShiftedSimilarity(const cv::Mat& a, const cv::Mat& b, const cv::Rect& box, int across, int radius) {
+  const cv::Rect image(0, 0, a.cols, a.rows);
   const cv::Rect search =
       cv::Rect(box.x - across, box.y - radius, box.width + 2 * across, box.height + 2 * radius) & image;
   if (box.width < 3 || box.height < 3 || search.width < box.width || search.height < box.height) return 0.0;
   cv::Mat scores;
-  cv::matchTemplate(prior(search), current(box), scores, cv::TM_CCOEFF_NORMED);
+  cv::matchTemplate(b(search), a(box), scores, cv::TM_CCOEFF_NORMED);
   double best = 0.0;
   cv::minMaxLoc(scores, nullptr, &best);
   return best;
@@ -284,17 +304,15 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
   FitLighting(warped, current_f, mask, &result.gain, &result.offset);
   if (options.dense_flow) FollowFlow(current_f, result.gain, result.offset, options.max_flow_px, &warped);
 
-  const int r = options.search_radius_px;
-  cv::Mat global = SmallestDifference(current_f, warped * result.gain + result.offset, r);
-  cv::Mat local = 1.0 - BestStructure(current_f, warped, r, options.structure_sigma_px);
+  cv::Mat global, local;
+  ComparePixels(current_f, warped, result.gain, result.offset, options, &global, &local);
   std::vector<cv::Mat> warps = {warped};                   // the prior through each plane
   for (const cv::Mat& plane : registration.more_planes) {  // where another plane registers better, it counts
-    cv::Mat plane_mask;
+    cv::Mat plane_mask, other, other_local;
     warps.emplace_back();
     WarpPrior(prior_f, plane, current_f.size(), margin, &warps.back(), &plane_mask);
-    const cv::Mat other = SmallestDifference(current_f, warps.back() * result.gain + result.offset, r);
+    ComparePixels(current_f, warps.back(), result.gain, result.offset, options, &other, &other_local);
     cv::Mat(cv::min(global, other)).copyTo(global, plane_mask);
-    const cv::Mat other_local = 1.0 - BestStructure(current_f, warps.back(), r, options.structure_sigma_px);
     cv::Mat(cv::min(local, other_local)).copyTo(local, plane_mask);
   }
   cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
@@ -345,9 +363,12 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       continue;
     }
     const int across = std::max(options.parallax_search_px, options.horizontal_parallax_search_px);
-    const bool shifted = std::any_of(warps.begin(), warps.end(), [&](const cv::Mat& w) {
-      return ShiftedSimilarity(current_f, w, region.current_box, across, options.parallax_search_px) >
+    const auto shows = [&](const cv::Mat& a, const cv::Mat& b) {
+      return ShiftedSimilarity(a, b, region.current_box, across, options.parallax_search_px) >
              options.max_shifted_similarity;
+    };
+    const bool shifted = std::any_of(warps.begin(), warps.end(), [&](const cv::Mat& w) {
+      return shows(current_f, w) && (!options.both_ways || shows(w, current_f));
     });
     if (shifted) {
       drop(DropReason::kShiftedCopy);  // the same content a few pixels off: parallax, not change

@@ -80,6 +80,32 @@ TEST(Appearance, AnAddedObjectIsARegionInBothImages) {
   EXPECT_GT(region.unmatched_prior_features, 0);  // the prior texture under the object no longer matches
 }
 
+// A scene whose middle is bare ground, a gentle gradient, and the same scene with a thin dark object (a person)
+// standing on it. An object that came is found whichever way the pixels are searched. One that left is found with
+// both_ways, both the pixels and the shift test: searched one way only, the bare ground now in its place is found
+// beside it in the prior, its outline shrinks to nothing, and what is left counts as the prior shown shifted.
+TEST(Appearance, AnObjectThatLeftIsFoundWhenThePairIsComparedBothWays) {
+  cv::Mat bare = Scene(4);
+  const cv::Rect ground(40, 20, 80, 80), object(76, 40, 8, 30);
+  for (int x = 0; x < ground.width; ++x) bare(ground).col(x).setTo(150 + x / 4);
+  cv::Mat with_object = bare.clone();
+  with_object(object).setTo(40);
+  cv::GaussianBlur(with_object, with_object, cv::Size(3, 3), 0.7);
+  const auto found = [&](const cv::Mat& prior, const cv::Mat& current, bool both_ways) {
+    AppearanceOptions options;
+    options.both_ways = both_ways;
+    const AppearanceChange change = DetectAppearanceChange(Describe(prior), Describe(current), options);
+    EXPECT_TRUE(change.registered);
+    return std::count_if(change.regions.begin(), change.regions.end(), [&](const AppearanceRegion& r) {
+      return (r.current_box & object).area() > 0.5 * object.area();
+    });
+  };
+  EXPECT_EQ(found(bare, with_object, false), 1);  // came
+  EXPECT_EQ(found(bare, with_object, true), 1);
+  EXPECT_EQ(found(with_object, bare, true), 1);  // left
+  EXPECT_EQ(found(with_object, bare, false), 0);
+}
+
 // Where the registered prior frame ends, what it shows is cut off or off the registered plane (graf1/graf3 in
 // route_compare_test): with edge_margin_px a region there is dropped, and one inside is kept. The current view
 // shows the scene 2 px further right than the prior, so the prior ends 2 px inside the current's right border.

@@ -130,7 +130,9 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
                            std::vector<eval::ReportedObject>* reported) {
   try {
     for (const nlohmann::json& o : objects) {
-      eval::ReportedObject r{o.at("state").get<std::string>(), o.at("label").get<std::string>(), {}, {}};
+      eval::ReportedObject r;
+      r.state = o.at("state").get<std::string>();
+      r.label = o.at("label").get<std::string>();
       r.class_agnostic = o.value("source", "detections") == "geometry";
       r.id = o.value("id", "");
       for (const char* key : {"before", "after"}) {

@@ -37,6 +37,10 @@ struct AppearanceOptions {
   // before explains (each needs min_inliers), and each pixel is compared through the plane that registers it
   // best: a facade and the ground, or a nearer building, seen with parallax. 1: the dominant plane only.
   int max_planes = 1;
+  // Also search each pixel's prior window in the current image, and require a region's content to be found
+  // shifted both ways before it counts as parallax: finds objects that left as well as objects that came. Off:
+  // a face lit in one flight and in shade in the other then gives regions too (BENCHMARKS.md, session 25).
+  bool both_ways = false;
 };
 
 // Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
