@@ -253,6 +253,30 @@ INSTANTIATE_TEST_SUITE_P(OpencvDoc, RealUnchangedPair,
                                          std::make_pair("graf3.png", "graf1.png"),
                                          std::make_pair("aero1.jpg", "aero3.jpg")));
 
+// Real revisits of one unchanged room (the shared EuRoC pairs, 752x480, a MAV seen from two viewpoints), at the route
+// frames' width, each pair both ways round: with both_ways, none gives a region. (With the defaults, left_img_3
+// against left_img_2 gives two, on furniture and a wall seen with parallax: BENCHMARKS.md, session 25.)
+TEST(RouteCompare, RealEurocRevisitsGiveNoRegionWithBothWays) {
+  const std::string folder = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/";
+  if (!std::filesystem::exists(folder)) GTEST_SKIP() << "shared EuRoC pairs not present";
+  const auto view = [&](int index) {
+    cv::Mat image = cv::imread(folder + cv::format("left_img_%d.png", index), cv::IMREAD_GRAYSCALE);
+    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
+               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
+    RouteFrame frame;
+    cv::imencode(".jpg", image, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+    return RouteFrameView(frame, RouteCompareOptions{}.max_features);
+  };
+  AppearanceOptions options;
+  options.both_ways = true;
+  for (const auto& [prior, current] : {std::pair(0, 1), std::pair(1, 0), std::pair(2, 3), std::pair(3, 2)}) {
+    const AppearanceChange change = DetectAppearanceChange(view(prior), view(current), options);
+    EXPECT_TRUE(change.registered) << prior << " -> " << current;
+    EXPECT_TRUE(change.regions.empty()) << prior << " -> " << current << ": " << change.regions.size()
+                                        << " regions, the first at " << change.regions[0].current_box;
+  }
+}
+
 // Real change (Debian's opencv-doc, vtest.avi): a static camera over a square where people walk. Between frames 0
 // and 400, three people left their place and three others came; their boxes at the route frames' width come from
 // the video's median frame and were checked by eye. Compared both ways round, each pair has 6 people to find: with
