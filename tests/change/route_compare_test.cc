@@ -48,6 +48,22 @@ std::vector<RouteFrame> Route(const cv::Mat& facade, int offset_px, double gain,
   return route;
 }
 
+// A grey image as a route frame: scaled to the route frames' width and JPEG-encoded at `jpeg_quality` (95 is
+// OpenCV's default).
+RouteFrame AsRouteFrame(const cv::Mat& grey, int jpeg_quality) {
+  cv::Mat scaled;
+  cv::resize(grey, scaled, cv::Size(), static_cast<double>(kFrameWidth) / grey.cols,
+             static_cast<double>(kFrameWidth) / grey.cols, cv::INTER_AREA);
+  RouteFrame frame;
+  cv::imencode(".jpg", scaled, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+  return frame;
+}
+
+// ... and as the comparison sees it.
+KeyFrameView RouteView(const cv::Mat& grey, int jpeg_quality) {
+  return RouteFrameView(AsRouteFrame(grey, jpeg_quality), RouteCompareOptions{}.max_features);
+}
+
 // Whether some view of the change outlines the object at facade columns [x0, x1) in its current frame.
 bool OnObject(const RouteComparison& comparison, const RouteChange& change, int offset_px, int x0, int x1,
               const cv::Rect& rows) {
@@ -182,12 +198,9 @@ std::vector<RouteFrame> KittiRoute(const cv::Rect& object, int first, int last) 
     std::snprintf(name, sizeof(name), "/%06d.png", i);
     cv::Mat image = cv::imread(kKittiImages + name, cv::IMREAD_GRAYSCALE);
     if (i >= first && i <= last) patch.copyTo(image(object));
-    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
-               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
-    RouteFrame f;
+    RouteFrame f = AsRouteFrame(image, 80);
     f.timestamp_ns = SecondsToNs(0.1 * i);
     f.frame_index = i;
-    cv::imencode(".jpg", image, f.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
     route.push_back(std::move(f));
   }
   return route;
@@ -226,14 +239,7 @@ class RealUnchangedPair : public testing::TestWithParam<std::pair<const char*, c
 TEST_P(RealUnchangedPair, GivesNoRegion) {
   const std::string data = "/usr/share/doc/opencv-doc/examples/data/";
   if (!std::filesystem::exists(data + GetParam().first)) GTEST_SKIP() << "opencv-doc not installed";
-  const auto view = [&](const char* name) {
-    cv::Mat image = cv::imread(data + name, cv::IMREAD_GRAYSCALE);
-    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
-               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
-    RouteFrame frame;
-    cv::imencode(".jpg", image, frame.jpeg);
-    return RouteFrameView(frame, RouteCompareOptions{}.max_features);
-  };
+  const auto view = [&](const char* name) { return RouteView(cv::imread(data + name, cv::IMREAD_GRAYSCALE), 95); };
   for (const bool both_ways : {false, true}) {  // with both_ways too
     AppearanceOptions options;
     options.both_ways = both_ways;
@@ -260,12 +266,7 @@ TEST(RouteCompare, RealEurocRevisitsGiveNoRegionWithBothWays) {
   const std::string folder = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/";
   if (!std::filesystem::exists(folder)) GTEST_SKIP() << "shared EuRoC pairs not present";
   const auto view = [&](int index) {
-    cv::Mat image = cv::imread(folder + cv::format("left_img_%d.png", index), cv::IMREAD_GRAYSCALE);
-    cv::resize(image, image, cv::Size(), static_cast<double>(kFrameWidth) / image.cols,
-               static_cast<double>(kFrameWidth) / image.cols, cv::INTER_AREA);
-    RouteFrame frame;
-    cv::imencode(".jpg", image, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
-    return RouteFrameView(frame, RouteCompareOptions{}.max_features);
+    return RouteView(cv::imread(folder + cv::format("left_img_%d.png", index), cv::IMREAD_GRAYSCALE), 80);
   };
   AppearanceOptions options;
   options.both_ways = true;
@@ -291,11 +292,7 @@ TEST(RouteCompare, RealPeopleThatLeftAndCameAreFoundWithBothWays) {
     if (index % 400 != 0) continue;
     cv::Mat grey;
     cv::cvtColor(frame, grey, cv::COLOR_BGR2GRAY);
-    cv::resize(grey, grey, cv::Size(), static_cast<double>(kFrameWidth) / grey.cols,
-               static_cast<double>(kFrameWidth) / grey.cols, cv::INTER_AREA);
-    RouteFrame route_frame;
-    cv::imencode(".jpg", grey, route_frame.jpeg);
-    views.push_back(RouteFrameView(route_frame, RouteCompareOptions{}.max_features));
+    views.push_back(RouteView(grey, 95));
   }
   if (views.size() < 2) GTEST_SKIP() << "vtest.avi ended before frame 400";
   const std::vector<std::vector<cv::Rect>> people = {{{243, 80, 18, 36}, {122, 106, 19, 47}, {311, 116, 26, 46}},
