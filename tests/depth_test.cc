@@ -217,6 +217,8 @@ TEST(StereoDepth, AWallAtKnownDepthComesOutAtThatDepth) {
   EXPECT_GT(known, 0.85 * (376 - 25) * 240);
   EXPECT_GT(right_depth, 0.98 * known);
   EXPECT_NEAR(stereo->RangeSigma(8.0), 64.0 * 0.5 / (400.0 * 0.5), 1e-9);
+  EXPECT_NEAR(stereo->DepthWithin(stereo->RangeSigma(8.0)), 8.0, 1e-9);
+  EXPECT_NEAR(stereo->DepthWithin(0.5), std::sqrt(0.5 * 400.0 * 0.5 / 0.5), 1e-9);  // 0.5 m of error at 14.1 m
 }
 
 // A textured wall 8 m ahead, slanted 30 degrees (its disparities vary smoothly, so SGBM's sub-pixel bias

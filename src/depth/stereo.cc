@@ -1,5 +1,6 @@
 #include "patrolmap/depth/stereo.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -204,6 +205,11 @@ Status StereoDepth::Create(const StereoCalibration& calibration, const StereoOpt
   result->buffers_ = std::make_unique<MatchBuffers>();
   *stereo = std::move(result);
   return Status::Ok();
+}
+
+double StereoDepth::DepthWithin(double sigma_m) const {
+  if (range_sigma_per_m2_ <= 0.0) return std::numeric_limits<double>::infinity();
+  return std::sqrt(std::max(0.0, sigma_m) / range_sigma_per_m2_);
 }
 
 StereoDepth::~StereoDepth() = default;

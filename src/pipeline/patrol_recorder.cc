@@ -1,5 +1,6 @@
 #include "patrolmap/pipeline/patrol_recorder.h"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 
@@ -46,6 +47,18 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
   if (stereo) {
     const Status status = depth::StereoDepth::Create(*info.stereo, config.depth.stereo, &stereo_);
     if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
+  }
+  if (stereo_ != nullptr) {
+    // Beyond this depth a return's range error passes change.grid.max_hit_sigma_m: it carves free space only, so
+    // nothing there can show as a surface that came or went.
+    const double marked =
+        std::min(stereo_->DepthWithin(config.change.grid.max_hit_sigma_m), config.change.grid.max_range_m);
+    spdlog::info(
+        "{}: depth from the stereo pair ({:.2f} m apart, focal length {:.0f} px): surfaces are marked within "
+        "{:.1f} m, where the range error for depth.stereo.disparity_sigma_px {} stays within "
+        "change.grid.max_hit_sigma_m {} m; farther returns only carve free space",
+        info.path, stereo_->baseline_m(), stereo_->focal_px(), marked, config.depth.stereo.disparity_sigma_px,
+        config.change.grid.max_hit_sigma_m);
   }
   use_stereo_ = stereo_ != nullptr;
   has_depth_ = images || use_stereo_;

@@ -46,6 +46,8 @@ class StereoDepth {
 
   // The range error expected at depth `z_m` [m].
   double RangeSigma(double z_m) const { return z_m * z_m * range_sigma_per_m2_; }
+  // The depth [m] up to which the range error stays within `sigma_m` (RangeSigma's inverse).
+  double DepthWithin(double sigma_m) const;
   double baseline_m() const { return baseline_m_; }
   double focal_px() const { return focal_px_; }
 
