@@ -12,6 +12,19 @@ namespace {
 
 constexpr double kViewRateHz = 5.0;  // views kept for visibility
 
+// Says how far the stereo pair marks surfaces: beyond, a return's range error exceeds
+// change.grid.max_hit_sigma_m, so it carves free space only and nothing there can show as a surface that came or went.
+void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, const Config& config) {
+  const double marked =
+      std::min(stereo.DepthWithin(config.change.grid.max_hit_sigma_m), config.change.grid.max_range_m);
+  spdlog::info(
+      "{}: depth from the stereo pair ({:.2f} m apart, focal length {:.0f} px): surfaces are marked within "
+      "{:.1f} m, where the range error for depth.stereo.disparity_sigma_px {} stays within "
+      "change.grid.max_hit_sigma_m {} m; farther returns only carve free space",
+      path, stereo.baseline_m(), stereo.focal_px(), marked, config.depth.stereo.disparity_sigma_px,
+      config.change.grid.max_hit_sigma_m);
+}
+
 }  // namespace
 
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
@@ -48,18 +61,7 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
     const Status status = depth::StereoDepth::Create(*info.stereo, config.depth.stereo, &stereo_);
     if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
   }
-  if (stereo_ != nullptr) {
-    // Beyond this depth a return's range error passes change.grid.max_hit_sigma_m: it carves free space only, so
-    // nothing there can show as a surface that came or went.
-    const double marked =
-        std::min(stereo_->DepthWithin(config.change.grid.max_hit_sigma_m), config.change.grid.max_range_m);
-    spdlog::info(
-        "{}: depth from the stereo pair ({:.2f} m apart, focal length {:.0f} px): surfaces are marked within "
-        "{:.1f} m, where the range error for depth.stereo.disparity_sigma_px {} stays within "
-        "change.grid.max_hit_sigma_m {} m; farther returns only carve free space",
-        info.path, stereo_->baseline_m(), stereo_->focal_px(), marked, config.depth.stereo.disparity_sigma_px,
-        config.change.grid.max_hit_sigma_m);
-  }
+  if (stereo_ != nullptr) SayStereoReach(info.path, *stereo_, config);
   use_stereo_ = stereo_ != nullptr;
   has_depth_ = images || use_stereo_;
   base_.depth_source = images ? "images" : (use_stereo_ ? "stereo" : "");
