@@ -1,10 +1,14 @@
 // Depth-stage speed: stereo depth of one rendered village pair (0.5 m baseline, 64 disparities) at 376x240
-// and 752x480, with and without the left-right check (which matches the pair a second time).
+// and 752x480, with and without the left-right check (which matches the pair a second time); and the fusion of a
+// depth frame with the frames before it (depth.stereo.fuse_frames) on the grid's ray lattice.
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 
+#include "patrolmap/depth/fusion.h"
 #include "patrolmap/depth/stereo.h"
 #include "patrolmap/sim/renderer.h"
 #include "patrolmap/sim/village.h"
@@ -60,6 +64,45 @@ BENCHMARK(BM_StereoDepth)
     ->Args({752, 1, 2, 0})
     ->Args({376, 1, 2, 1})
     ->Args({752, 1, 2, 1})
+    ->Unit(benchmark::kMillisecond);
+
+// One depth frame of the pair fused with `frames` before it, the camera 0.2 m further along each frame (a
+// 1 m/s flight at the grid's 5 Hz), on the lattice of change.grid.rays_per_row 94.
+void BM_DepthFusion(benchmark::State& state) {
+  const int width = static_cast<int>(state.range(0));
+  const Pair pair = RenderPair(width);
+  std::unique_ptr<depth::StereoDepth> stereo;
+  if (!depth::StereoDepth::Create(pair.calibration, depth::StereoOptions(), &stereo).ok()) {
+    return state.SkipWithError("calibration");
+  }
+  cv::Mat raw, depth, views;
+  if (!stereo->Compute(pair.left, pair.right, &raw).ok()) return state.SkipWithError("compute");
+  const int frames = static_cast<int>(state.range(1));
+  depth::DepthFusion fusion(pair.calibration.left, depth::FusionOptions{frames, 2.0, stereo->RangeSigma(1.0)});
+  const int step = std::max(1, static_cast<int>(std::lround(width / 94.0)));
+  CameraPoseSample pose;
+  for (int frame = 0; frame < frames; ++frame, pose.position.x() += 0.2) {
+    raw.copyTo(depth);
+    fusion.Fuse(pose, step, &depth, &views);
+  }
+  for (auto _ : state) {
+    raw.copyTo(depth);  // as the matcher hands each frame over
+    fusion.Fuse(pose, step, &depth, &views);
+    benchmark::DoNotOptimize(depth.data);
+  }
+  double views_sum = 0.0;
+  int traced = 0;
+  for (int y = step / 2; y < views.rows; y += step) {
+    for (int x = step / 2; x < views.cols; x += step)
+      views_sum += views.at<std::uint8_t>(y, x), traced += views.at<std::uint8_t>(y, x) > 0;
+  }
+  state.counters["views"] = traced > 0 ? views_sum / traced : 0.0;
+}
+BENCHMARK(BM_DepthFusion)
+    ->ArgNames({"width", "frames"})
+    ->Args({376, 4})
+    ->Args({752, 4})
+    ->Args({752, 8})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

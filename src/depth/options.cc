@@ -37,7 +37,9 @@ bool StereoOptions::IsValid(std::string* error) const {
       .AboveAtMost("depth.stereo.max_range_m", max_range_m, 0.0, 1000.0)
       .Holds("depth.stereo.max_range_m", max_range_m, max_range_m > min_range_m,
              "must be above depth.stereo.min_range_m")
-      .InRange("depth.stereo.disparity_sigma_px", disparity_sigma_px, 0.0, 16.0);
+      .InRange("depth.stereo.disparity_sigma_px", disparity_sigma_px, 0.0, 16.0)
+      .InRange("depth.stereo.fuse_frames", fuse_frames, 0, 16)
+      .AboveAtMost("depth.stereo.fuse_gate_sigmas", fuse_gate_sigmas, 0.0, 10.0);
   return check.ok();
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include <spdlog/spdlog.h>
@@ -14,15 +15,21 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 
 // Says how far the stereo pair marks surfaces: beyond, a return's range error exceeds
 // change.grid.max_hit_sigma_m, so it carves free space only and nothing there can show as a surface that came or went.
+// With depth.stereo.fuse_frames, surfaces seen alike by every fused frame are marked farther.
 void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, const Config& config) {
-  const double marked =
-      std::min(stereo.DepthWithin(config.change.grid.max_hit_sigma_m), config.change.grid.max_range_m);
+  const change::EvidenceGridOptions& grid = config.change.grid;
+  const double marked = std::min(stereo.DepthWithin(grid.max_hit_sigma_m), grid.max_range_m);
   spdlog::info(
       "{}: depth from the stereo pair ({:.2f} m apart, focal length {:.0f} px): surfaces are marked within "
       "{:.1f} m, where the range error for depth.stereo.disparity_sigma_px {} stays within "
       "change.grid.max_hit_sigma_m {} m; farther returns only carve free space",
       path, stereo.baseline_m(), stereo.focal_px(), marked, config.depth.stereo.disparity_sigma_px,
-      config.change.grid.max_hit_sigma_m);
+      grid.max_hit_sigma_m);
+  const int views = config.depth.stereo.fuse_frames + 1;
+  if (views == 1) return;
+  const double fused = std::min(stereo.DepthWithin(grid.max_hit_sigma_m * std::sqrt(views)), grid.max_range_m);
+  spdlog::info("{}: with depth.stereo.fuse_frames {}, within {:.1f} m where all {} fused depth frames agree", path,
+               views - 1, fused, views);
 }
 
 }  // namespace
@@ -61,7 +68,12 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
     const Status status = depth::StereoDepth::Create(*info.stereo, config.depth.stereo, &stereo_);
     if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
   }
-  if (stereo_ != nullptr) SayStereoReach(info.path, *stereo_, config);
+  if (stereo_ != nullptr) {
+    SayStereoReach(info.path, *stereo_, config);
+    const depth::FusionOptions fusion{config.depth.stereo.fuse_frames, config.depth.stereo.fuse_gate_sigmas,
+                                      stereo_->RangeSigma(1.0)};
+    if (fusion.frames > 0) fusion_ = std::make_unique<depth::DepthFusion>(base_.camera, fusion);
+  }
   use_stereo_ = stereo_ != nullptr;
   has_depth_ = images || use_stereo_;
   base_.depth_source = images ? "images" : (use_stereo_ ? "stereo" : "");
@@ -204,7 +216,8 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     ++stats_.skipped_depth_frames;
     return;
   }
-  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0);
+  if (fusion_ != nullptr) fusion_->Fuse(*work.pose, grid_.RayStep(depth_.cols), &depth_, &views_);
+  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0, views_);
   next_grid_ns_ = work.timestamp_ns + grid_step_ns_;
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

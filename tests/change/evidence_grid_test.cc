@@ -169,6 +169,9 @@ TEST(EvidenceGrid, StereoDepthCarvesLessAndHitsOnlyWhereItIsSure) {
   near_stereo.Integrate(wall, kCamera, pose, 0.2 / 100.0);
   // Range error 1 m at 10 m, above change.grid.max_hit_sigma_m (0.5 m): free space up to 8 m and no hit.
   far_stereo.Integrate(wall, kCamera, pose, 1.0 / 100.0);
+  // The same error, averaged over 16 depth frames (depth::DepthFusion): a quarter, and hits again.
+  EvidenceGrid fused(options);
+  fused.Integrate(wall, kCamera, pose, 1.0 / 100.0, cv::Mat(wall.size(), CV_8U, cv::Scalar(16)));
   const auto count = [](const EvidenceGridData& data, int from_x, int to_x, bool hits) {
     long long total = 0;
     for (const VoxelEvidence& v : data.voxels) {
@@ -180,6 +183,7 @@ TEST(EvidenceGrid, StereoDepthCarvesLessAndHitsOnlyWhereItIsSure) {
   EXPECT_EQ(count(a, 50, 50, true), 16 * 12);
   EXPECT_EQ(count(b, 50, 50, true), 16 * 12);
   EXPECT_EQ(count(c, 0, 1000, true), 0);
+  EXPECT_EQ(count(fused.ToData(), 50, 50, true), 16 * 12);
   EXPECT_GT(count(a, 48, 49, false), 0);
   EXPECT_EQ(count(b, 49, 49, false), 0);
   EXPECT_GT(count(b, 45, 46, false), 0);

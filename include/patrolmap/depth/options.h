@@ -40,6 +40,11 @@ struct StereoOptions {
   double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]
+  // Each depth frame at the grid's rate is fused with this many frames before it (DepthFusion): where they agree
+  // within fuse_gate_sigmas combined range errors the depths are averaged, and the range error falls with the
+  // square root of the views. 0: off. BENCHMARKS.md, "Stereo depth".
+  int fuse_frames = 0;
+  double fuse_gate_sigmas = 2.0;
   bool IsValid(std::string* error) const;
 };
 

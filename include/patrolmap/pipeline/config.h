@@ -194,6 +194,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.stereo.min_range_m", &depth.stereo.min_range_m);
   visitor->Field("depth.stereo.max_range_m", &depth.stereo.max_range_m);
   visitor->Field("depth.stereo.disparity_sigma_px", &depth.stereo.disparity_sigma_px);
+  visitor->Field("depth.stereo.fuse_frames", &depth.stereo.fuse_frames);
+  visitor->Field("depth.stereo.fuse_gate_sigmas", &depth.stereo.fuse_gate_sigmas);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

@@ -19,6 +19,7 @@
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/status.h"
+#include "patrolmap/depth/fusion.h"
 #include "patrolmap/depth/stereo.h"
 #include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
@@ -115,6 +116,8 @@ class PatrolRecorder {
   TimestampNs last_frame_ns_ = 0, frame_spacing_ns_ = 0;
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
+  std::unique_ptr<depth::DepthFusion> fusion_;  // depth.stereo.fuse_frames; none when 0
+  cv::Mat views_;                               // depth frames averaged at each traced pixel (fusion_)
   cv::Mat left_, right_;
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;

@@ -1,0 +1,62 @@
+#include "patrolmap/depth/fusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace patrolmap::depth {
+
+DepthFusion::DepthFusion(const CameraIntrinsics& camera, const FusionOptions& options)
+    : camera_(camera), options_(options), kept_(static_cast<std::size_t>(std::max(0, options.frames))) {}
+
+bool DepthFusion::DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, const CameraPoseSample& pose,
+                              double* z) const {
+  const Eigen::Vector3d in_kept = kept.pose.ToCamera(world);
+  if (in_kept.z() <= 0.0) return false;
+  const int u = static_cast<int>(std::lround(camera_.fx * in_kept.x() / in_kept.z() + camera_.cx));
+  const int v = static_cast<int>(std::lround(camera_.fy * in_kept.y() / in_kept.z() + camera_.cy));
+  if (u < 0 || v < 0 || u >= kept.depth_m.cols || v >= kept.depth_m.rows) return false;
+  const double depth = kept.depth_m.at<float>(v, u);
+  if (depth <= 0.0) return false;
+  const Eigen::Vector3d seen(depth * (u - camera_.cx) / camera_.fx, depth * (v - camera_.cy) / camera_.fy, depth);
+  *z = pose.ToCamera(kept.pose.ToWorld(seen)).z();
+  return true;
+}
+
+void DepthFusion::Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m, cv::Mat* views) {
+  views->create(depth_m->size(), CV_8U);
+  views->setTo(0);
+  const int frames = static_cast<int>(kept_.size());
+  if (frames > 0) depth_m->copyTo(raw_);  // kept unfused; the buffer is reused
+  const int first = step / 2;
+  for (int y = first; y < depth_m->rows; y += step) {
+    float* row = depth_m->ptr<float>(y);
+    std::uint8_t* seen = views->ptr<std::uint8_t>(y);
+    for (int x = first; x < depth_m->cols; x += step) {
+      const double z = row[x];
+      if (z <= 0.0) continue;
+      const Eigen::Vector3d world =
+          pose.ToWorld(Eigen::Vector3d(z * (x - camera_.cx) / camera_.fx, z * (y - camera_.cy) / camera_.fy, z));
+      double sum = z;
+      int n = 1;
+      for (int back = 1; back <= count_; ++back) {
+        double other = 0.0;
+        const Kept& kept = kept_[(next_ - back + frames) % frames];
+        if (!DepthSeenBy(kept, world, pose, &other)) continue;
+        const double gate = options_.gate_sigmas * std::hypot(Sigma(z), Sigma(other));
+        if (std::abs(other - z) > gate) continue;
+        sum += other;
+        ++n;
+      }
+      row[x] = static_cast<float>(sum / n);
+      seen[x] = static_cast<std::uint8_t>(n);
+    }
+  }
+  if (frames == 0) return;
+  std::swap(kept_[next_].depth_m, raw_);  // the oldest frame's buffer becomes the next raw_
+  kept_[next_].pose = pose;
+  next_ = (next_ + 1) % frames;
+  count_ = std::min(count_ + 1, frames);
+}
+
+}  // namespace patrolmap::depth
