@@ -4,18 +4,25 @@
 #include <cmath>
 #include <utility>
 
+#include "patrolmap/core/status.h"
+
 namespace patrolmap::depth {
 
 DepthFusion::DepthFusion(const CameraIntrinsics& camera, const FusionOptions& options)
-    : camera_(camera), options_(options), kept_(static_cast<std::size_t>(std::max(0, options.frames))) {}
+    : camera_(camera), options_(options), kept_(static_cast<std::size_t>(std::max(0, options.frames))) {
+  PATROLMAP_CHECK(options.frames < 255);  // views are counted in 8 bits (depth.stereo.fuse_frames is at most 16)
+}
 
 bool DepthFusion::DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, const CameraPoseSample& pose,
                               double* z) const {
   const Eigen::Vector3d in_kept = kept.pose.ToCamera(world);
   if (in_kept.z() <= 0.0) return false;
-  const int u = static_cast<int>(std::lround(camera_.fx * in_kept.x() / in_kept.z() + camera_.cx));
-  const int v = static_cast<int>(std::lround(camera_.fy * in_kept.y() / in_kept.z() + camera_.cy));
-  if (u < 0 || v < 0 || u >= kept.depth_m.cols || v >= kept.depth_m.rows) return false;
+  const double column = camera_.fx * in_kept.x() / in_kept.z() + camera_.cx;
+  const double row = camera_.fy * in_kept.y() / in_kept.z() + camera_.cy;
+  if (!(column > -0.5 && row > -0.5 && column < kept.depth_m.cols - 0.5 && row < kept.depth_m.rows - 0.5)) {
+    return false;  // outside that frame (tested before rounding: a point almost beside the camera lands far off)
+  }
+  const int u = static_cast<int>(std::lround(column)), v = static_cast<int>(std::lround(row));
   const double depth = kept.depth_m.at<float>(v, u);
   if (depth <= 0.0) return false;
   const Eigen::Vector3d seen(depth * (u - camera_.cx) / camera_.fx, depth * (v - camera_.cy) / camera_.fy, depth);
