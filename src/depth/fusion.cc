@@ -25,8 +25,7 @@ bool DepthFusion::DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, co
   const int u = static_cast<int>(std::lround(column)), v = static_cast<int>(std::lround(row));
   const double depth = kept.depth_m.at<float>(v, u);
   if (depth <= 0.0) return false;
-  const Eigen::Vector3d seen(depth * (u - camera_.cx) / camera_.fx, depth * (v - camera_.cy) / camera_.fy, depth);
-  *z = pose.ToCamera(kept.pose.ToWorld(seen)).z();
+  *z = pose.ToCamera(kept.pose.ToWorld(InCamera(u, v, depth))).z();
   return true;
 }
 
@@ -42,8 +41,7 @@ void DepthFusion::Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m,
     for (int x = first; x < depth_m->cols; x += step) {
       const double z = row[x];
       if (z <= 0.0) continue;
-      const Eigen::Vector3d world =
-          pose.ToWorld(Eigen::Vector3d(z * (x - camera_.cx) / camera_.fx, z * (y - camera_.cy) / camera_.fy, z));
+      const Eigen::Vector3d world = pose.ToWorld(InCamera(x, y, z));
       double sum = z;
       int n = 1;
       for (int back = 1; back <= count_; ++back) {

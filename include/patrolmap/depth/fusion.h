@@ -39,6 +39,10 @@ class DepthFusion {
   // The depth along the current optical axis of the surface frame `kept` saw where `world` projects, if any.
   bool DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, const CameraPoseSample& pose, double* z) const;
   double Sigma(double z) const { return options_.range_sigma_per_m2 * z * z; }
+  // The point at depth `z` along pixel (u, v)'s ray, in the camera.
+  Eigen::Vector3d InCamera(double u, double v, double z) const {
+    return {z * (u - camera_.cx) / camera_.fx, z * (v - camera_.cy) / camera_.fy, z};
+  }
 
   CameraIntrinsics camera_;
   FusionOptions options_;
