@@ -320,6 +320,12 @@ cv::Mat NoisyWall(const CameraIntrinsics& camera, double z, double sigma, cv::RN
   return depth;
 }
 
+// The number of views averaged at (y, x), from the fused error's scale 1 / sqrt(views) (no shared error).
+int ViewsAt(const cv::Mat& scale, int y, int x) {
+  const float s = scale.at<float>(y, x);
+  return s > 0.0f ? static_cast<int>(std::lround(1.0 / (s * s))) : 0;
+}
+
 CameraPoseSample At(double x) {
   CameraPoseSample pose;
   pose.position = Eigen::Vector3d(x, 0.0, 0.0);
@@ -331,10 +337,10 @@ TEST(DepthFusion, AgreeingFramesAverageAwayTheirNoise) {
   DepthFusion fusion(camera, FusionOptions{4, 2.0, kFusionSigmaPerM2});
   cv::RNG rng(7);
   const double sigma = kFusionSigmaPerM2 * 20.0 * 20.0;
-  cv::Mat depth, views;
+  cv::Mat depth, scale;
   for (int frame = 0; frame < 5; ++frame) {
     depth = NoisyWall(camera, 20.0, sigma, &rng);
-    fusion.Fuse(At(0.5 * frame), 4, &depth, &views);
+    fusion.Fuse(At(0.5 * frame), 4, &depth, &scale);
   }
   // The fifth frame, fused with four before it (the wall moved 2.5 px a frame: columns from 12 on are in all).
   double squares = 0.0, averaged = 0.0;
@@ -342,7 +348,7 @@ TEST(DepthFusion, AgreeingFramesAverageAwayTheirNoise) {
   for (int y = 2; y < depth.rows; y += 4) {
     for (int x = 14; x < depth.cols; x += 4) {
       squares += std::pow(depth.at<float>(y, x) - 20.0, 2);
-      averaged += views.at<std::uint8_t>(y, x);
+      averaged += ViewsAt(scale, y, x);
       ++pixels;
     }
   }
@@ -352,50 +358,68 @@ TEST(DepthFusion, AgreeingFramesAverageAwayTheirNoise) {
   EXPECT_GT(averaged / pixels, 4.6);
   EXPECT_LT(std::sqrt(squares / pixels), 0.6 * sigma);
   EXPECT_GT(std::sqrt(squares / pixels), 0.4 * sigma);
-  EXPECT_EQ(views.at<std::uint8_t>(3, 14), 0);  // off the lattice: left as it was
+  EXPECT_EQ(scale.at<float>(3, 14), 0.0f);  // off the lattice: left as it was
 }
 
 TEST(DepthFusion, AFrameThatSawAnotherSurfaceIsNotAveraged) {
   const CameraIntrinsics camera{100.0, 100.0, 100.0, 50.0, 200, 100};
   DepthFusion fusion(camera, FusionOptions{2, 2.0, kFusionSigmaPerM2});
-  cv::Mat views;
+  cv::Mat scale;
   cv::Mat before(camera.height, camera.width, CV_32F, cv::Scalar(10.0));  // something 10 m ahead, then gone
-  fusion.Fuse(At(0.0), 4, &before, &views);
-  EXPECT_EQ(views.at<std::uint8_t>(2, 2), 1);
+  fusion.Fuse(At(0.0), 4, &before, &scale);
+  EXPECT_EQ(ViewsAt(scale, 2, 2), 1);
   cv::Mat wall(camera.height, camera.width, CV_32F, cv::Scalar(20.0));
   wall.at<float>(6, 6) = 0.0f;  // no return
-  fusion.Fuse(At(0.0), 4, &wall, &views);
-  EXPECT_EQ(views.at<std::uint8_t>(10, 10), 1);
+  fusion.Fuse(At(0.0), 4, &wall, &scale);
+  EXPECT_EQ(ViewsAt(scale, 10, 10), 1);
   EXPECT_EQ(wall.at<float>(10, 10), 20.0f);
-  EXPECT_EQ(views.at<std::uint8_t>(6, 6), 0);
+  EXPECT_EQ(ViewsAt(scale, 6, 6), 0);
   cv::Mat again(camera.height, camera.width, CV_32F, cv::Scalar(20.4));  // the wall again, within the gate
-  fusion.Fuse(At(0.0), 4, &again, &views);
-  EXPECT_EQ(views.at<std::uint8_t>(10, 10), 2);  // the wall seen before, not what stood in front of it
+  fusion.Fuse(At(0.0), 4, &again, &scale);
+  EXPECT_EQ(ViewsAt(scale, 10, 10), 2);  // the wall seen before, not what stood in front of it
   EXPECT_NEAR(again.at<float>(10, 10), 20.2, 1e-5);
-  EXPECT_EQ(views.at<std::uint8_t>(6, 6), 1);  // the frame before had no return there
+  EXPECT_EQ(ViewsAt(scale, 6, 6), 1);  // the frame before had no return there
 }
 
 // A frame's noise counts once: the frames kept are the ones that came, not their fused depths.
 TEST(DepthFusion, FramesAreKeptAsTheyCameNotAsFused) {
   const CameraIntrinsics camera{100.0, 100.0, 100.0, 50.0, 200, 100};
   DepthFusion fusion(camera, FusionOptions{2, 2.0, kFusionSigmaPerM2});
-  cv::Mat views;
+  cv::Mat scale;
   for (const float z : {20.0f, 21.0f}) {
     cv::Mat depth(camera.height, camera.width, CV_32F, cv::Scalar(z));
-    fusion.Fuse(At(0.0), 4, &depth, &views);
+    fusion.Fuse(At(0.0), 4, &depth, &scale);
   }
   cv::Mat depth(camera.height, camera.width, CV_32F, cv::Scalar(20.0));
-  fusion.Fuse(At(0.0), 4, &depth, &views);
-  EXPECT_EQ(views.at<std::uint8_t>(10, 10), 3);
+  fusion.Fuse(At(0.0), 4, &depth, &scale);
+  EXPECT_EQ(ViewsAt(scale, 10, 10), 3);
   EXPECT_NEAR(depth.at<float>(10, 10), (20.0 + 21.0 + 20.0) / 3.0, 1e-5);  // 20.17 with the second frame fused
+}
+
+// Frames that see a surface from the same distance share part of their error: averaging them shrinks only the rest.
+TEST(DepthFusion, AnErrorTheFramesShareIsNotAveragedAway) {
+  const CameraIntrinsics camera{100.0, 100.0, 100.0, 50.0, 200, 100};
+  const auto scale_after_five = [&](double shared) {
+    DepthFusion fusion(camera, FusionOptions{4, 2.0, kFusionSigmaPerM2, shared});
+    cv::Mat scale;
+    for (int frame = 0; frame < 5; ++frame) {
+      cv::Mat wall(camera.height, camera.width, CV_32F, cv::Scalar(20.0));
+      fusion.Fuse(At(0.0), 4, &wall, &scale);
+    }
+    return scale.at<float>(10, 10);
+  };
+  EXPECT_NEAR(scale_after_five(0.0), std::sqrt(1.0 / 5.0), 1e-6);
+  EXPECT_NEAR(scale_after_five(0.25), std::sqrt(0.25 + 0.75 / 5.0), 1e-6);  // 0.63 instead of 0.45
+  EXPECT_NEAR(scale_after_five(1.0), 1.0, 1e-6);                            // all shared: no gain
+  EXPECT_NEAR(DepthFusion(camera, FusionOptions{4, 2.0, kFusionSigmaPerM2, 0.5}).ErrorScale(1), 1.0, 1e-12);
 }
 
 TEST(DepthFusion, WithoutFramesKeptDepthIsUntouched) {
   const CameraIntrinsics camera{100.0, 100.0, 100.0, 50.0, 200, 100};
   DepthFusion fusion(camera, FusionOptions{0, 2.0, kFusionSigmaPerM2});
-  cv::Mat views, depth(camera.height, camera.width, CV_32F, cv::Scalar(20.0));
-  for (int frame = 0; frame < 3; ++frame) fusion.Fuse(At(0.5 * frame), 4, &depth, &views);
-  EXPECT_EQ(views.at<std::uint8_t>(2, 2), 1);
+  cv::Mat scale, depth(camera.height, camera.width, CV_32F, cv::Scalar(20.0));
+  for (int frame = 0; frame < 3; ++frame) fusion.Fuse(At(0.5 * frame), 4, &depth, &scale);
+  EXPECT_EQ(ViewsAt(scale, 2, 2), 1);
   EXPECT_EQ(cv::countNonZero(depth != 20.0f), 0);
 }
 

@@ -294,13 +294,13 @@ int EvidenceGrid::RayStep(int cols) const {
 }
 
 void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose,
-                             double range_sigma_per_m2, const cv::Mat& views) {
+                             double range_sigma_per_m2, const cv::Mat& error_scale) {
   constexpr double kNoReturnBeyond = 65.0;  // 16-bit millimetre depth saturates at 65.535 m
   ++stamp_;
   const int step = RayStep(depth_m.cols);
   for (int y = step / 2; y < depth_m.rows; y += step) {
     const float* row = depth_m.ptr<float>(y);
-    const std::uint8_t* averaged = views.empty() ? nullptr : views.ptr<std::uint8_t>(y);
+    const float* fused = error_scale.empty() ? nullptr : error_scale.ptr<float>(y);
     for (int x = step / 2; x < depth_m.cols; x += step) {
       const double depth = row[x];
       if (depth <= 0.0) continue;  // no return: unknown
@@ -310,7 +310,7 @@ void EvidenceGrid::Integrate(const cv::Mat& depth_m, const CameraIntrinsics& cam
       const double traced = hit ? depth : options_.max_range_m / ray.norm();
       // Free space ends free_space_sigmas range errors before a return (the error grows with depth squared).
       double sigma = range_sigma_per_m2 * length * length;
-      if (averaged != nullptr && averaged[x] > 1) sigma /= std::sqrt(static_cast<double>(averaged[x]));
+      if (fused != nullptr && fused[x] > 0.0f) sigma *= fused[x];
       // A return too uncertain to place in a voxel still says the space before it is free.
       const double hold_back = hit ? options_.free_space_sigmas * sigma : 0.0;
       TraceRay(pose.position, pose.ToWorld(traced * ray), hit && sigma <= options_.max_hit_sigma_m, hold_back);

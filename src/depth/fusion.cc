@@ -10,7 +10,16 @@ namespace patrolmap::depth {
 
 DepthFusion::DepthFusion(const CameraIntrinsics& camera, const FusionOptions& options)
     : camera_(camera), options_(options), kept_(static_cast<std::size_t>(std::max(0, options.frames))) {
-  PATROLMAP_CHECK(options.frames < 255);  // views are counted in 8 bits (depth.stereo.fuse_frames is at most 16)
+  PATROLMAP_CHECK(options.shared_variance >= 0.0 && options.shared_variance <= 1.0);  // StereoOptions::IsValid
+  scales_.resize(kept_.size() + 2);                                                   // 1 to frames + 1 views
+  for (std::size_t views = 1; views < scales_.size(); ++views) {
+    scales_[views] = static_cast<float>(ErrorScale(static_cast<int>(views)));
+  }
+}
+
+double DepthFusion::ErrorScale(int views) const {
+  const double shared = options_.shared_variance;
+  return views < 1 ? 0.0 : std::sqrt(shared + (1.0 - shared) / views);
 }
 
 bool DepthFusion::DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, const CameraPoseSample& pose,
@@ -29,15 +38,15 @@ bool DepthFusion::DepthSeenBy(const Kept& kept, const Eigen::Vector3d& world, co
   return true;
 }
 
-void DepthFusion::Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m, cv::Mat* views) {
-  views->create(depth_m->size(), CV_8U);
-  views->setTo(0);
+void DepthFusion::Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m, cv::Mat* error_scale) {
+  error_scale->create(depth_m->size(), CV_32F);
+  error_scale->setTo(0);
   const int frames = static_cast<int>(kept_.size());
   if (frames > 0) depth_m->copyTo(raw_);  // kept unfused; the buffer is reused
   const int first = step / 2;
   for (int y = first; y < depth_m->rows; y += step) {
     float* row = depth_m->ptr<float>(y);
-    std::uint8_t* seen = views->ptr<std::uint8_t>(y);
+    float* scale = error_scale->ptr<float>(y);
     for (int x = first; x < depth_m->cols; x += step) {
       const double z = row[x];
       if (z <= 0.0) continue;
@@ -54,7 +63,7 @@ void DepthFusion::Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m,
         ++n;
       }
       row[x] = static_cast<float>(sum / n);
-      seen[x] = static_cast<std::uint8_t>(n);
+      scale[x] = scales_[n];
     }
   }
   if (frames == 0) return;

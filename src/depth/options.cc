@@ -39,7 +39,8 @@ bool StereoOptions::IsValid(std::string* error) const {
              "must be above depth.stereo.min_range_m")
       .InRange("depth.stereo.disparity_sigma_px", disparity_sigma_px, 0.0, 16.0)
       .InRange("depth.stereo.fuse_frames", fuse_frames, 0, 16)
-      .AboveAtMost("depth.stereo.fuse_gate_sigmas", fuse_gate_sigmas, 0.0, 10.0);
+      .AboveAtMost("depth.stereo.fuse_gate_sigmas", fuse_gate_sigmas, 0.0, 10.0)
+      .InRange("depth.stereo.fuse_shared_variance", fuse_shared_variance, 0.0, 1.0);
   return check.ok();
 }
 

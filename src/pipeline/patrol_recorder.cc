@@ -16,7 +16,8 @@ constexpr double kViewRateHz = 5.0;  // views kept for visibility
 // Says how far the stereo pair marks surfaces: beyond, a return's range error exceeds
 // change.grid.max_hit_sigma_m, so it carves free space only and nothing there can show as a surface that came or went.
 // With depth.stereo.fuse_frames, surfaces seen alike by every fused frame are marked farther.
-void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, const Config& config) {
+void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, const depth::DepthFusion* fusion,
+                    const Config& config) {
   const change::EvidenceGridOptions& grid = config.change.grid;
   const double marked = std::min(stereo.DepthWithin(grid.max_hit_sigma_m), grid.max_range_m);
   spdlog::info(
@@ -25,9 +26,9 @@ void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, c
       "change.grid.max_hit_sigma_m {} m; farther returns only carve free space",
       path, stereo.baseline_m(), stereo.focal_px(), marked, config.depth.stereo.disparity_sigma_px,
       grid.max_hit_sigma_m);
+  if (fusion == nullptr) return;
   const int views = config.depth.stereo.fuse_frames + 1;
-  if (views == 1) return;
-  const double fused = std::min(stereo.DepthWithin(grid.max_hit_sigma_m * std::sqrt(views)), grid.max_range_m);
+  const double fused = std::min(stereo.DepthWithin(grid.max_hit_sigma_m / fusion->ErrorScale(views)), grid.max_range_m);
   spdlog::info("{}: with depth.stereo.fuse_frames {}, within {:.1f} m where all {} fused depth frames agree", path,
                views - 1, fused, views);
 }
@@ -69,10 +70,10 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
     if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
   }
   if (stereo_ != nullptr) {
-    SayStereoReach(info.path, *stereo_, config);
     const depth::FusionOptions fusion{config.depth.stereo.fuse_frames, config.depth.stereo.fuse_gate_sigmas,
-                                      stereo_->RangeSigma(1.0)};
+                                      stereo_->RangeSigma(1.0), config.depth.stereo.fuse_shared_variance};
     if (fusion.frames > 0) fusion_ = std::make_unique<depth::DepthFusion>(base_.camera, fusion);
+    SayStereoReach(info.path, *stereo_, fusion_.get(), config);
   }
   use_stereo_ = stereo_ != nullptr;
   has_depth_ = images || use_stereo_;
@@ -216,8 +217,8 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     ++stats_.skipped_depth_frames;
     return;
   }
-  if (fusion_ != nullptr) fusion_->Fuse(*work.pose, grid_.RayStep(depth_.cols), &depth_, &views_);
-  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0, views_);
+  if (fusion_ != nullptr) fusion_->Fuse(*work.pose, grid_.RayStep(depth_.cols), &depth_, &error_scale_);
+  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0, error_scale_);
   next_grid_ns_ = work.timestamp_ns + grid_step_ns_;
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -171,7 +171,7 @@ TEST(EvidenceGrid, StereoDepthCarvesLessAndHitsOnlyWhereItIsSure) {
   far_stereo.Integrate(wall, kCamera, pose, 1.0 / 100.0);
   // The same error, averaged over 16 depth frames (depth::DepthFusion): a quarter, and hits again.
   EvidenceGrid fused(options);
-  fused.Integrate(wall, kCamera, pose, 1.0 / 100.0, cv::Mat(wall.size(), CV_8U, cv::Scalar(16)));
+  fused.Integrate(wall, kCamera, pose, 1.0 / 100.0, cv::Mat(wall.size(), CV_32F, cv::Scalar(0.25)));
   const auto count = [](const EvidenceGridData& data, int from_x, int to_x, bool hits) {
     long long total = 0;
     for (const VoxelEvidence& v : data.voxels) {

@@ -28,10 +28,10 @@ class EvidenceGrid {
   // Traces the rays of one depth image (metres along the optical axis, 0 = no
   // return) seen from `pose`, one every RayStep() pixels from RayStep() / 2 in both directions. Depth whose
   // range error grows as sigma(r) = range_sigma_per_m2 * r^2 (stereo; 0 for exact depth) carves free space only
-  // up to free_space_sigmas * sigma(r) before each return. `views` (CV_8U, optional): at each traced pixel the
-  // number of depth frames averaged there (depth::DepthFusion), which divides sigma(r) by its square root.
+  // up to free_space_sigmas * sigma(r) before each return. `error_scale` (CV_32F, optional): at each traced pixel
+  // the factor on sigma(r) of depth averaged over several frames (depth::DepthFusion); 0 or empty: 1.
   void Integrate(const cv::Mat& depth_m, const CameraIntrinsics& camera, const CameraPoseSample& pose,
-                 double range_sigma_per_m2 = 0.0, const cv::Mat& views = cv::Mat());
+                 double range_sigma_per_m2 = 0.0, const cv::Mat& error_scale = cv::Mat());
   // The pixel spacing of the rays traced in a depth image `cols` wide (options.rays_per_row a row).
   int RayStep(int cols) const;
   // Traces one ray from `origin` towards `end`; `hit` when it ends on a surface. The voxels of the last

@@ -1,8 +1,11 @@
 // Multi-frame fusion of stereo depth (DESIGN.md, depth): one pair's range error grows with the square of the depth
 // (StereoDepth::RangeSigma), so past some distance a single return is too uncertain to mark a surface. A flight sees
 // the same surface from several poses; where the depth frames before agree with a return, their depths (moved into
-// the current camera with the poses) are averaged with it, and the range error of the mean falls with the square
-// root of the number of views.
+// the current camera with the poses) are averaged with it, and the range error of the mean falls with the number
+// of views. Not all of it: frames that see a surface from nearly the same distance share part of their matching
+// error (SGBM's pull towards whole pixels, a textureless patch filled in alike), and averaging leaves that part.
+// So the error of a mean of n views is sigma * sqrt(shared + (1 - shared) / n), `shared` the share of a frame's
+// error variance the frames have in common.
 //
 // Only the pixels the evidence grid traces are fused (every `step` pixels from step / 2 in both directions). The
 // frames kept are the raw ones, so no noise is counted twice.
@@ -20,6 +23,7 @@ struct FusionOptions {
   int frames = 0;                   // earlier depth frames fused with each one; 0: no fusion
   double gate_sigmas = 2.0;         // an earlier frame agrees when its depth is within this many combined range errors
   double range_sigma_per_m2 = 0.0;  // the range error at depth z is this * z^2 [m] (StereoDepth::RangeSigma(1))
+  double shared_variance = 0.0;     // share of a frame's error variance common to the frames fused, in [0, 1]
 };
 
 class DepthFusion {
@@ -27,9 +31,12 @@ class DepthFusion {
   DepthFusion(const CameraIntrinsics& camera, const FusionOptions& options);
 
   // Fuses the pixels on the lattice `step` of `depth_m` (CV_32F along the optical axis, 0 = no return; the camera's
-  // size) seen from `pose` with the frames kept, in place; `views` (CV_8U, same size) gets the number of frames
-  // averaged at each lattice pixel (1: this one alone; 0: no return). Then keeps the raw frame, dropping the oldest.
-  void Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m, cv::Mat* views);
+  // size) seen from `pose` with the frames kept, in place; `error_scale` (CV_32F, same size) gets at each lattice
+  // pixel the factor ErrorScale(views) of the fused depth's range error (1: this frame alone; 0: no return). Then
+  // keeps the raw frame, dropping the oldest.
+  void Fuse(const CameraPoseSample& pose, int step, cv::Mat* depth_m, cv::Mat* error_scale);
+  // The range error of a mean of `views` agreeing depths, as a share of one depth's.
+  double ErrorScale(int views) const;
 
  private:
   struct Kept {
@@ -46,8 +53,9 @@ class DepthFusion {
 
   CameraIntrinsics camera_;
   FusionOptions options_;
-  std::vector<Kept> kept_;  // a ring of options.frames, newest at next_ - 1
-  cv::Mat raw_;             // the current frame before fusion
+  std::vector<Kept> kept_;     // a ring of options.frames, newest at next_ - 1
+  std::vector<float> scales_;  // ErrorScale of each number of views
+  cv::Mat raw_;                // the current frame before fusion
   int next_ = 0, count_ = 0;
 };
 

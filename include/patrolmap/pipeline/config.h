@@ -196,6 +196,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.stereo.disparity_sigma_px", &depth.stereo.disparity_sigma_px);
   visitor->Field("depth.stereo.fuse_frames", &depth.stereo.fuse_frames);
   visitor->Field("depth.stereo.fuse_gate_sigmas", &depth.stereo.fuse_gate_sigmas);
+  visitor->Field("depth.stereo.fuse_shared_variance", &depth.stereo.fuse_shared_variance);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

@@ -117,7 +117,7 @@ class PatrolRecorder {
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
   std::unique_ptr<depth::DepthFusion> fusion_;  // depth.stereo.fuse_frames; none when 0
-  cv::Mat views_;                               // depth frames averaged at each traced pixel (fusion_)
+  cv::Mat error_scale_;                         // the fused range error's factor at each traced pixel (fusion_)
   cv::Mat left_, right_;
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;
