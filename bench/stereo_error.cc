@@ -6,6 +6,9 @@
 //     stereo options and each depth compared with depth0/'s, as disparity f * b / z.
 //   stereo_error [--cancel-locking] --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES
 //     A rectified pair with its 8-bit true disparity (0 = unknown), matched with the defaults and that range.
+//   stereo_error [--cancel-locking] --shared LOG [STEP]
+//     How much of the error depth frames share where they see the same surface (depth.stereo.fuse_shared_variance,
+//     session 28): every STEP-th pair (default 6: 5 Hz at 30 Hz) against the 4 before it, with the log's poses.
 //
 // Prints the pixels compared, the share off by more than 3 px, and the mean and rms of the rest; for a log also
 // the mean per metre of true depth, per grey level of the left image's 7x7 standard deviation and per tenth of the
@@ -13,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -81,52 +85,85 @@ cv::Mat LocalDeviation(const cv::Mat& left) {
   return deviation;
 }
 
-int Log(const std::string& log, int step, const depth::StereoOptions& options) {
+// A log's stereo pairs and its depth0/ images by time, with the matcher for its calibration.
+struct LogPairs {
+  std::vector<DepthSample> pairs;
+  std::map<TimestampNs, std::string> truth;
+  std::unique_ptr<depth::StereoDepth> stereo;
+  CameraIntrinsics camera;  // the left camera's, in which depth is given
+};
+
+int ReadLog(const std::string& log, const depth::StereoOptions& options, LogPairs* out) {
   std::unique_ptr<io::FrameSource> source;
   Status status = io::OpenEuroc(log, &source);
   if (!status.ok()) return Fail(status.message());
   if (!source->info().stereo) return Fail(log + ": no stereo pair (cam1/ with sensor.yaml)");
-  std::map<TimestampNs, std::string> truth;  // depth0/ images by time
-  std::vector<DepthSample> pairs;            // stereo pairs
   Frame frame;
   while ((status = source->Next(false, &frame)).ok()) {
     for (DepthSample& d : frame.depth) {
       if (d.stereo()) {
-        pairs.push_back(std::move(d));
+        out->pairs.push_back(std::move(d));
       } else {
-        truth[d.timestamp_ns] = d.path;
+        out->truth[d.timestamp_ns] = d.path;
       }
     }
   }
   if (!status.end_of_stream()) return Fail(status.message());
-  if (truth.empty()) return Fail(log + ": no depth0/ images to compare with");
-  std::unique_ptr<depth::StereoDepth> stereo;
-  status = depth::StereoDepth::Create(*source->info().stereo, options, &stereo);
+  if (out->truth.empty()) return Fail(log + ": no depth0/ images to compare with");
+  out->camera = source->info().stereo->left;
+  status = depth::StereoDepth::Create(*source->info().stereo, options, &out->stereo);
   if (!status.ok()) return Fail(status.message());
-  const double fb = stereo->focal_px() * stereo->baseline_m();
+  return 0;
+}
+
+// Matches `pair` and reads its true depth; `error` gets measured minus true disparity [px] (NaN: either unknown,
+// or off by more than kGrossPx, counted in `gross` when given).
+int MatchedError(const LogPairs& log, const DepthSample& pair, cv::Mat* left, cv::Mat* true_depth, cv::Mat* error,
+                 long* gross) {
+  const auto found = log.truth.find(pair.timestamp_ns);
+  if (found == log.truth.end()) return -1;
+  *left = cv::imread(pair.path, cv::IMREAD_GRAYSCALE);
+  const cv::Mat right = cv::imread(pair.right_path, cv::IMREAD_GRAYSCALE);
+  if (left->empty() || right.empty()) return Fail(pair.path + " or " + pair.right_path + ": unreadable");
+  cv::Mat measured;
+  Status status = log.stereo->Compute(*left, right, &measured);
+  if (status.ok()) status = io::ReadDepthImage(found->second, true_depth);
+  if (!status.ok()) return Fail(status.message());
+  if (true_depth->size() != measured.size()) return Fail(found->second + ": not the size of the left image");
+  const double fb = log.stereo->focal_px() * log.stereo->baseline_m();
+  error->create(measured.size(), CV_32F);
+  for (int y = 0; y < measured.rows; ++y) {
+    for (int x = 0; x < measured.cols; ++x) {
+      const float z = measured.at<float>(y, x), z_true = true_depth->at<float>(y, x);
+      float& e = error->at<float>(y, x);
+      e = std::numeric_limits<float>::quiet_NaN();
+      if (z <= 0.0f || z_true <= 0.0f) continue;
+      const double d = fb / z - fb / z_true;
+      if (std::abs(d) > kGrossPx) {
+        if (gross != nullptr) ++*gross;
+        continue;
+      }
+      e = static_cast<float>(d);
+    }
+  }
+  return 0;
+}
+
+int Log(const std::string& log_path, int step, const depth::StereoOptions& options) {
+  LogPairs log;
+  if (const int failed = ReadLog(log_path, options, &log)) return failed;
+  const double fb = log.stereo->focal_px() * log.stereo->baseline_m();
   Errors errors;
-  for (std::size_t i = 0; i < pairs.size(); i += step) {
-    const DepthSample& pair = pairs[i];
-    const auto found = truth.find(pair.timestamp_ns);
-    if (found == truth.end()) continue;
-    const cv::Mat left = cv::imread(pair.path, cv::IMREAD_GRAYSCALE);
-    const cv::Mat right = cv::imread(pair.right_path, cv::IMREAD_GRAYSCALE);
-    if (left.empty() || right.empty()) return Fail(pair.path + " or " + pair.right_path + ": unreadable");
-    cv::Mat measured, true_depth;
-    status = stereo->Compute(left, right, &measured);
-    if (status.ok()) status = io::ReadDepthImage(found->second, &true_depth);
-    if (!status.ok()) return Fail(status.message());
-    if (true_depth.size() != measured.size()) return Fail(found->second + ": not the size of the left image");
+  for (std::size_t i = 0; i < log.pairs.size(); i += step) {
+    cv::Mat left, true_depth, error;
+    const int result = MatchedError(log, log.pairs[i], &left, &true_depth, &error, &errors.gross);
+    if (result < 0) continue;
+    if (result > 0) return result;
     const cv::Mat deviation = LocalDeviation(left);
-    for (int y = 0; y < measured.rows; ++y) {
-      for (int x = 0; x < measured.cols; ++x) {
-        const float z = measured.at<float>(y, x), z_true = true_depth.at<float>(y, x);
-        if (z <= 0.0f || z_true <= 0.0f) continue;
-        const double e = fb / z - fb / z_true;
-        if (std::abs(e) > kGrossPx) {
-          ++errors.gross;
-          continue;
-        }
+    for (int y = 0; y < error.rows; ++y) {
+      for (int x = 0; x < error.cols; ++x) {
+        const float e = error.at<float>(y, x), z_true = true_depth.at<float>(y, x);
+        if (std::isnan(e)) continue;
         errors.all.Add(e);
         errors.by_depth[static_cast<int>(z_true)].Add(e);
         errors.by_texture[std::min(20, static_cast<int>(deviation.at<float>(y, x)))].Add(e);
@@ -137,6 +174,79 @@ int Log(const std::string& log, int step, const depth::StereoOptions& options) {
     }
   }
   Print(errors, true);
+  return 0;
+}
+
+// How much of the matching error frames share (depth.stereo.fuse_shared_variance): every `step`-th pair is matched,
+// and each point of a lattice 8 px apart, at least kSharedBeyondM deep, is followed into the kSharedFrames pairs
+// before (with the log's poses and true depth; the same surface: true depths within 5 %). Prints the correlation of
+// the errors at each lag, and for points seen by all, var(mean) / var(one) = shared + (1 - shared) / n solved for
+// the shared share.
+int Shared(const std::string& log_path, int step, const depth::StereoOptions& options) {
+  constexpr int kSharedFrames = 4;  // depth.stereo.fuse_frames' choice
+  constexpr float kSharedBeyondM = 8.0f;
+  constexpr int kLatticePx = 8;
+  LogPairs log;
+  if (const int failed = ReadLog(log_path, options, &log)) return failed;
+  struct Seen {
+    cv::Mat true_depth, error;
+    CameraPoseSample pose;
+  };
+  std::vector<Seen> seen;
+  struct Products {
+    double xy = 0.0, xx = 0.0, yy = 0.0;
+    long count = 0;
+  } lags[kSharedFrames + 1];
+  Mean one, mean_of_all;
+  const CameraIntrinsics& camera = log.camera;
+  for (std::size_t i = 0; i < log.pairs.size(); i += step) {
+    const DepthSample& pair = log.pairs[i];
+    if (!pair.pose) return Fail(pair.path + ": no pose (the log needs state_groundtruth_estimate0/)");
+    Seen now;
+    cv::Mat left;
+    const int result = MatchedError(log, pair, &left, &now.true_depth, &now.error, nullptr);
+    if (result < 0) continue;
+    if (result > 0) return result;
+    now.pose = *pair.pose;
+    seen.push_back(std::move(now));
+    const int k = static_cast<int>(seen.size()) - 1;
+    if (k < kSharedFrames) continue;
+    const Seen& current = seen[k];
+    for (int y = kLatticePx / 2; y < current.error.rows; y += kLatticePx) {
+      for (int x = kLatticePx / 2; x < current.error.cols; x += kLatticePx) {
+        const float z = current.true_depth.at<float>(y, x), e = current.error.at<float>(y, x);
+        if (!(z >= kSharedBeyondM) || std::isnan(e)) continue;
+        const Eigen::Vector3d world =
+            current.pose.ToWorld(Eigen::Vector3d(z * (x - camera.cx) / camera.fx, z * (y - camera.cy) / camera.fy, z));
+        double sum = e;
+        int views = 1;
+        for (int lag = 1; lag <= kSharedFrames; ++lag, ++views) {
+          const Seen& before = seen[k - lag];
+          const Eigen::Vector3d p = before.pose.ToCamera(world);
+          if (p.z() <= 0.0) break;
+          const long u = std::lround(camera.fx * p.x() / p.z() + camera.cx);
+          const long v = std::lround(camera.fy * p.y() / p.z() + camera.cy);
+          if (u < 0 || v < 0 || u >= before.error.cols || v >= before.error.rows) break;
+          const float other = before.error.at<float>(v, u);
+          if (std::abs(before.true_depth.at<float>(v, u) - p.z()) > 0.05 * p.z() || std::isnan(other)) break;
+          lags[lag].xy += e * other, lags[lag].xx += e * e, lags[lag].yy += other * other, ++lags[lag].count;
+          sum += other;
+        }
+        if (views != kSharedFrames + 1) continue;
+        one.Add(e);
+        mean_of_all.Add(sum / views);
+      }
+    }
+  }
+  for (int lag = 1; lag <= kSharedFrames; ++lag) {
+    const Products& p = lags[lag];
+    std::printf("lag %d: %ld points, correlation %.3f\n", lag, p.count, p.xy / std::sqrt(std::max(1e-12, p.xx * p.yy)));
+  }
+  if (one.count == 0) return Fail("no point was seen by " + std::to_string(kSharedFrames + 1) + " pairs");
+  const double n = kSharedFrames + 1, ratio = mean_of_all.squares / one.squares;
+  std::printf("seen by all %d: %ld points, rms one %.3f px, rms of the mean %.3f px; var ratio %.3f => shared %.3f\n",
+              kSharedFrames + 1, one.count, std::sqrt(one.squares / one.count),
+              std::sqrt(mean_of_all.squares / one.count), ratio, (ratio - 1.0 / n) / (1.0 - 1.0 / n));
   return 0;
 }
 
@@ -175,6 +285,7 @@ int Middlebury(const std::string& left_path, const std::string& right_path, cons
 int main(int argc, char** argv) {
   const std::string usage =
       "usage: stereo_error [--cancel-locking] LOG [STEP]\n"
+      "       stereo_error [--cancel-locking] --shared LOG [STEP]\n"
       "       stereo_error [--cancel-locking] --middlebury LEFT RIGHT TRUTH NUM_DISPARITIES\n";
   depth::StereoOptions options;
   if (argc > 1 && std::string(argv[1]) == "--cancel-locking") {
@@ -183,6 +294,11 @@ int main(int argc, char** argv) {
   }
   if (argc == 6 && std::string(argv[1]) == "--middlebury") {
     return Middlebury(argv[2], argv[3], argv[4], std::atoi(argv[5]), options);
+  }
+  if ((argc == 3 || argc == 4) && std::string(argv[1]) == "--shared") {
+    const int step = argc == 4 ? std::atoi(argv[3]) : 6;
+    if (step < 1) return Fail(std::string("STEP must be a whole number of at least 1, not '") + argv[3] + "'");
+    return Shared(argv[2], step, options);
   }
   if (argc == 2 || argc == 3) {
     const int step = argc == 3 ? std::atoi(argv[2]) : 60;
