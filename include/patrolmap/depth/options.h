@@ -44,9 +44,9 @@ struct StereoOptions {
   // within fuse_gate_sigmas combined range errors the depths are averaged, and the range error falls with the
   // square root of the views, but only on the share 1 - fuse_shared_variance of its variance: frames seeing a surface
   // from nearly the same distance share part of their matching error. 0: off. BENCHMARKS.md, "Stereo depth".
-  int fuse_frames = 0;
+  int fuse_frames = 4;
   double fuse_gate_sigmas = 2.0;
-  double fuse_shared_variance = 0.0;
+  double fuse_shared_variance = 0.3;
   bool IsValid(std::string* error) const;
 };
 
