@@ -11,7 +11,8 @@ namespace patrolmap::depth {
 DepthFusion::DepthFusion(const CameraIntrinsics& camera, const FusionOptions& options)
     : camera_(camera), options_(options), kept_(static_cast<std::size_t>(std::max(0, options.frames))) {
   PATROLMAP_CHECK(options.shared_variance >= 0.0 && options.shared_variance <= 1.0);  // StereoOptions::IsValid
-  scales_.resize(kept_.size() + 2);                                                   // 1 to frames + 1 views
+  // ErrorScale of 1 to frames + 1 views, looked up per pixel.
+  scales_.resize(kept_.size() + 2);
   for (std::size_t views = 1; views < scales_.size(); ++views) {
     scales_[views] = static_cast<float>(ErrorScale(static_cast<int>(views)));
   }
