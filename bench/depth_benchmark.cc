@@ -75,7 +75,7 @@ void BM_DepthFusion(benchmark::State& state) {
   if (!depth::StereoDepth::Create(pair.calibration, depth::StereoOptions(), &stereo).ok()) {
     return state.SkipWithError("calibration");
   }
-  cv::Mat raw, depth, views;
+  cv::Mat raw, depth, error_scale;
   if (!stereo->Compute(pair.left, pair.right, &raw).ok()) return state.SkipWithError("compute");
   const int frames = static_cast<int>(state.range(1));
   depth::DepthFusion fusion(pair.calibration.left, depth::FusionOptions{frames, 2.0, stereo->RangeSigma(1.0)});
@@ -83,18 +83,18 @@ void BM_DepthFusion(benchmark::State& state) {
   CameraPoseSample pose;
   for (int frame = 0; frame < frames; ++frame, pose.position.x() += 0.2) {
     raw.copyTo(depth);
-    fusion.Fuse(pose, step, &depth, &views);
+    fusion.Fuse(pose, step, &depth, &error_scale);
   }
   for (auto _ : state) {
     raw.copyTo(depth);  // as the matcher hands each frame over
-    fusion.Fuse(pose, step, &depth, &views);
+    fusion.Fuse(pose, step, &depth, &error_scale);
     benchmark::DoNotOptimize(depth.data);
   }
   double views_sum = 0.0;  // views averaged: 1 / scale^2 with no shared error
   int traced = 0;
-  for (int y = step / 2; y < views.rows; y += step) {
-    for (int x = step / 2; x < views.cols; x += step) {
-      const float scale = views.at<float>(y, x);
+  for (int y = step / 2; y < error_scale.rows; y += step) {
+    for (int x = step / 2; x < error_scale.cols; x += step) {
+      const float scale = error_scale.at<float>(y, x);
       if (scale > 0.0f) views_sum += 1.0 / (scale * scale), ++traced;
     }
   }
