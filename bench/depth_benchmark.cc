@@ -1,5 +1,6 @@
 // Depth-stage speed: stereo depth of one rendered village pair (0.5 m baseline, 64 disparities) at 376x240
-// and 752x480, with and without the left-right check (which matches the pair a second time); and the fusion of a
+// and 752x480, with and without the left-right check (which matches the pair a second time), and at 752x480
+// with 128 disparities or the near pass (both reach 1.8 m instead of 3.6 m); and the fusion of a
 // depth frame with the frames before it (depth.stereo.fuse_frames) on the grid's ray lattice.
 #include <algorithm>
 #include <cmath>
@@ -45,6 +46,8 @@ void BM_StereoDepth(benchmark::State& state) {
   options.lr_check = state.range(1) != 0;
   options.edge_radius_px = static_cast<int>(state.range(2));
   options.cancel_pixel_locking = state.range(3) != 0;
+  options.num_disparities = static_cast<int>(state.range(4));
+  options.near_pass = state.range(5) != 0;
   std::unique_ptr<depth::StereoDepth> stereo;
   if (!depth::StereoDepth::Create(pair.calibration, options, &stereo).ok()) return state.SkipWithError("calibration");
   cv::Mat depth;
@@ -55,15 +58,17 @@ void BM_StereoDepth(benchmark::State& state) {
   state.counters["known"] = static_cast<double>(cv::countNonZero(depth)) / depth.total();
 }
 BENCHMARK(BM_StereoDepth)
-    ->ArgNames({"width", "lr_check", "edge_radius", "cancel_locking"})
-    ->Args({376, 1, 0, 0})
-    ->Args({752, 1, 0, 0})
-    ->Args({376, 0, 0, 0})
-    ->Args({752, 0, 0, 0})
-    ->Args({376, 1, 2, 0})
-    ->Args({752, 1, 2, 0})
-    ->Args({376, 1, 2, 1})
-    ->Args({752, 1, 2, 1})
+    ->ArgNames({"width", "lr_check", "edge_radius", "cancel_locking", "disparities", "near_pass"})
+    ->Args({376, 1, 0, 0, 64, 0})
+    ->Args({752, 1, 0, 0, 64, 0})
+    ->Args({376, 0, 0, 0, 64, 0})
+    ->Args({752, 0, 0, 0, 64, 0})
+    ->Args({376, 1, 2, 0, 64, 0})
+    ->Args({752, 1, 2, 0, 64, 0})
+    ->Args({376, 1, 2, 1, 64, 0})
+    ->Args({752, 1, 2, 1, 64, 0})
+    ->Args({752, 1, 2, 0, 128, 0})
+    ->Args({752, 1, 2, 0, 64, 1})
     ->Unit(benchmark::kMillisecond);
 
 // One depth frame of the pair fused with `frames` before it, the camera 0.2 m further along each frame (a

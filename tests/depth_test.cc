@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -183,17 +184,33 @@ struct WallPair {
   cv::Mat left, right;
 };
 
-WallPair Wall() {
+// A textured wall facing a pair 0.5 m apart (f = 400 px) with `disparity` pixels between the views: at
+// 200 / disparity metres (25 px: 8 m).
+WallPair Wall(int disparity = 25) {
   WallPair pair;
   const CameraIntrinsics camera{400.0, 400.0, 188.0, 120.0, 376, 240};
   pair.calibration.left = pair.calibration.right = camera;
   pair.calibration.right_from_left_translation = Eigen::Vector3d(-0.5, 0.0, 0.0);
-  cv::Mat texture(240, 376 + 25, CV_8UC1);
+  cv::Mat texture(240, 376 + disparity, CV_8UC1);
   cv::randu(texture, 0, 256);
   cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
   pair.left = texture.colRange(0, 376).clone();
-  pair.right = texture.colRange(25, 376 + 25).clone();
+  pair.right = texture.colRange(disparity, 376 + disparity).clone();
   return pair;
+}
+
+// Known pixels of `depth`, and those within `tolerance` of `z`.
+std::pair<int, int> KnownAndAt(const cv::Mat& depth, double z, double tolerance) {
+  int known = 0, at = 0;
+  for (int y = 0; y < depth.rows; ++y) {
+    for (int x = 0; x < depth.cols; ++x) {
+      const float value = depth.at<float>(y, x);
+      if (value <= 0) continue;
+      ++known;
+      at += std::abs(value - z) < tolerance;
+    }
+  }
+  return {known, at};
 }
 
 TEST(StereoDepth, AWallAtKnownDepthComesOutAtThatDepth) {
@@ -205,21 +222,60 @@ TEST(StereoDepth, AWallAtKnownDepthComesOutAtThatDepth) {
   ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
   ASSERT_EQ(depth.type(), CV_32FC1);
   ASSERT_EQ(depth.size(), pair.left.size());
-  int known = 0, right_depth = 0;
-  for (int y = 0; y < depth.rows; ++y) {
-    for (int x = 0; x < depth.cols; ++x) {
-      const float z = depth.at<float>(y, x);
-      if (z <= 0) continue;
-      ++known;
-      right_depth += std::abs(z - 8.0) < 0.08;
-    }
-  }
+  const auto [known, right_depth] = KnownAndAt(depth, 8.0, 0.08);
   // The first 25 columns see wall the right camera does not.
   EXPECT_GT(known, 0.85 * (376 - 25) * 240);
   EXPECT_GT(right_depth, 0.98 * known);
   EXPECT_NEAR(stereo->RangeSigma(8.0), 64.0 * 0.5 / (400.0 * 0.5), 1e-9);
   EXPECT_NEAR(stereo->DepthWithin(stereo->RangeSigma(8.0)), 8.0, 1e-9);
   EXPECT_NEAR(stereo->DepthWithin(0.5), std::sqrt(0.5 * 400.0 * 0.5 / 0.5), 1e-9);  // 0.5 m of error at 14.1 m
+}
+
+// The disparity range sets the nearest depth, f * b / num_disparities (what the run says at its start): a wall
+// 2.5 m ahead (80 px) is beyond 64 disparities (3.1 m) and gets no depth; it comes out at 2.5 m with 96 (2.1 m),
+// and with 64 and the near pass at half resolution (1.6 m).
+TEST(StereoDepth, NothingNearerThanTheDisparityRangeReachesIsMatched) {
+  const WallPair pair = Wall(80);
+  StereoOptions options;
+  std::unique_ptr<StereoDepth> stereo;
+  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 64, 1e-9);
+  cv::Mat depth;
+  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
+  const auto [known_64, at_64] = KnownAndAt(depth, 2.5, 0.05);
+  EXPECT_LT(at_64, 0.01 * 376 * 240);
+  EXPECT_LT(known_64, 0.05 * 376 * 240);  // no wrong depth in its place either
+
+  options.num_disparities = 96;
+  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 96, 1e-9);
+  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
+  const auto [known_96, at_96] = KnownAndAt(depth, 2.5, 0.05);
+  EXPECT_GT(at_96, 0.8 * (376 - 80) * 240);
+  EXPECT_GT(at_96, 0.98 * known_96);
+
+  options.num_disparities = 64;
+  options.near_pass = true;
+  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 128, 1e-9);
+  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
+  const auto [known_near, at_near] = KnownAndAt(depth, 2.5, 0.05);
+  EXPECT_GT(at_near, 0.8 * (376 - 80) * 240);
+  EXPECT_GT(at_near, 0.98 * known_near);
+}
+
+// The near pass leaves what the full resolution reaches as it was: the wall 8 m ahead keeps its depth to the pixel.
+TEST(StereoDepth, TheNearPassLeavesDepthWithinTheRangeAlone) {
+  const WallPair pair = Wall();
+  StereoOptions options;
+  std::unique_ptr<StereoDepth> stereo;
+  cv::Mat full, with_near;
+  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &full).ok());
+  options.near_pass = true;
+  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &with_near).ok());
+  EXPECT_EQ(cv::countNonZero(full != with_near), 0);
 }
 
 // A textured wall 8 m ahead, slanted 30 degrees (its disparities vary smoothly, so SGBM's sub-pixel bias

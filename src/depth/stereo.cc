@@ -14,6 +14,8 @@ namespace patrolmap::depth {
 struct MatchBuffers {
   cv::Mat padded_left, padded_right, padded_disparity, flipped_left, flipped_right, right_view, local_max, local_min,
       unknown, shifted_right, second;
+  cv::Mat half_left, half_right, half_disparity;  // StereoOptions::near_pass: the pair at half resolution, ...
+  std::unique_ptr<MatchBuffers> half;             // ... matched with buffers of its own (its sizes differ)
 };
 
 namespace {
@@ -136,6 +138,33 @@ void MatchPair(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& righ
   DropDepthEdges(options.edge_radius_px, options.edge_jump_px, buffers, disparity);
 }
 
+// Where the half-resolution disparity `half` (fixed point, of the pair pyrDown'd), doubled, lies beyond the
+// range of `disparity` (the full resolution's, num_disparities wide), it stands in for it: a surface nearer than
+// the full range reaches, which the full resolution cannot have matched right.
+void TakeNearHalf(const cv::Mat& half, int num_disparities, cv::Mat* disparity) {
+  const int beyond = (num_disparities - 1) * cv::StereoMatcher::DISP_SCALE;
+  for (int y = 0; y < disparity->rows; ++y) {
+    std::int16_t* d = disparity->ptr<std::int16_t>(y);
+    const std::int16_t* h = half.ptr<std::int16_t>(std::min(y / 2, half.rows - 1));
+    for (int x = 0; x < disparity->cols; ++x) {
+      const int doubled = 2 * h[std::min(x / 2, half.cols - 1)];
+      if (doubled >= beyond) d[x] = static_cast<std::int16_t>(doubled);
+    }
+  }
+}
+
+// MatchPair, and with options.near_pass the same at half resolution standing in where it lies beyond the range.
+void MatchRectified(cv::StereoSGBM* matcher, const cv::Mat& left, const cv::Mat& right, const StereoOptions& options,
+                    MatchBuffers* buffers, cv::Mat* disparity) {
+  MatchPair(matcher, left, right, options, buffers, disparity);
+  if (!options.near_pass) return;
+  if (buffers->half == nullptr) buffers->half = std::make_unique<MatchBuffers>();
+  cv::pyrDown(left, buffers->half_left);
+  cv::pyrDown(right, buffers->half_right);
+  MatchPair(matcher, buffers->half_left, buffers->half_right, options, buffers->half.get(), &buffers->half_disparity);
+  TakeNearHalf(buffers->half_disparity, options.num_disparities, disparity);
+}
+
 // Left pinhole grid -> rectified left pixel, and the factor turning a rectified depth into a left one.
 void BackMaps(const CameraIntrinsics& left, const cv::Mat& rotation, const cv::Mat& projection, cv::Mat* map_x,
               cv::Mat* map_y, cv::Mat* scale) {
@@ -161,7 +190,7 @@ void BackMaps(const CameraIntrinsics& left, const cv::Mat& rotation, const cv::M
 void ComputeDisparity(const cv::Mat& left, const cv::Mat& right, const StereoOptions& options, cv::Mat* disparity) {
   cv::Mat fixed_point;
   MatchBuffers buffers;
-  MatchPair(CreateMatcher(options).get(), left, right, options, &buffers, &fixed_point);
+  MatchRectified(CreateMatcher(options).get(), left, right, options, &buffers, &fixed_point);
   fixed_point.convertTo(*disparity, CV_32F, 1.0 / cv::StereoMatcher::DISP_SCALE);
 }
 
@@ -212,6 +241,11 @@ double StereoDepth::DepthWithin(double sigma_m) const {
   return std::sqrt(std::max(0.0, sigma_m) / range_sigma_per_m2_);
 }
 
+double StereoDepth::NearestDepth() const {
+  const int reach = options_.near_pass ? 2 * options_.num_disparities : options_.num_disparities;
+  return std::max(focal_px_ * baseline_m_ / reach, options_.min_range_m);
+}
+
 StereoDepth::~StereoDepth() = default;
 
 Status StereoDepth::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* depth_m) {
@@ -227,7 +261,7 @@ Status StereoDepth::Compute(const cv::Mat& left, const cv::Mat& right, cv::Mat* 
   }
   cv::remap(left, left_rectified_, left_map_x_, left_map_y_, cv::INTER_LINEAR);
   cv::remap(right, right_rectified_, right_map_x_, right_map_y_, cv::INTER_LINEAR);
-  MatchPair(matcher_.get(), left_rectified_, right_rectified_, options_, buffers_.get(), &disparity_);
+  MatchRectified(matcher_.get(), left_rectified_, right_rectified_, options_, buffers_.get(), &disparity_);
   // Rectified depth f * b / d, unknown outside the range (and where no disparity was found).
   rectified_depth_.create(disparity_.size(), CV_32F);
   const double focal_baseline = focal_px_ * baseline_m_ * cv::StereoMatcher::DISP_SCALE;

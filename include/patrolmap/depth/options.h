@@ -37,6 +37,11 @@ struct StereoOptions {
   // their fraction, so their pull is opposite) are averaged; where they disagree by more than
   // max_lr_difference the disparity is left unknown. Costs one more matching per pair. BENCHMARKS.md.
   bool cancel_pixel_locking = false;
+  // The pair is matched a second time at half the resolution with the same disparity range, which reaches half as
+  // near (f * b / (2 num_disparities)) for about a quarter of the cost; where its disparity, doubled, lies beyond
+  // the full resolution's range it stands in for it. Surfaces beside the path nearer than f * b / num_disparities
+  // then get depth. BENCHMARKS.md, "Stereo depth".
+  bool near_pass = false;
   double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]

@@ -48,6 +48,9 @@ class StereoDepth {
   double RangeSigma(double z_m) const { return z_m * z_m * range_sigma_per_m2_; }
   // The depth [m] up to which the range error stays within `sigma_m` (RangeSigma's inverse).
   double DepthWithin(double sigma_m) const;
+  // The nearest depth [m] the disparity range reaches, f * b / num_disparities (half that with near_pass): nearer
+  // surfaces get no depth.
+  double NearestDepth() const;
   double baseline_m() const { return baseline_m_; }
   double focal_px() const { return focal_px_; }
 
