@@ -595,6 +595,39 @@ TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
   }
 }
 
+// A frame both the grid and the object map take (detections at a grid frame's time) is matched once, and both
+// get its depth.
+TEST_F(StereoStreet, AFrameTheGridAndTheObjectMapBothTakeIsMatchedOnce) {
+  std::unique_ptr<io::FrameSource> source;
+  ASSERT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
+  Config config;
+  config.depth.source = depth::DepthSource::kStereo;
+  PatrolRecorder recorder(config, source->info());
+  Frame frame;
+  std::vector<ChangeWork> work;
+  ASSERT_TRUE(source->Next(false, &frame).ok());
+  recorder.Collect(frame, &work);
+  const auto grid =
+      std::find_if(work.begin(), work.end(), [](const ChangeWork& w) { return w.kind == ChangeWork::Kind::kGrid; });
+  ASSERT_NE(grid, work.end());
+  ASSERT_TRUE(grid->pose.has_value());
+  ChangeWork objects = *grid;
+  objects.kind = ChangeWork::Kind::kObjects;
+  ChangeWork later = *grid;  // the next frame's pair: matched again
+  later.timestamp_ns += 1;
+  later.kind = ChangeWork::Kind::kObjects;
+  recorder.Apply(*grid);
+  recorder.Apply(objects);
+  recorder.Apply(later);
+  PatrolRecord record;
+  PatrolRecordStats stats;
+  recorder.Finish(&record, &stats);
+  EXPECT_EQ(stats.depth_frames, 1);
+  EXPECT_EQ(stats.skipped_depth_frames, 0);
+  EXPECT_EQ(stats.stereo_pairs, 2);
+  EXPECT_GT(record.grid.voxels.size(), 100u);
+}
+
 // The evidence grid of the whole log at `path`, from the depth `choice` gives, with `fuse_frames` (stereo only).
 EvidenceGridData GridOfLog(const std::string& path, depth::DepthSource choice, int fuse_frames) {
   std::unique_ptr<io::FrameSource> source;

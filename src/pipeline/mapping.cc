@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 
 #include <spdlog/spdlog.h>
 
@@ -68,8 +69,11 @@ void LogRecord(const FlightResult& flight) {
                  stats.detections, stats.associations ? 1e3 * stats.association_seconds / stats.associations : 0.0);
   }
   if (record.grid.voxel_size > 0) {
-    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s", record.flight,
-                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds);
+    spdlog::info("{}: evidence grid of {} voxels from {} depth frames in {:.1f} s{}", record.flight,
+                 record.grid.voxels.size(), stats.depth_frames, stats.grid_seconds,
+                 stats.stereo_pairs > 0
+                     ? " (" + std::to_string(stats.stereo_pairs) + " stereo pairs matched, with the object map's)"
+                     : std::string());
   }
 }
 

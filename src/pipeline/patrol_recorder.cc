@@ -163,12 +163,22 @@ void PatrolRecorder::CollectRest(std::vector<ChangeWork>* work) {
 }
 
 bool PatrolRecorder::ReadStereoDepth(const ChangeWork& work, cv::Mat* depth) {
+  if (work.timestamp_ns == stereo_depth_ns_) {  // matched already for the grid or the object map
+    stereo_depth_.copyTo(*depth);
+    return true;
+  }
   left_ = work.depth_image.empty() ? cv::imread(work.depth_path, cv::IMREAD_GRAYSCALE) : work.depth_image;
   right_ = work.right_image.empty() ? cv::imread(work.right_path, cv::IMREAD_GRAYSCALE) : work.right_image;
   const std::string& unreadable = left_.empty() ? work.depth_path : work.right_path;
   Status status = left_.empty() || right_.empty() ? Status::DataLoss(unreadable + ": missing or unreadable image")
-                                                  : stereo_->Compute(left_, right_, depth);
-  if (status.ok()) return true;
+                                                  : stereo_->Compute(left_, right_, &stereo_depth_);
+  if (status.ok()) {
+    ++stats_.stereo_pairs;
+    stereo_depth_ns_ = work.timestamp_ns;
+    stereo_depth_.copyTo(*depth);
+    return true;
+  }
+  stereo_depth_ns_ = std::numeric_limits<TimestampNs>::min();
   spdlog::warn("{} and {}: {}; skipped", work.depth_path, work.right_path, status.message());
   ++stats_.skipped_depth_frames;
   depth->release();

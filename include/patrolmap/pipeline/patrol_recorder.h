@@ -8,6 +8,7 @@
 // One thread or two, the record is the same.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -34,6 +35,7 @@ struct PatrolRecordStats {
   double association_seconds = 0.0;
   int depth_frames = 0;
   int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
+  int stereo_pairs = 0;          // pairs matched, for the grid and the object map (once where both take a frame)
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
   long long evicted_voxels = 0;        // the grid's least recently observed voxels, dropped at its memory budget
@@ -119,6 +121,9 @@ class PatrolRecorder {
   std::unique_ptr<depth::DepthFusion> fusion_;  // depth.stereo.fuse_frames; none when 0
   cv::Mat error_scale_;                         // the fused range error's factor at each traced pixel (fusion_)
   cv::Mat left_, right_;
+  // The last stereo depth and its frame's time: a frame the grid and the object map both take is matched once.
+  cv::Mat stereo_depth_;
+  TimestampNs stereo_depth_ns_ = std::numeric_limits<TimestampNs>::min();
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;
   TimestampNs next_grid_ns_;
