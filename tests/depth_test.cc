@@ -236,30 +236,28 @@ TEST(StereoDepth, AWallAtKnownDepthComesOutAtThatDepth) {
 // and with 64 and the near pass at half resolution (1.6 m).
 TEST(StereoDepth, NothingNearerThanTheDisparityRangeReachesIsMatched) {
   const WallPair pair = Wall(80);
+  // Known pixels, and those at the wall's 2.5 m, with `options`, whose nearest depth must be `nearest`.
+  const auto known_and_at_wall = [&pair](const StereoOptions& options, double nearest) {
+    std::unique_ptr<StereoDepth> stereo;
+    cv::Mat depth;
+    EXPECT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
+    EXPECT_NEAR(stereo->NearestDepth(), nearest, 1e-9);
+    EXPECT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
+    return KnownAndAt(depth, 2.5, 0.05);
+  };
   StereoOptions options;
-  std::unique_ptr<StereoDepth> stereo;
-  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
-  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 64, 1e-9);
-  cv::Mat depth;
-  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
-  const auto [known_64, at_64] = KnownAndAt(depth, 2.5, 0.05);
+  const auto [known_64, at_64] = known_and_at_wall(options, 400.0 * 0.5 / 64);
   EXPECT_LT(at_64, 0.01 * 376 * 240);
   EXPECT_LT(known_64, 0.05 * 376 * 240);  // no wrong depth in its place either
 
   options.num_disparities = 96;
-  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
-  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 96, 1e-9);
-  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
-  const auto [known_96, at_96] = KnownAndAt(depth, 2.5, 0.05);
+  const auto [known_96, at_96] = known_and_at_wall(options, 400.0 * 0.5 / 96);
   EXPECT_GT(at_96, 0.8 * (376 - 80) * 240);
   EXPECT_GT(at_96, 0.98 * known_96);
 
   options.num_disparities = 64;
   options.near_pass = true;
-  ASSERT_TRUE(StereoDepth::Create(pair.calibration, options, &stereo).ok());
-  EXPECT_NEAR(stereo->NearestDepth(), 400.0 * 0.5 / 128, 1e-9);
-  ASSERT_TRUE(stereo->Compute(pair.left, pair.right, &depth).ok());
-  const auto [known_near, at_near] = KnownAndAt(depth, 2.5, 0.05);
+  const auto [known_near, at_near] = known_and_at_wall(options, 400.0 * 0.5 / 128);
   EXPECT_GT(at_near, 0.8 * (376 - 80) * 240);
   EXPECT_GT(at_near, 0.98 * known_near);
 }
