@@ -22,11 +22,12 @@ void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, c
   const double marked = std::min(stereo.DepthWithin(grid.max_hit_sigma_m), grid.max_range_m);
   spdlog::info(
       "{}: depth from the stereo pair ({:.2f} m apart, focal length {:.0f} px): nothing nearer than {:.1f} m is "
-      "matched (depth.stereo.num_disparities {}); surfaces are marked within {:.1f} m, where the range error for "
+      "matched (depth.stereo.num_disparities {}{}); surfaces are marked within {:.1f} m, where the range error for "
       "depth.stereo.disparity_sigma_px {} stays within change.grid.max_hit_sigma_m {} m; farther returns only "
       "carve free space",
-      path, stereo.baseline_m(), stereo.focal_px(), stereo.NearestDepth(), config.depth.stereo.num_disparities, marked,
-      config.depth.stereo.disparity_sigma_px, grid.max_hit_sigma_m);
+      path, stereo.baseline_m(), stereo.focal_px(), stereo.NearestDepth(), config.depth.stereo.num_disparities,
+      config.depth.stereo.near_pass ? ", near_pass on" : "", marked, config.depth.stereo.disparity_sigma_px,
+      grid.max_hit_sigma_m);
   if (fusion == nullptr) return;
   const int views = config.depth.stereo.fuse_frames + 1;
   const double fused = std::min(stereo.DepthWithin(grid.max_hit_sigma_m / fusion->ErrorScale(views)), grid.max_range_m);
