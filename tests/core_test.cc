@@ -1,10 +1,12 @@
 #include <filesystem>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/rate_gate.h"
 #include "patrolmap/core/types.h"
 #include "test_util.h"
 
@@ -66,6 +68,47 @@ TEST(Time, SecondsAndNanosecondsRoundTrip) {
   EXPECT_EQ(SecondsToNs(1.5), 1500000000);
   EXPECT_EQ(SecondsToNs(-0.25), -250000000);
   EXPECT_DOUBLE_EQ(NsToSeconds(2500000000), 2.5);
+}
+
+// The frames a gate at `rate_hz` takes from `count` frames at the times `time_of` gives.
+template <typename TimeOf>
+std::vector<int> TakenFrames(double rate_hz, int count, TimeOf time_of) {
+  RateGate gate(rate_hz);
+  std::vector<int> taken;
+  for (int i = 0; i < count; ++i) {
+    if (!gate.Due(time_of(i))) continue;
+    gate.Take(time_of(i));
+    taken.push_back(i);
+  }
+  return taken;
+}
+
+// A 30 Hz log's times are rounded to the nanosecond: 15 Hz takes every second frame (a gate that waits a whole step
+// after the frame taken takes every third), 10 Hz every third, 5 Hz every sixth.
+TEST(RateGate, TakesEveryNthFrameOfARoundedLog) {
+  const auto at_30_hz = [](int i) { return SecondsToNs(i / 30.0); };
+  for (const int every : {1, 2, 3, 6}) {
+    const std::vector<int> taken = TakenFrames(30.0 / every, 300, at_30_hz);
+    ASSERT_EQ(taken.size(), 300u / every) << every;
+    for (std::size_t k = 0; k < taken.size(); ++k) EXPECT_EQ(taken[k], static_cast<int>(k) * every) << every;
+  }
+}
+
+// Jittered times (a 20 Hz camera, +-1.5 ms) keep the rate on average; a frame a little early is taken, a gap starts
+// the schedule again at the next frame, and a frame not used (Due without Take) leaves the schedule as it was.
+TEST(RateGate, KeepsTheRateOfAJitteredLogAndRestartsAfterAGap) {
+  const auto jittered = [](int i) { return SecondsToNs(1.0 + i * 0.05 + ((i * 7) % 3 - 1) * 0.0015); };
+  EXPECT_EQ(TakenFrames(5.0, 400, jittered).size(), 100u);  // 20 s of flight
+  const auto with_gap = [](int i) { return SecondsToNs(i < 10 ? i * 0.05 : 10.0 + i * 0.05); };
+  const std::vector<int> taken = TakenFrames(5.0, 30, with_gap);
+  EXPECT_EQ(taken, (std::vector<int>{0, 4, 8, 10, 14, 18, 22, 26}));
+  RateGate gate(5.0);
+  gate.Take(0);
+  EXPECT_FALSE(gate.Due(SecondsToNs(0.197)));
+  EXPECT_TRUE(gate.Due(SecondsToNs(0.1985)));  // within a hundredth of the step
+  EXPECT_TRUE(gate.Due(SecondsToNs(0.25)));
+  gate.Take(SecondsToNs(0.25));
+  EXPECT_TRUE(gate.Due(SecondsToNs(0.399)));  // the schedule, not the frame taken, sets the next time
 }
 
 }  // namespace

@@ -61,7 +61,7 @@ TEST(Config, EveryKeyRefusesAnOutOfRangeValueNamingIt) {
   KeyKinds kinds;
   Config defaults;
   VisitConfig(&defaults, &kinds);
-  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 145u);  // every numeric key (the rest are switches)
+  EXPECT_EQ(kinds.doubles.size() + kinds.integers.size(), 146u);  // every numeric key (the rest are switches)
   const auto refused = [&](const std::string& key, const std::string& value) {
     testing::WriteText(dir / "bad.yaml", YamlSetting(key, value));
     Config config;
@@ -593,6 +593,36 @@ TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
       EXPECT_EQ(step.right_path.empty(), choice == depth::DepthSource::kImages) << step.depth_path;
     }
   }
+}
+
+// Depth images go to the grid at change.grid.rate_hz; stereo pairs, which cost far more, are matched at
+// depth.stereo.rate_hz, or at the grid's rate when that is lower. One second of the 30 Hz log.
+TEST_F(StereoStreet, EachDepthSourceIsTakenAtItsOwnRate) {
+  const auto grid_frames = [](depth::DepthSource choice, double grid_hz, double stereo_hz) {
+    std::unique_ptr<io::FrameSource> source;
+    EXPECT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
+    Config config;
+    config.depth.source = choice;
+    config.depth.stereo.fuse_frames = 0;
+    config.change.grid.rate_hz = grid_hz;
+    config.depth.stereo.rate_hz = stereo_hz;
+    PatrolRecorder recorder(config, source->info());
+    Frame frame;
+    std::vector<ChangeWork> work;
+    for (int i = 0; i < 30 && source->Next(false, &frame).ok(); ++i) {
+      work.clear();
+      recorder.Collect(frame, &work);
+      for (const ChangeWork& step : work) recorder.Apply(step);
+    }
+    PatrolRecord record;
+    PatrolRecordStats stats;
+    recorder.Finish(&record, &stats);
+    return std::make_pair(stats.depth_frames, stats.stereo_pairs);
+  };
+  EXPECT_EQ(grid_frames(depth::DepthSource::kImages, 15.0, 5.0), std::make_pair(15, 0));
+  EXPECT_EQ(grid_frames(depth::DepthSource::kImages, 10.0, 30.0), std::make_pair(10, 0));
+  EXPECT_EQ(grid_frames(depth::DepthSource::kStereo, 15.0, 5.0), std::make_pair(5, 5));
+  EXPECT_EQ(grid_frames(depth::DepthSource::kStereo, 3.0, 10.0), std::make_pair(3, 3));
 }
 
 // A frame both the grid and the object map take (detections at a grid frame's time) is matched once, and both

@@ -33,6 +33,7 @@ bool StereoOptions::IsValid(std::string* error) const {
       .InRange("depth.stereo.speckle_range", speckle_range, 1, 64)
       .InRange("depth.stereo.edge_radius_px", edge_radius_px, 0, 16)
       .AboveAtMost("depth.stereo.edge_jump_px", edge_jump_px, 0.0, 512.0)
+      .AboveAtMost("depth.stereo.rate_hz", rate_hz, 0.0, 1000.0)
       .AboveAtMost("depth.stereo.min_range_m", min_range_m, 0.0, 1000.0)
       .AboveAtMost("depth.stereo.max_range_m", max_range_m, 0.0, 1000.0)
       .Holds("depth.stereo.max_range_m", max_range_m, max_range_m > min_range_m,

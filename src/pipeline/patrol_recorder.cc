@@ -38,13 +38,12 @@ void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, c
 }  // namespace
 
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
-    : grid_step_ns_(SecondsToNs(1.0 / config.change.grid.rate_hz)),
-      next_view_ns_(std::numeric_limits<TimestampNs>::min()),
+    : next_view_ns_(std::numeric_limits<TimestampNs>::min()),
+      stereo_gate_(std::min(config.depth.stereo.rate_hz, config.change.grid.rate_hz)),
       route_(config.change.route_frames),
       mapper_(config.change.object_map, info.camera.value_or(CameraIntrinsics())),
       grid_(config.change.grid),
-      next_grid_ns_(std::numeric_limits<TimestampNs>::min()) {
-  next_stereo_ns_ = next_grid_ns_;
+      grid_gate_(config.change.grid.rate_hz) {
   base_.flight = info.flight_id;
   base_.timed = info.timed;
   if (info.has_poses) base_.pose_source = info.pose_source;
@@ -100,8 +99,8 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
   if (has_depth_) {
     for (const DepthSample& depth : frame.depth) {
       if (depth.stereo() != use_stereo_) continue;
-      if (use_stereo_ && depth.timestamp_ns < next_stereo_ns_) continue;
-      if (use_stereo_) next_stereo_ns_ = depth.timestamp_ns + grid_step_ns_;
+      if (use_stereo_ && !stereo_gate_.Due(depth.timestamp_ns)) continue;
+      if (use_stereo_) stereo_gate_.Take(depth.timestamp_ns);
       ChangeWork step_work;
       step_work.kind = ChangeWork::Kind::kGrid;
       step_work.timestamp_ns = depth.timestamp_ns;
@@ -220,7 +219,8 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     mapper_.AddFrame(work.detections, *work.pose, depth_, work.image);
     return;
   }
-  if (work.timestamp_ns < next_grid_ns_) return;  // change.grid.rate_hz
+  // Stereo pairs were chosen as they came (Collect), depth images are chosen here.
+  if (!use_stereo_ && !grid_gate_.Due(work.timestamp_ns)) return;
   const auto start = std::chrono::steady_clock::now();
   if (!ReadDepth(work, &depth_)) return;
   if (depth_.cols != base_.camera.width || depth_.rows != base_.camera.height) {
@@ -231,7 +231,7 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
   }
   if (fusion_ != nullptr) fusion_->Fuse(*work.pose, grid_.RayStep(depth_.cols), &depth_, &error_scale_);
   grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0, error_scale_);
-  next_grid_ns_ = work.timestamp_ns + grid_step_ns_;
+  if (!use_stereo_) grid_gate_.Take(work.timestamp_ns);
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

@@ -42,6 +42,9 @@ struct StereoOptions {
   // the full resolution's range it stands in for it. Surfaces beside the path nearer than f * b / num_disparities
   // then get depth. BENCHMARKS.md, "Stereo depth".
   bool near_pass = false;
+  // Stereo pairs matched per second of flight. The grid integrates depth at change.grid.rate_hz, so a pair is matched
+  // at the lower of the two rates: matching costs far more than reading a depth image (BENCHMARKS.md, "Stereo depth").
+  double rate_hz = 5.0;
   double min_range_m = 0.3;  // depths outside [min_range_m, max_range_m] are left unknown
   double max_range_m = 30.0;
   double disparity_sigma_px = 0.5;  // matching noise for RangeSigma [px]

@@ -192,6 +192,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.stereo.full_paths", &depth.stereo.full_paths);
   visitor->Field("depth.stereo.cancel_pixel_locking", &depth.stereo.cancel_pixel_locking);
   visitor->Field("depth.stereo.near_pass", &depth.stereo.near_pass);
+  visitor->Field("depth.stereo.rate_hz", &depth.stereo.rate_hz);
   visitor->Field("depth.stereo.min_range_m", &depth.stereo.min_range_m);
   visitor->Field("depth.stereo.max_range_m", &depth.stereo.max_range_m);
   visitor->Field("depth.stereo.disparity_sigma_px", &depth.stereo.disparity_sigma_px);

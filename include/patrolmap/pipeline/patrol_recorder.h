@@ -19,6 +19,7 @@
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/core/patrol_data.h"
+#include "patrolmap/core/rate_gate.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/depth/fusion.h"
 #include "patrolmap/depth/stereo.h"
@@ -105,7 +106,6 @@ class PatrolRecorder {
                      const std::optional<CameraPoseSample>& pose, const std::optional<Eigen::Vector3d>& gps,
                      bool key_frame, std::vector<ChangeWork>* work);
 
-  TimestampNs grid_step_ns_;  // change.grid.rate_hz
   bool active_ = false;
   bool has_depth_ = false;
   bool use_stereo_ = false;  // depth from the stereo pair, not depth0/
@@ -113,8 +113,9 @@ class PatrolRecorder {
   // Frame thread:
   TimestampNs next_view_ns_;
   std::vector<CameraPoseSample> pending_views_;
-  TimestampNs next_stereo_ns_;  // stereo pairs come with every frame: only those at the grid's rate are work
-  RouteStrip route_;            // Due() and Scale() on the frame thread, the rest on the change thread
+  RateGate stereo_gate_;  // stereo pairs come with every frame: only those at the lower of depth.stereo.rate_hz and
+                          // change.grid.rate_hz are work
+  RouteStrip route_;      // Due() and Scale() on the frame thread, the rest on the change thread
   TimestampNs last_frame_ns_ = 0, frame_spacing_ns_ = 0;
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
@@ -126,7 +127,7 @@ class PatrolRecorder {
   TimestampNs stereo_depth_ns_ = std::numeric_limits<TimestampNs>::min();
   change::ObjectMapper mapper_;
   change::EvidenceGrid grid_;
-  TimestampNs next_grid_ns_;
+  RateGate grid_gate_;  // depth images at change.grid.rate_hz
   cv::Mat depth_;
   PatrolRecordStats stats_;
 };
