@@ -141,7 +141,7 @@ struct EvidenceGridOptions {
   double max_range_m = 20.0;  // rays are traced this far; farther returns count as passes only
   int rays_per_row = 94;      // depth pixels traced per image row (every width/94-th pixel, and
                               // every as many rows): 94 is every 8th pixel at 752 px
-  double rate_hz = 5.0;       // depth frames integrated per second of flight (stereo: see depth.stereo.rate_hz)
+  double rate_hz = 10.0;      // depth frames integrated per second of flight (stereo: see depth.stereo.rate_hz)
   // Uncertain depth (stereo) carves free space only up to this many range errors before a return.
   double free_space_sigmas = 2.0;
   // ... and marks a voxel hit only where its range error is at most this [m] (farther returns carve only).
