@@ -1,5 +1,6 @@
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -496,6 +497,23 @@ TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   EXPECT_EQ(work[2].depth_path, "");
 }
 
+// Records the first `max_frames` frames of the log at `path` with `config`, the frame thread's work applied at once.
+PatrolRecordStats RecordLog(const std::string& path, const Config& config, int max_frames, PatrolRecord* record) {
+  std::unique_ptr<io::FrameSource> source;
+  EXPECT_TRUE(io::OpenLog(path, {}, &source).ok());
+  PatrolRecorder recorder(config, source->info());
+  Frame frame;
+  std::vector<ChangeWork> work;
+  for (int i = 0; i < max_frames && source->Next(false, &frame).ok(); ++i) {
+    work.clear();
+    recorder.Collect(frame, &work);
+    for (const ChangeWork& step : work) recorder.Apply(step);
+  }
+  PatrolRecordStats stats;
+  recorder.Finish(record, &stats);
+  return stats;
+}
+
 // Onboard events: an object the prior patrol did not have is announced once two checks in a row find it, as
 // one whole JSON line.
 // A simulated street flown with a depth camera and a stereo pair 0.5 m wide (logged as EuRoC cam0 + cam1
@@ -599,24 +617,13 @@ TEST_F(StereoStreet, TheGridWorksOnlyOnTheChosenDepth) {
 // depth.stereo.rate_hz, or at the grid's rate when that is lower. One second of the 30 Hz log.
 TEST_F(StereoStreet, EachDepthSourceIsTakenAtItsOwnRate) {
   const auto grid_frames = [](depth::DepthSource choice, double grid_hz, double stereo_hz) {
-    std::unique_ptr<io::FrameSource> source;
-    EXPECT_TRUE(io::OpenLog(*dir_ / "log", {}, &source).ok());
     Config config;
     config.depth.source = choice;
     config.depth.stereo.fuse_frames = 0;
     config.change.grid.rate_hz = grid_hz;
     config.depth.stereo.rate_hz = stereo_hz;
-    PatrolRecorder recorder(config, source->info());
-    Frame frame;
-    std::vector<ChangeWork> work;
-    for (int i = 0; i < 30 && source->Next(false, &frame).ok(); ++i) {
-      work.clear();
-      recorder.Collect(frame, &work);
-      for (const ChangeWork& step : work) recorder.Apply(step);
-    }
     PatrolRecord record;
-    PatrolRecordStats stats;
-    recorder.Finish(&record, &stats);
+    const PatrolRecordStats stats = RecordLog(*dir_ / "log", config, 30, &record);
     return std::make_pair(stats.depth_frames, stats.stereo_pairs);
   };
   EXPECT_EQ(grid_frames(depth::DepthSource::kImages, 15.0, 5.0), std::make_pair(15, 0));
@@ -660,22 +667,11 @@ TEST_F(StereoStreet, AFrameTheGridAndTheObjectMapBothTakeIsMatchedOnce) {
 
 // The evidence grid of the whole log at `path`, from the depth `choice` gives, with `fuse_frames` (stereo only).
 EvidenceGridData GridOfLog(const std::string& path, depth::DepthSource choice, int fuse_frames) {
-  std::unique_ptr<io::FrameSource> source;
-  EXPECT_TRUE(io::OpenLog(path, {}, &source).ok());
   Config config;
   config.depth.source = choice;
   config.depth.stereo.fuse_frames = fuse_frames;
-  PatrolRecorder recorder(config, source->info());
-  Frame frame;
-  std::vector<ChangeWork> work;
-  while (source->Next(false, &frame).ok()) {
-    work.clear();
-    recorder.Collect(frame, &work);
-    for (const ChangeWork& step : work) recorder.Apply(step);
-  }
   PatrolRecord record;
-  PatrolRecordStats stats;
-  recorder.Finish(&record, &stats);
+  RecordLog(path, config, std::numeric_limits<int>::max(), &record);
   return record.grid;
 }
 
