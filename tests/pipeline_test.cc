@@ -468,6 +468,15 @@ TEST(RouteStrip, ThinsIntervalFramesPastItsBudgetAndKeepsKeyFrames) {
   EXPECT_EQ(indices, (std::vector<std::int64_t>{0, 2, 4, 99, 6, 8, 10, 12, 14}));
 }
 
+// A camera whose rate is no divisor of the interval (KITTI's 10.36 Hz) still gives a route frame a second: the
+// interval is a schedule, not a wait after the frame kept (which gave one every 1.036 s, 97 in 100 s).
+TEST(RouteStrip, KeepsAFrameAnIntervalWhateverTheCameraRate) {
+  RouteStrip strip(change::RouteFrameOptions{});
+  int due = 0;
+  for (int i = 0; i * 0.1036 < 100.0; ++i) due += strip.Due(SecondsToNs(i * 0.1036));
+  EXPECT_EQ(due, 100);
+}
+
 TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   io::LogInfo info;
   info.camera = CameraIntrinsics{40.0, 40.0, 31.5, 23.5, 64, 48};

@@ -1,7 +1,6 @@
 #include "patrolmap/pipeline/route_strip.h"
 
 #include <algorithm>
-#include <limits>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -10,17 +9,17 @@ namespace patrolmap::pipeline {
 
 RouteStrip::RouteStrip(const change::RouteFrameOptions& options)
     : options_(options),
-      next_due_ns_(std::numeric_limits<TimestampNs>::min()),
+      gate_(options.interval_s > 0.0 ? 1.0 / options.interval_s : 1.0),
       encode_parameters_{cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality} {}
 
 bool RouteStrip::Due(TimestampNs timestamp_ns) {
-  if (options_.interval_s <= 0.0 || timestamp_ns < next_due_ns_) return false;
-  next_due_ns_ = timestamp_ns + SecondsToNs(options_.interval_s);
+  if (options_.interval_s <= 0.0 || !gate_.Due(timestamp_ns)) return false;
+  gate_.Take(timestamp_ns);
   return true;
 }
 
 bool RouteStrip::DueSoon(TimestampNs last_ns, TimestampNs spacing_ns) const {
-  return options_.interval_s > 0.0 && last_ns + 2 * std::max<TimestampNs>(spacing_ns, 0) >= next_due_ns_;
+  return options_.interval_s > 0.0 && gate_.Due(last_ns + 2 * std::max<TimestampNs>(spacing_ns, 0));
 }
 
 void RouteStrip::Scale(const cv::Mat& image, cv::Mat* scaled) const {

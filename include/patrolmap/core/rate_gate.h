@@ -1,4 +1,5 @@
-// Takes frames at a rate from a stream timed in nanoseconds (depth frames for the evidence grid, stereo pairs).
+// Takes frames at a rate from a stream timed in nanoseconds (depth frames for the evidence grid, stereo pairs, route
+// frames).
 #pragma once
 
 #include "patrolmap/core/types.h"

@@ -16,6 +16,7 @@
 
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/patrol_data.h"
+#include "patrolmap/core/rate_gate.h"
 
 namespace patrolmap::pipeline {
 
@@ -44,7 +45,7 @@ class RouteStrip {
   void Thin();
 
   change::RouteFrameOptions options_;
-  TimestampNs next_due_ns_;  // frame thread
+  RateGate gate_;  // frame thread: one frame every interval_s
   // Change thread:
   std::vector<RouteFrame> frames_;
   std::vector<long long> candidate_;  // per frame: its number among the interval frames; -1 for key frames
