@@ -4,10 +4,10 @@
 
 namespace patrolmap {
 
-RateGate::RateGate(double rate_hz)
-    : step_ns_(std::max<TimestampNs>(1, SecondsToNs(1.0 / rate_hz))), early_ns_(step_ns_ / 100) {}
+RateGate::RateGate(double rate_hz) : step_ns_(std::max<TimestampNs>(1, SecondsToNs(1.0 / rate_hz))) {}
 
-bool RateGate::Due(TimestampNs timestamp_ns) const { return !started_ || timestamp_ns >= next_ns_ - early_ns_; }
+// Up to a hundredth of a step early counts as due.
+bool RateGate::Due(TimestampNs timestamp_ns) const { return !started_ || timestamp_ns >= next_ns_ - step_ns_ / 100; }
 
 void RateGate::Take(TimestampNs timestamp_ns) {
   const bool on_schedule = started_ && timestamp_ns < next_ns_ + step_ns_;

@@ -19,7 +19,6 @@ class RateGate {
 
  private:
   TimestampNs step_ns_;
-  TimestampNs early_ns_;  // a hundredth of the step
   bool started_ = false;
   TimestampNs next_ns_ = 0;
 };
