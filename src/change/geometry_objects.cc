@@ -241,14 +241,33 @@ std::vector<Eigen::Vector3f> Moved(const std::vector<Eigen::Vector3f>& points, c
   return moved;
 }
 
-// The smaller of the two shares of voxels that lie on the other cluster once moved onto it by `rotation`
-// (before -> after) about the centroids.
-double ShapeOverlap(const VoxelCluster& before, const VoxelCluster& after, const Eigen::Matrix3d& rotation,
-                    double tolerance) {
-  const Eigen::Vector3d b = before.Centroid(), a = after.Centroid();
-  const double forward = PairFraction(Moved(before.points, rotation, b, a), after.points, tolerance);
-  const double backward = PairFraction(Moved(after.points, rotation.transpose(), a, b), before.points, tolerance);
-  return std::min(forward, backward);
+// Two clusters and their points indexed for the shape test of a move.
+struct ShapePair {
+  ShapePair(const VoxelCluster& b, const VoxelCluster& a)
+      : before(b), after(a), before_index(b.points), after_index(a.points) {}
+  const VoxelCluster& before;
+  const VoxelCluster& after;
+  const PointIndex before_index, after_index;
+};
+
+// The smaller of the two shares of voxels that lie within `tolerance` of the other cluster once moved onto it by
+// `rotation` (before -> after) about the centroids, the after centroid shifted horizontally by up to `search` each
+// way in steps of `step`: the best shift. A partial view pulls a centroid off the object's centre.
+double ShapeOverlap(const ShapePair& pair, const Eigen::Matrix3d& rotation, double tolerance, double search,
+                    double step) {
+  const Eigen::Vector3d b = pair.before.Centroid(), a = pair.after.Centroid();
+  const int steps = step > 0.0 ? static_cast<int>(std::floor(search / step + 1e-9)) : 0;
+  double best = 0.0;
+  for (int i = -steps; i <= steps; ++i) {
+    for (int j = -steps; j <= steps; ++j) {
+      const Eigen::Vector3d to = a + Eigen::Vector3d(i * step, j * step, 0.0);
+      const double forward = pair.after_index.PairFraction(Moved(pair.before.points, rotation, b, to), tolerance);
+      const double backward =
+          pair.before_index.PairFraction(Moved(pair.after.points, rotation.transpose(), to, b), tolerance);
+      best = std::max(best, std::min(forward, backward));
+    }
+  }
+  return best;
 }
 
 struct MoveCandidate {
@@ -257,9 +276,10 @@ struct MoveCandidate {
   Eigen::Matrix3d rotation;
 };
 
-// Whether appeared cluster `after` may be vanished cluster `before` moved; fills the candidate's cost.
-bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, const GeometryObjectOptions& options,
-                  MoveCandidate* candidate) {
+// Whether appeared cluster `after` may be vanished cluster `before` moved; fills the candidate's cost. The shape
+// test searches shifts in steps of `voxel`.
+bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double voxel,
+                  const GeometryObjectOptions& options, MoveCandidate* candidate) {
   const Eigen::Vector3d shift = after.Centroid() - before.Centroid();
   const double distance = shift.head<2>().norm();
   if (distance > options.max_move_m) return false;
@@ -267,8 +287,11 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, const G
   if (top_difference > std::max(options.max_top_difference_m, options.alike_top_difference_m)) return false;
   // The registration of partial surfaces can flip an axis: keep it only where it fits better than none.
   const Eigen::Matrix3d registered = RegisterRotation(before.points, after.points);
-  const double unrotated = ShapeOverlap(before, after, Eigen::Matrix3d::Identity(), options.shape_tolerance_m);
-  const double rotated = ShapeOverlap(before, after, registered, options.shape_tolerance_m);
+  const ShapePair pair(before, after);
+  const double step = voxel > 0.0 ? voxel : options.shape_tolerance_m;
+  const double unrotated =
+      ShapeOverlap(pair, Eigen::Matrix3d::Identity(), options.shape_tolerance_m, options.shape_search_m, step);
+  const double rotated = ShapeOverlap(pair, registered, options.shape_tolerance_m, options.shape_search_m, step);
   candidate->overlap = std::max(unrotated, rotated);
   candidate->rotation = rotated > unrotated ? registered : Eigen::Matrix3d::Identity();
   if (candidate->overlap < options.min_shape_overlap) return false;
@@ -280,12 +303,13 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, const G
 }
 
 std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
-                                     const std::vector<VoxelCluster>& appeared, const GeometryObjectOptions& options) {
+                                     const std::vector<VoxelCluster>& appeared, double voxel,
+                                     const GeometryObjectOptions& options) {
   std::vector<MoveCandidate> candidates;
   for (std::size_t v = 0; v < vanished.size(); ++v) {
     for (std::size_t a = 0; a < appeared.size(); ++a) {
       MoveCandidate candidate{v, a, 0.0, 0.0, Eigen::Matrix3d::Identity()};
-      if (MayHaveMoved(vanished[v], appeared[a], options, &candidate)) candidates.push_back(candidate);
+      if (MayHaveMoved(vanished[v], appeared[a], voxel, options, &candidate)) candidates.push_back(candidate);
     }
   }
   std::stable_sort(candidates.begin(), candidates.end(),
@@ -364,7 +388,7 @@ std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const Vo
   const std::vector<VoxelCluster> vanished = ObjectClusters(change, false, prior_grid, prior_detected, options);
   const std::vector<VoxelCluster> appeared = ObjectClusters(change, true, current_grid, current_detected, options);
   std::vector<bool> vanished_moved(vanished.size()), appeared_moved(appeared.size());
-  for (const MoveCandidate& move : PairMoves(vanished, appeared, options)) {
+  for (const MoveCandidate& move : PairMoves(vanished, appeared, change.voxel_size, options)) {
     ObjectChange moved = ClassAgnostic(ObjectState::kMoved, &vanished[move.vanished], &appeared[move.appeared]);
     moved.confidence *= move.overlap;
     moved.rotation = move.rotation;

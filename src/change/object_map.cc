@@ -90,19 +90,33 @@ void Absorb(double point_voxel, MapObject* into, const MapObject& from) {
 
 }  // namespace
 
-double PairFraction(const std::vector<Eigen::Vector3f>& query, const std::vector<Eigen::Vector3f>& reference,
-                    double distance) {
-  if (query.empty() || reference.empty()) return 0.0;
-  const PointCloud cloud{&reference};
-  const KdTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+struct PointIndex::Tree {
+  explicit Tree(const std::vector<Eigen::Vector3f>& points)
+      : cloud{&points}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
+  PointCloud cloud;
+  KdTree tree;
+};
+
+PointIndex::PointIndex(const std::vector<Eigen::Vector3f>& points) : tree_(std::make_unique<Tree>(points)) {}
+
+PointIndex::~PointIndex() = default;
+
+double PointIndex::PairFraction(const std::vector<Eigen::Vector3f>& query, double distance) const {
+  if (query.empty() || tree_->cloud.points->empty()) return 0.0;
   const float limit = static_cast<float>(distance * distance);
   int close = 0;
   for (const Eigen::Vector3f& point : query) {
     std::uint32_t index = 0;
     float squared = 0.0f;
-    if (tree.knnSearch(point.data(), 1, &index, &squared) == 1 && squared < limit) ++close;
+    if (tree_->tree.knnSearch(point.data(), 1, &index, &squared) == 1 && squared < limit) ++close;
   }
   return static_cast<double>(close) / static_cast<double>(query.size());
+}
+
+double PairFraction(const std::vector<Eigen::Vector3f>& query, const std::vector<Eigen::Vector3f>& reference,
+                    double distance) {
+  if (query.empty() || reference.empty()) return 0.0;
+  return PointIndex(reference).PairFraction(query, distance);
 }
 
 void VoxelFilter(double voxel, std::vector<Eigen::Vector3f>* points) {

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -78,6 +79,21 @@ class ObjectMapper {
   double association_seconds_ = 0.0;
   int skipped_ = 0;
   int forgotten_ = 0;
+};
+
+// A fixed set of points for nearest-neighbour queries (a k-d tree built once). `points` must outlive it.
+class PointIndex {
+ public:
+  explicit PointIndex(const std::vector<Eigen::Vector3f>& points);
+  ~PointIndex();
+  PointIndex(const PointIndex&) = delete;
+  PointIndex& operator=(const PointIndex&) = delete;
+  // The share of `query` whose nearest neighbour in the set is closer than `distance`; 0 when either is empty.
+  double PairFraction(const std::vector<Eigen::Vector3f>& query, double distance) const;
+
+ private:
+  struct Tree;
+  std::unique_ptr<Tree> tree_;
 };
 
 // Shares of nearest-neighbour pairs closer than `distance`: for each point of

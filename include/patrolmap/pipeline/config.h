@@ -165,6 +165,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.alike_shape_overlap", &change.geometry_objects.alike_shape_overlap);
   visitor->Field("change.geometry_objects.min_shape_overlap", &change.geometry_objects.min_shape_overlap);
   visitor->Field("change.geometry_objects.shape_tolerance_m", &change.geometry_objects.shape_tolerance_m);
+  visitor->Field("change.geometry_objects.shape_search_m", &change.geometry_objects.shape_search_m);
   visitor->Field("change.geometry_objects.physical_weight", &change.geometry_objects.physical_weight);
   visitor->Field("change.geometry_objects.shape_weight", &change.geometry_objects.shape_weight);
   visitor->Field("change.geometry_objects.detection_margin_m", &change.geometry_objects.detection_margin_m);
