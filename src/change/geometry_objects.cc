@@ -232,21 +232,19 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
   return clusters;
 }
 
-// `points` rotated by `rotation` about `from` and moved to `to`.
-std::vector<Eigen::Vector3f> Moved(const std::vector<Eigen::Vector3f>& points, const Eigen::Matrix3d& rotation,
-                                   const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-  std::vector<Eigen::Vector3f> moved;
-  moved.reserve(points.size());
-  for (const Eigen::Vector3f& p : points) moved.push_back((rotation * (p.cast<double>() - from) + to).cast<float>());
-  return moved;
-}
-
-// Two clusters and their points indexed for the shape test of a move.
+// Two clusters, their centroids and their points indexed for the shape test of a move.
 struct ShapePair {
-  ShapePair(const VoxelCluster& b, const VoxelCluster& a)
-      : before(b), after(a), before_index(b.points), after_index(a.points) {}
+  ShapePair(const VoxelCluster& b, const VoxelCluster& a, const Eigen::Vector3d& b_centroid,
+            const Eigen::Vector3d& a_centroid)
+      : before(b),
+        after(a),
+        before_centroid(b_centroid),
+        after_centroid(a_centroid),
+        before_index(b.points),
+        after_index(a.points) {}
   const VoxelCluster& before;
   const VoxelCluster& after;
+  const Eigen::Vector3d before_centroid, after_centroid;
   const PointIndex before_index, after_index;
 };
 
@@ -255,16 +253,22 @@ struct ShapePair {
 // way in steps of `step`: the best shift. A partial view pulls a centroid off the object's centre.
 double ShapeOverlap(const ShapePair& pair, const Eigen::Matrix3d& rotation, double tolerance, double search,
                     double step) {
-  const Eigen::Vector3d b = pair.before.Centroid(), a = pair.after.Centroid();
-  const int steps = step > 0.0 ? static_cast<int>(std::floor(search / step + 1e-9)) : 0;
+  const std::vector<Eigen::Vector3f>&before = pair.before.points, &after = pair.after.points;
+  const Eigen::Vector3d& from = pair.before_centroid;
+  std::vector<Eigen::Vector3f> forward(before.size()), backward(after.size());  // reused for every shift
+  const int steps = static_cast<int>(std::floor(search / step + 1e-9));
   double best = 0.0;
   for (int i = -steps; i <= steps; ++i) {
     for (int j = -steps; j <= steps; ++j) {
-      const Eigen::Vector3d to = a + Eigen::Vector3d(i * step, j * step, 0.0);
-      const double forward = pair.after_index.PairFraction(Moved(pair.before.points, rotation, b, to), tolerance);
-      const double backward =
-          pair.before_index.PairFraction(Moved(pair.after.points, rotation.transpose(), to, b), tolerance);
-      best = std::max(best, std::min(forward, backward));
+      const Eigen::Vector3d to = pair.after_centroid + Eigen::Vector3d(i * step, j * step, 0.0);
+      for (std::size_t k = 0; k < before.size(); ++k) {
+        forward[k] = (rotation * (before[k].cast<double>() - from) + to).cast<float>();
+      }
+      for (std::size_t k = 0; k < after.size(); ++k) {
+        backward[k] = (rotation.transpose() * (after[k].cast<double>() - to) + from).cast<float>();
+      }
+      best = std::max(best, std::min(pair.after_index.PairFraction(forward, tolerance),
+                                     pair.before_index.PairFraction(backward, tolerance)));
     }
   }
   return best;
@@ -277,18 +281,20 @@ struct MoveCandidate {
 };
 
 // Whether appeared cluster `after` may be vanished cluster `before` moved; fills the candidate's cost. The shape
-// test searches shifts in steps of `voxel`.
+// test searches shifts in steps of `voxel`, or of half the shape tolerance where that is larger (a finer shift
+// changes little within the tolerance, and a coarser step bounds the search).
 bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double voxel,
                   const GeometryObjectOptions& options, MoveCandidate* candidate) {
-  const Eigen::Vector3d shift = after.Centroid() - before.Centroid();
+  const Eigen::Vector3d before_centroid = before.Centroid(), after_centroid = after.Centroid();
+  const Eigen::Vector3d shift = after_centroid - before_centroid;
   const double distance = shift.head<2>().norm();
   if (distance > options.max_move_m) return false;
   const double top_difference = std::abs(after.box.max().z() - before.box.max().z());
   if (top_difference > std::max(options.max_top_difference_m, options.alike_top_difference_m)) return false;
   // The registration of partial surfaces can flip an axis: keep it only where it fits better than none.
   const Eigen::Matrix3d registered = RegisterRotation(before.points, after.points);
-  const ShapePair pair(before, after);
-  const double step = voxel > 0.0 ? voxel : options.shape_tolerance_m;
+  const ShapePair pair(before, after, before_centroid, after_centroid);
+  const double step = std::max(voxel, options.shape_tolerance_m / 2);
   const double unrotated =
       ShapeOverlap(pair, Eigen::Matrix3d::Identity(), options.shape_tolerance_m, options.shape_search_m, step);
   const double rotated = ShapeOverlap(pair, registered, options.shape_tolerance_m, options.shape_search_m, step);

@@ -102,6 +102,9 @@ void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
       .InRange("change.geometry_objects.min_shape_overlap", g.min_shape_overlap, 0.0, 1.0)
       .AboveAtMost("change.geometry_objects.shape_tolerance_m", g.shape_tolerance_m, 0.0, 100.0)
       .InRange("change.geometry_objects.shape_search_m", g.shape_search_m, 0.0, 10.0)
+      .Holds("change.geometry_objects.shape_search_m", g.shape_search_m, g.shape_search_m <= 10.0 * g.shape_tolerance_m,
+             "must be at most 10 times change.geometry_objects.shape_tolerance_m (the search's steps are at least "
+             "half of it)")
       .InRange("change.geometry_objects.physical_weight", g.physical_weight, 0.0, 1000.0)
       .InRange("change.geometry_objects.shape_weight", g.shape_weight, 0.0, 1000.0)
       .InRange("change.geometry_objects.detection_margin_m", g.detection_margin_m, 0.0, 100.0);

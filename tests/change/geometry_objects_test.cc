@@ -181,6 +181,19 @@ TEST(GeometryObjects, AMoveSeenFromEachEndIsFoundBySearchingTheShift) {
   EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
 }
 
+// A search of more than ten shape tolerances each way is refused, naming the key: its steps are at least half a
+// tolerance, so this bounds the shifts tried.
+TEST(GeometryObjects, AShiftSearchOfOverTenTolerancesIsRefused) {
+  ChangeOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.geometry_objects.shape_search_m = 3.5;  // the tolerance is 0.3 m
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("change.geometry_objects.shape_search_m = 3.5"), std::string::npos) << error;
+  options.geometry_objects.shape_tolerance_m = 0.4;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+}
+
 // A crate's near side and its top, seen apart (two voxels between them): one object, not two.
 TEST(GeometryObjects, ClustersStackedInOneFootprintAreOneObject) {
   std::vector<Eigen::Vector3i> appeared;

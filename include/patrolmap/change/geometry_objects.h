@@ -9,14 +9,13 @@
 // object: appeared, it is new; vanished, it was removed. A vanished and an appeared cluster are one object moved when
 // they lie within max_move_m, their tops differ by at most max_top_difference_m (alike_top_difference_m where the
 // overlap below is at least alike_shape_overlap) and each, registered onto the other (centroids aligned, then the
-// best horizontal shift of up to shape_search_m each way in steps of a voxel, since a partial view pulls a centroid
-// off the object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its voxels within
-// shape_tolerance_m of the other's; pairs are taken greedily by paper 003's weighted distance (physical_weight x
-// distance / max_move_m + shape_weight x (1 - overlap)). Unchanged space never makes an object, so these objects are
-// never persistent or unobserved.
-// Detections (objects0/) take precedence: a cluster whose box, grown by detection_margin_m, holds the centroid of an
-// object its patrol's detector mapped, or at least half of whose voxels lie in that object's box grown by
-// detection_margin_m, is left to the detected objects' states.
+// best horizontal shift of up to shape_search_m each way in steps of a voxel or half shape_tolerance_m, since a partial
+// view pulls a centroid off the object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its
+// voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper 003's weighted distance
+// (physical_weight x distance / max_move_m + shape_weight x (1 - overlap)). Unchanged space never makes an object, so
+// these objects are never persistent or unobserved. Detections (objects0/) take precedence: a cluster whose box, grown
+// by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at least half of whose voxels
+// lie in that object's box grown by detection_margin_m, is left to the detected objects' states.
 #pragma once
 
 #include <vector>

@@ -120,8 +120,9 @@ struct GeometryObjectOptions {
   double min_shape_overlap = 0.5;      // ... and each of which, moved onto the other by the registration, has at
   double shape_tolerance_m = 0.3;      // least this share of its voxels within this distance of the other's [m]
   double shape_search_m = 0.6;         // ... at the best horizontal shift of up to this each way, in steps of a
-                                       // voxel, from centroid onto centroid (a partial view pulls a centroid off the
-                                       // object's centre) [m]; 0 = centroids only
+                                       // voxel (at least shape_tolerance_m / 2), from centroid onto centroid (a
+                                       // partial view pulls a centroid off the object's centre) [m]; 0 = centroids
+                                       // only; at most 10 x shape_tolerance_m
   double physical_weight = 0.6;        // alpha of paper 003's weighted distance (physical, normalised)
   double shape_weight = 0.4;           // beta (1 - the shape overlap)
   double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol,
