@@ -279,7 +279,8 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
 }
 
 AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
-                                   const Registration& registration, const AppearanceOptions& options) {
+                                   const Registration& registration, const AppearanceOptions& options,
+                                   const cv::Mat& also_changed) {
   AppearanceChange result;
   const std::vector<cv::DMatch>& matches = registration.matches;
   result.matches = static_cast<int>(matches.size());
@@ -316,6 +317,7 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
     cv::Mat(cv::min(local, other_local)).copyTo(local, plane_mask);
   }
   cv::Mat changed = (global > options.min_difference) & (local > options.min_structure_change) & mask;
+  if (!also_changed.empty()) changed |= also_changed & mask;
   cv::morphologyEx(changed, changed, cv::MORPH_CLOSE, cv::Mat(), cv::Point(-1, -1), options.closing_px);
   cv::morphologyEx(changed, changed, cv::MORPH_OPEN, cv::Mat());
   changed &= mask;

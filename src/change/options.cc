@@ -122,7 +122,18 @@ void CheckRoute(const RouteCompareOptions& r, OptionCheck* check) {
       .InRange("change.route.max_features", r.max_features, 16, 100000)
       .InRange("change.route.max_candidates", r.max_candidates, 1, 1000)
       .InRange("change.route.min_votes", r.min_votes, 1, 1000)
-      .InRange("change.route.min_overlap", r.min_overlap, 0.0, 1.0);
+      .InRange("change.route.min_overlap", r.min_overlap, 0.0, 1.0)
+      .InRange("change.route.depth.min_baseline_m", r.depth.min_baseline_m, 0.0, 1000.0)
+      .InRange("change.route.depth.min_sideways_share", r.depth.min_sideways_share, 0.0, 1.0)
+      .InRange("change.route.depth.num_disparities", r.depth.num_disparities, 16, 1024)
+      .Holds("change.route.depth.num_disparities", r.depth.num_disparities, r.depth.num_disparities % 16 == 0,
+             "must be a multiple of 16")
+      .InRange("change.route.depth.block_size", r.depth.block_size, 1, 31)
+      .Holds("change.route.depth.block_size", r.depth.block_size, r.depth.block_size % 2 == 1, "must be odd")
+      .AboveAtMost("change.route.depth.disparity_sigma_px", r.depth.disparity_sigma_px, 0.0, 100.0)
+      .AboveAtMost("change.route.depth.max_range_m", r.depth.max_range_m, 0.0, 10000.0)
+      .AboveAtMost("change.route.depth.min_change_m", r.depth.min_change_m, 0.0, 1000.0)
+      .InRange("change.route.depth.sigmas", r.depth.sigmas, 0.0, 100.0);
 }
 
 }  // namespace

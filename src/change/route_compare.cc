@@ -13,6 +13,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "patrolmap/change/route_depth.h"
+
 namespace patrolmap::change {
 namespace {
 
@@ -147,11 +149,14 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
   const auto& [registration, prior] = alignment.registered[0];
   pair.prior = prior;
   pair.current = alignment.current;
-  pair.appearance = CompareRegistered(prior_views[prior], current_views[pair.current], registration, appearance);
+  const KeyFrameView& current = current_views[pair.current];
+  const cv::Mat marks = VisibilityChange(prior_views[prior], current, options.depth);
+  pair.appearance = CompareRegistered(prior_views[prior], current, registration, appearance, marks);
   if (alignment.registered.size() > 1 && !pair.appearance.regions.empty()) {
     const auto& [second_registration, second_prior] = alignment.registered[1];
     const AppearanceChange second =
-        CompareRegistered(prior_views[second_prior], current_views[pair.current], second_registration, appearance);
+        CompareRegistered(prior_views[second_prior], current, second_registration, appearance,
+                          VisibilityChange(prior_views[second_prior], current, options.depth));
     if (second.registered) {
       KeepSeenFromBoth(second, prior_views[second_prior].image.size(), options.min_overlap, &pair.appearance);
     }
@@ -246,6 +251,32 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
   return changes;
 }
 
+// Gives each route frame with a pose depth from the frames with poses before and after it, each matched with it as a
+// stereo pair (route_depth.h). Each frame's depth is its own: the same whatever the threads.
+void AddRouteDepth(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats,
+                   const CameraIntrinsics& camera, const RouteDepthOptions& options, std::vector<KeyFrameView>* views) {
+  std::vector<int> usable;
+  for (std::size_t k = 0; k < route.size(); ++k) {
+    if (!repeats[k] && route[k].pose && !(*views)[k].image.empty()) usable.push_back(static_cast<int>(k));
+  }
+  if (usable.size() < 2 || !camera.valid()) return;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(usable.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const int k = usable[i];
+      std::vector<RouteNeighbour> neighbours;
+      for (const int j : {i - 1, i + 1}) {
+        if (j < 0 || j >= static_cast<int>(usable.size())) continue;
+        neighbours.push_back({(*views)[usable[j]].image, *route[usable[j]].pose});
+      }
+      KeyFrameView& view = (*views)[k];
+      CameraIntrinsics scaled = camera.Scaled(static_cast<double>(view.image.cols) / camera.width);
+      scaled.width = view.image.cols;
+      scaled.height = view.image.rows;
+      AddMotionDepth(neighbours, scaled, *route[k].pose, options, &view);
+    }
+  });
+}
+
 }  // namespace
 
 void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
@@ -280,7 +311,7 @@ KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features) {
 
 RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
-                              const AppearanceOptions& appearance) {
+                              const AppearanceOptions& appearance, const RouteCameras& cameras) {
   RouteComparison comparison;
   const std::vector<bool> prior_repeats = Repeats(prior), current_repeats = Repeats(current);
   comparison.current_frames = static_cast<int>(std::count(current_repeats.begin(), current_repeats.end(), false));
@@ -302,6 +333,10 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
       }
     }
   });
+  if (options.depth.enabled && cameras.poses_comparable) {
+    AddRouteDepth(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
+    AddRouteDepth(current, current_repeats, cameras.current, options.depth, &current_views);
+  }
   std::vector<Alignment> alignments;
   for (std::size_t c = 0; c < current.size(); ++c) {  // in order: each predicts the next one's partner
     if (current_repeats[c]) continue;

@@ -14,6 +14,13 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Route frames get depth only from poses both patrols place in one world frame: a GPS fix's bias (metres) would
+// put one patrol's surfaces where the other saw through.
+change::RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& current) {
+  const auto comparable = [](const std::string& source) { return !source.empty() && source != kPosesFromGps; };
+  return {prior.camera, current.camera, comparable(prior.pose_source) && comparable(current.pose_source)};
+}
+
 }  // namespace
 
 Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const std::string& current,
@@ -41,7 +48,10 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     if (map.node(a).flight != prior || map.node(b).flight != current) continue;
     const auto view = [&map](int node, const PatrolRecord* record) {
       const graph::NodeData& n = map.node(node);
-      change::KeyFrameView v{n.thumbnail, n.points, n.descriptors, 1.0};
+      change::KeyFrameView v;
+      v.image = n.thumbnail;
+      v.points = n.points;
+      v.descriptors = n.descriptors;
       if (record != nullptr && record->feature_image_width > 0 && !n.thumbnail.empty()) {
         v.feature_scale = static_cast<double>(record->feature_image_width) / n.thumbnail.cols;
       }
@@ -57,8 +67,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     report->places.push_back(std::move(place));
   }
   if (along_route) {
-    report->route =
-        change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route, options.appearance);
+    report->route = change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route,
+                                          options.appearance, RouteCamerasOf(*prior_record, *current_record));
   }
   report->seconds_appearance = SecondsSince(start);
   if (prior_record == nullptr || current_record == nullptr) return Status::Ok();

@@ -43,7 +43,10 @@ bool Reported(change::ObjectState state) {
 // The key frame of a node as the appearance comparison needs it (as pipeline::CompareFlights builds it).
 change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::Point2f> points, cv::Mat descriptors,
                             int feature_width) {
-  change::KeyFrameView view{thumbnail, std::move(points), std::move(descriptors), 1.0};
+  change::KeyFrameView view;
+  view.image = thumbnail;
+  view.points = std::move(points);
+  view.descriptors = std::move(descriptors);
   if (feature_width > 0 && !thumbnail.empty()) view.feature_scale = static_cast<double>(feature_width) / thumbnail.cols;
   return view;
 }

@@ -18,6 +18,7 @@
 #include <opencv2/core/types.hpp>
 
 #include "patrolmap/change/options.h"
+#include "patrolmap/core/types.h"
 
 namespace patrolmap::change {
 
@@ -29,6 +30,12 @@ struct KeyFrameView {
   std::vector<cv::Point2f> points;  // feature positions
   cv::Mat descriptors;              // float, 8-bit or packed 4-bit rows (vocab/descriptors.h)
   double feature_scale = 1.0;
+  // Route frames only, when their depth is known (route_depth.h): depth [m] on the image's grid (CV_32F, 0 =
+  // unknown), the camera at the image's size and its pose, and the range error per squared metre of depth.
+  cv::Mat depth;
+  CameraIntrinsics camera;
+  CameraPoseSample pose;
+  double range_sigma_per_m2 = 0.0;
 };
 
 struct AppearanceRegion {
@@ -85,9 +92,12 @@ struct Registration {
 };
 Registration Register(const KeyFrameView& prior, const KeyFrameView& current, const AppearanceOptions& options);
 
-// The changed regions of a registered pair (none when it has fewer than min_inliers inliers).
+// The changed regions of a registered pair (none when it has fewer than min_inliers inliers). `also_changed`
+// (CV_8U on the current image, 255 = changed; may be empty) holds pixels known changed by other means (the
+// visibility test of route_depth.h): they join the changed pixels before regions form.
 AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
-                                   const Registration& registration, const AppearanceOptions& options);
+                                   const Registration& registration, const AppearanceOptions& options,
+                                   const cv::Mat& also_changed = cv::Mat());
 
 // Register, then CompareRegistered.
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,

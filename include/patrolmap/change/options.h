@@ -45,6 +45,23 @@ struct AppearanceOptions {
 
 // Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
 // prior patrol's, and voting over consecutive aligned pairs.
+// Depth along the route (route_depth.h): each route frame with a pose is matched against the next frame its own
+// patrol kept (motion stereo: one flight, so one light), and a compared pair's pixels also count as changed where one
+// patrol's surface lies in the space the other patrol saw through.
+struct RouteDepthOptions {
+  bool enabled = true;              // needs poses both patrols place in one world frame (not GPS fixes)
+  double min_baseline_m = 0.3;      // frames closer together than this give no depth [m]
+  double min_sideways_share = 0.7;  // ... nor frames whose baseline runs less than this share across the optical axis
+  int num_disparities = 128;        // disparity search range [px], a multiple of 16
+  int block_size = 5;               // matched block side [px], odd
+  double disparity_sigma_px = 1.0;  // matching noise: the range error is z^2 * this / (f * baseline)
+  double max_range_m = 30.0;        // depths beyond this are left unknown [m]
+  // A surface counts as gone (or new) where the other patrol's depth along the ray lies beyond it by more than
+  // this, and by more than sigmas times the two range errors.
+  double min_change_m = 0.5;
+  double sigmas = 3.0;
+};
+
 struct RouteCompareOptions {
   bool enabled = true;           // false: only the key frames of the places both patrols saw are compared
   double search_window_s = 4.0;  // a frame's partner is searched this far either side of its predicted time [s]
@@ -52,6 +69,7 @@ struct RouteCompareOptions {
   int max_candidates = 6;        // prior frames registered per current frame: those most alike in a thumbnail
   int min_votes = 2;             // consecutive aligned pairs that must agree on a region for it to be reported
   double min_overlap = 0.3;      // agreeing regions overlap by this share of the smaller box
+  RouteDepthOptions depth;
 };
 
 // Object map of one patrol (paper 000, with the 2D fallback of paper 001).

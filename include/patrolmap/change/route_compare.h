@@ -64,11 +64,19 @@ struct RouteComparison {
 void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
                       AppearanceChange* change);
 
+// The cameras of the two patrols' route frames (PatrolRecord::camera, at the log's resolution), and whether the two
+// patrols' poses lie in one world frame. With change.route.depth on and such poses, each route frame with a pose
+// gets depth from the next frame of its patrol (route_depth.h), and each compared pair is also tested by visibility.
+struct RouteCameras {
+  CameraIntrinsics prior, current;
+  bool poses_comparable = false;
+};
+
 // The route frame decoded (grey), with its SIFT features; feature_scale 1.
 KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features);
 
 RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
-                              const AppearanceOptions& appearance);
+                              const AppearanceOptions& appearance, const RouteCameras& cameras = RouteCameras());
 
 }  // namespace patrolmap::change

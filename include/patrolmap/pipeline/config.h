@@ -179,6 +179,15 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.max_candidates", &change.route.max_candidates);
   visitor->Field("change.route.min_votes", &change.route.min_votes);
   visitor->Field("change.route.min_overlap", &change.route.min_overlap);
+  visitor->Field("change.route.depth.enabled", &change.route.depth.enabled);
+  visitor->Field("change.route.depth.min_baseline_m", &change.route.depth.min_baseline_m);
+  visitor->Field("change.route.depth.min_sideways_share", &change.route.depth.min_sideways_share);
+  visitor->Field("change.route.depth.num_disparities", &change.route.depth.num_disparities);
+  visitor->Field("change.route.depth.block_size", &change.route.depth.block_size);
+  visitor->Field("change.route.depth.disparity_sigma_px", &change.route.depth.disparity_sigma_px);
+  visitor->Field("change.route.depth.max_range_m", &change.route.depth.max_range_m);
+  visitor->Field("change.route.depth.min_change_m", &change.route.depth.min_change_m);
+  visitor->Field("change.route.depth.sigmas", &change.route.depth.sigmas);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);

@@ -1,0 +1,39 @@
+// Depth along the route (issue 15): a route frame with a pose gets depth by semi-global matching against another
+// frame of its own patrol (motion stereo; depth::StereoDepth with the pair's relative pose as its calibration).
+// Both frames come from one flight, so they share the light, and depth tells what brightness cannot: a small face
+// lit otherwise from a small object.
+//
+// Two patrols' frames with depth are then compared by visibility: a current surface that the prior camera saw
+// through (its depth along that ray lies well beyond the surface) is new, and a prior surface the current camera
+// sees through is gone. Both need the two patrols' poses in one world frame.
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "patrolmap/change/appearance.h"
+#include "patrolmap/change/options.h"
+#include "patrolmap/core/types.h"
+
+namespace patrolmap::change {
+
+// Another frame of the same patrol, matched against a route frame for its depth.
+struct RouteNeighbour {
+  cv::Mat image;  // grey, the route frame's size
+  CameraPoseSample pose;
+};
+
+// Gives `view` (a route frame decoded, of camera `camera` at its own size, seen from `pose`) depth from its
+// neighbours: each one standing far enough, across the optical axis (RouteDepthOptions), is matched as a stereo pair.
+// Where two give depth they must agree within the matching's range errors (repeated texture, a brick wall, matches
+// a wrong period at a depth that depends on the baseline) and are averaged; elsewhere the one depth is kept. False,
+// and `view` left without depth, when no neighbour gives any.
+bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraIntrinsics& camera,
+                    const CameraPoseSample& pose, const RouteDepthOptions& options, KeyFrameView* view);
+
+// The pixels of `current` (CV_8U, 255 = changed) where one patrol's surface stands in the space the other patrol
+// saw through; empty when either view has no depth.
+cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current, const RouteDepthOptions& options);
+
+}  // namespace patrolmap::change

@@ -1,0 +1,155 @@
+#include "patrolmap/change/route_depth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/depth/stereo.h"
+
+namespace patrolmap::change {
+namespace {
+
+depth::StereoOptions MatchingOptions(const RouteDepthOptions& options) {
+  depth::StereoOptions stereo;
+  stereo.num_disparities = options.num_disparities;
+  stereo.block_size = options.block_size;
+  stereo.disparity_sigma_px = options.disparity_sigma_px;
+  stereo.max_range_m = options.max_range_m;
+  return stereo;
+}
+
+// The depth image with each pixel the least depth around it (one pixel each way), and unknown (0) wherever a pixel
+// around it is unknown: a ray that lands beside a depth edge is compared with the nearer surface.
+cv::Mat NearestAround(const cv::Mat& depth) {
+  cv::Mat nearest;
+  cv::erode(depth, nearest, cv::Mat());
+  return nearest;
+}
+
+// Where `from`'s surfaces lie in space `into` saw through: for each pixel of `from` with depth, its point in
+// `into`'s camera is compared with `into`'s depth there. A hit marks, in `marks` (of the current frame), the
+// pixel of `from` itself (`at_source`) or the pixel of `into` it lands on.
+void MarkSeenThrough(const KeyFrameView& from, const KeyFrameView& into, const cv::Mat& into_nearest,
+                     const RouteDepthOptions& options, bool at_source, cv::Mat* marks) {
+  const Eigen::Matrix3d rotation = (into.pose.rotation.conjugate() * from.pose.rotation).toRotationMatrix();
+  const Eigen::Vector3d translation = into.pose.rotation.conjugate() * (from.pose.position - into.pose.position);
+  const CameraIntrinsics& a = from.camera;
+  const CameraIntrinsics& b = into.camera;
+  for (int v = 0; v < from.depth.rows; ++v) {
+    const float* z = from.depth.ptr<float>(v);
+    for (int u = 0; u < from.depth.cols; ++u) {
+      if (!(z[u] > 0.0f)) continue;
+      const Eigen::Vector3d point(z[u] * (u - a.cx) / a.fx, z[u] * (v - a.cy) / a.fy, z[u]);
+      const Eigen::Vector3d in_into = rotation * point + translation;
+      if (!(in_into.z() > 0.0)) continue;
+      const int ub = static_cast<int>(std::lround(b.fx * in_into.x() / in_into.z() + b.cx));
+      const int vb = static_cast<int>(std::lround(b.fy * in_into.y() / in_into.z() + b.cy));
+      if (ub < 0 || vb < 0 || ub >= into_nearest.cols || vb >= into_nearest.rows) continue;
+      const double seen = into_nearest.at<float>(vb, ub);
+      if (!(seen > 0.0)) continue;
+      const double error = from.range_sigma_per_m2 * z[u] * z[u] + into.range_sigma_per_m2 * seen * seen;
+      const double margin = std::max(options.min_change_m, options.sigmas * error);
+      if (seen <= in_into.z() + margin) continue;
+      if (at_source) {
+        marks->at<std::uint8_t>(v, u) = 255;
+      } else {
+        marks->at<std::uint8_t>(vb, ub) = 255;
+      }
+    }
+  }
+}
+
+// Depth of the frame seen from `pose` by matching it against `other` (seen from `other_pose`); the range error per
+// squared metre into `sigma_per_m2`. Empty when the two stand too close or along the optical axis.
+cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const CameraIntrinsics& camera,
+                  const CameraPoseSample& pose, const RouteDepthOptions& options, double* sigma_per_m2) {
+  const Eigen::Vector3d baseline = pose.ToCamera(other.pose.position);  // the other camera, seen from this one
+  const double length = baseline.norm();
+  if (other.image.size() != image.size() || length < options.min_baseline_m ||
+      std::hypot(baseline.x(), baseline.y()) < options.min_sideways_share * length) {
+    return cv::Mat();
+  }
+  // The other camera must stand to the right; when it stands to the left, both images (and the x axis) are mirrored.
+  const bool mirrored = baseline.x() < 0.0;
+  const Eigen::Matrix3d mirror = Eigen::Vector3d(mirrored ? -1.0 : 1.0, 1.0, 1.0).asDiagonal();
+  StereoCalibration calibration;
+  calibration.left = calibration.right = camera;
+  if (mirrored) calibration.left.cx = calibration.right.cx = camera.width - 1 - camera.cx;
+  const Eigen::Matrix3d rotation = (other.pose.rotation.conjugate() * pose.rotation).toRotationMatrix();
+  calibration.right_from_left_rotation = mirror * rotation * mirror;
+  calibration.right_from_left_translation =
+      mirror * (other.pose.rotation.conjugate() * (pose.position - other.pose.position));
+  std::unique_ptr<depth::StereoDepth> stereo;
+  if (!depth::StereoDepth::Create(calibration, MatchingOptions(options), &stereo).ok()) return cv::Mat();
+  cv::Mat left = image, right = other.image, depth_m;
+  if (mirrored) {  // into new images: `left` and `right` share the callers' pixels
+    left = cv::Mat(), right = cv::Mat();
+    cv::flip(image, left, 1);
+    cv::flip(other.image, right, 1);
+  }
+  if (!stereo->Compute(left, right, &depth_m).ok()) return cv::Mat();
+  if (mirrored) cv::flip(depth_m, depth_m, 1);
+  *sigma_per_m2 = stereo->RangeSigma(1.0);
+  return depth_m;
+}
+
+// `a` and `b` fused into `a`: averaged where both know the depth and agree within `sigmas` range errors (at least
+// min_change_m), unknown where they disagree, and the one depth where only one knows it.
+void Fuse(const cv::Mat& b, double sigma_a, double sigma_b, const RouteDepthOptions& options, cv::Mat* a) {
+  for (int y = 0; y < a->rows; ++y) {
+    float* za = a->ptr<float>(y);
+    const float* zb = b.ptr<float>(y);
+    for (int x = 0; x < a->cols; ++x) {
+      if (!(zb[x] > 0.0f)) continue;
+      if (!(za[x] > 0.0f)) {
+        za[x] = zb[x];
+        continue;
+      }
+      const double error = sigma_a * za[x] * za[x] + sigma_b * zb[x] * zb[x];
+      const bool agree = std::abs(za[x] - zb[x]) <= std::max(options.min_change_m, options.sigmas * error);
+      za[x] = agree ? 0.5f * (za[x] + zb[x]) : 0.0f;
+    }
+  }
+}
+
+}  // namespace
+
+bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraIntrinsics& camera,
+                    const CameraPoseSample& pose, const RouteDepthOptions& options, KeyFrameView* view) {
+  if (view->image.empty() || !camera.valid() || camera.width != view->image.cols || camera.height != view->image.rows) {
+    return false;
+  }
+  cv::Mat fused;
+  double fused_sigma = 0.0;
+  for (const RouteNeighbour& other : neighbours) {
+    double sigma = 0.0;
+    const cv::Mat depth_m = PairDepth(view->image, other, camera, pose, options, &sigma);
+    if (depth_m.empty()) continue;
+    if (fused.empty()) {
+      fused = depth_m, fused_sigma = sigma;
+    } else {
+      Fuse(depth_m, fused_sigma, sigma, options, &fused);
+      fused_sigma = std::max(fused_sigma, sigma);
+    }
+  }
+  if (fused.empty()) return false;
+  view->depth = fused;
+  view->camera = camera;
+  view->pose = pose;
+  view->range_sigma_per_m2 = fused_sigma;
+  return true;
+}
+
+cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current, const RouteDepthOptions& options) {
+  if (prior.depth.empty() || current.depth.empty()) return cv::Mat();
+  cv::Mat marks = cv::Mat::zeros(current.depth.size(), CV_8U);
+  MarkSeenThrough(current, prior, NearestAround(prior.depth), options, true, &marks);     // new surfaces
+  MarkSeenThrough(prior, current, NearestAround(current.depth), options, false, &marks);  // surfaces gone
+  return marks;
+}
+
+}  // namespace patrolmap::change

@@ -1,0 +1,189 @@
+// Depth along the route (route_depth.h): motion stereo between route frames of one patrol, and the visibility test
+// between two patrols' frames with depth.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "patrolmap/change/route_depth.h"
+
+namespace patrolmap::change {
+namespace {
+
+constexpr int kWidth = 376, kHeight = 240;
+
+CameraIntrinsics Camera() {
+  CameraIntrinsics camera;
+  camera.fx = camera.fy = 230.0;
+  camera.cx = 176.0, camera.cy = 119.5;  // off centre: a mirrored camera differs
+  camera.width = kWidth, camera.height = kHeight;
+  return camera;
+}
+
+// A textured wall seen face on.
+cv::Mat Wall() {
+  cv::Mat wall(kHeight + 100, kWidth + 300, CV_8UC1, cv::Scalar(120));
+  cv::RNG rng(5);
+  for (int i = 0; i < 2500; ++i) {
+    const cv::Point a(rng.uniform(0, wall.cols), rng.uniform(0, wall.rows));
+    cv::rectangle(wall, a, a + cv::Point(rng.uniform(2, 9), rng.uniform(2, 9)), cv::Scalar(rng.uniform(0, 255)),
+                  cv::FILLED);
+  }
+  return wall;
+}
+
+// A camera at (x, 0, z), turned by `yaw` [rad] about its y axis (world axes = the first camera's).
+CameraPoseSample At(double x, double z = 0.0, double yaw = 0.0) {
+  CameraPoseSample pose;
+  pose.position = Eigen::Vector3d(x, 0.0, z);
+  pose.rotation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY());
+  return pose;
+}
+
+constexpr double kWallPxPerM = 230.0 / 8.0;  // the wall's texture: pixels per metre
+
+// The wall, a plane at z = `distance_m` whose texture centre lies on the world's z axis, seen from `pose`.
+cv::Mat View(const cv::Mat& wall, double distance_m, const CameraPoseSample& pose) {
+  const CameraIntrinsics c = Camera();
+  Eigen::Matrix3d k;
+  k << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1;
+  Eigen::Matrix3d on_plane;  // texture pixel -> (X, Y, 1) on the plane
+  on_plane << 1 / kWallPxPerM, 0, -0.5 * wall.cols / kWallPxPerM, 0, 1 / kWallPxPerM, -0.5 * wall.rows / kWallPxPerM, 0,
+      0, 1;
+  Eigen::Matrix3d to_camera;  // (X, Y, 1) -> the point relative to the camera, in world axes
+  to_camera << 1, 0, -pose.position.x(), 0, 1, -pose.position.y(), 0, 0, distance_m - pose.position.z();
+  const Eigen::Matrix3d h = k * pose.rotation.conjugate().toRotationMatrix() * to_camera * on_plane;
+  cv::Mat homography(3, 3, CV_64F), view;
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) homography.at<double>(r, col) = h(r, col);
+  cv::warpPerspective(wall, view, homography, cv::Size(c.width, c.height), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  return view;
+}
+cv::Mat View(const cv::Mat& wall, double distance_m, double x_m) { return View(wall, distance_m, At(x_m)); }
+
+double MedianDepth(const cv::Mat& depth, int* known) {
+  std::vector<float> values;
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x)
+      if (depth.at<float>(y, x) > 0.0f) values.push_back(depth.at<float>(y, x));
+  *known = static_cast<int>(values.size());
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+TEST(RouteDepth, NeighboursEitherSideGiveTheWallsDistanceAndLeaveTheImagesAlone) {
+  const cv::Mat wall = Wall();
+  const double distance = 8.0, step = 1.6;  // 46 px of disparity
+  const cv::Mat before = View(wall, distance, -step), here = View(wall, distance, 0.0),
+                after = View(wall, distance, step);
+  const cv::Mat here_copy = here.clone(), before_copy = before.clone();
+  for (const std::vector<RouteNeighbour>& neighbours :
+       {std::vector<RouteNeighbour>{{after, At(step)}}, std::vector<RouteNeighbour>{{before, At(-step)}},
+        std::vector<RouteNeighbour>{{before, At(-step)}, {after, At(step)}}}) {
+    KeyFrameView view;
+    view.image = here;
+    ASSERT_TRUE(AddMotionDepth(neighbours, Camera(), At(0.0), RouteDepthOptions{}, &view));
+    int known = 0;
+    EXPECT_NEAR(MedianDepth(view.depth, &known), distance, 0.02 * distance);
+    EXPECT_GT(known, kWidth * kHeight / 2) << "neighbours: " << neighbours.size();
+    EXPECT_GT(view.range_sigma_per_m2, 0.0);
+    // A neighbour on the left is matched on mirrored copies, never on the frames themselves.
+    EXPECT_EQ(cv::norm(here, here_copy, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(before, before_copy, cv::NORM_INF), 0.0);
+  }
+}
+
+TEST(RouteDepth, ANeighbourTurnedAwayIsRectifiedFirst) {
+  const cv::Mat wall = Wall();
+  const double distance = 8.0, step = 1.6, yaw = 0.25;  // 14 degrees, as in a turn
+  for (const double x : {step, -step}) {
+    KeyFrameView view;
+    view.image = View(wall, distance, At(0.0));
+    ASSERT_TRUE(AddMotionDepth({{View(wall, distance, At(x, 0.0, yaw)), At(x, 0.0, yaw)}}, Camera(), At(0.0),
+                               RouteDepthOptions{}, &view));
+    int known = 0;
+    EXPECT_NEAR(MedianDepth(view.depth, &known), distance, 0.02 * distance) << "neighbour at x = " << x;
+    EXPECT_GT(known, kWidth * kHeight / 3);
+  }
+}
+
+TEST(RouteDepth, NeighboursThatDisagreeLeaveTheDepthUnknown) {
+  const cv::Mat wall = Wall();
+  const double distance = 8.0, step = 1.6;
+  KeyFrameView view;
+  view.image = View(wall, distance, 0.0);
+  // The second neighbour's pose says twice the baseline its image was seen from: its depths are twice too far.
+  const RouteNeighbour before{View(wall, distance, -step), At(-step)}, wrong{View(wall, distance, step), At(2 * step)};
+  ASSERT_TRUE(AddMotionDepth({before, wrong}, Camera(), At(0.0), RouteDepthOptions{}, &view));
+  const cv::Rect middle(120, 40, 120, 160);  // where both neighbours match
+  EXPECT_LT(cv::countNonZero(view.depth(middle)), middle.area() / 20);
+}
+
+TEST(RouteDepth, BothSidesCoverTheBandOneNeighbourCannotMatch) {
+  const cv::Mat wall = Wall();
+  const double distance = 8.0, step = 1.6;
+  KeyFrameView one, both;
+  one.image = both.image = View(wall, distance, 0.0);
+  const RouteNeighbour after{View(wall, distance, step), At(step)}, before{View(wall, distance, -step), At(-step)};
+  ASSERT_TRUE(AddMotionDepth({after}, Camera(), At(0.0), RouteDepthOptions{}, &one));
+  ASSERT_TRUE(AddMotionDepth({before, after}, Camera(), At(0.0), RouteDepthOptions{}, &both));
+  // The left edge of the frame has no match in a neighbour to the right.
+  const cv::Rect left_band(0, 0, 40, kHeight);
+  EXPECT_EQ(cv::countNonZero(one.depth(left_band)), 0);
+  EXPECT_GT(cv::countNonZero(both.depth(left_band)), left_band.area() / 2);
+}
+
+TEST(RouteDepth, NeighboursTooCloseOrAheadGiveNoDepth) {
+  const cv::Mat wall = Wall();
+  KeyFrameView view;
+  view.image = View(wall, 8.0, 0.0);
+  RouteDepthOptions options;
+  EXPECT_FALSE(AddMotionDepth({{View(wall, 8.0, 0.2), At(0.2)}}, Camera(), At(0.0), options, &view));  // 0.2 m
+  EXPECT_FALSE(AddMotionDepth({{view.image, At(0.0, 1.5)}}, Camera(), At(0.0), options, &view));       // ahead
+  EXPECT_TRUE(view.depth.empty());
+  options.min_baseline_m = 0.1;
+  EXPECT_TRUE(AddMotionDepth({{View(wall, 8.0, 0.2), At(0.2)}}, Camera(), At(0.0), options, &view));
+}
+
+// A view of a wall 10 m away, with a box 6 m away over `box` when given.
+KeyFrameView WithDepth(const CameraPoseSample& pose, const cv::Rect& box) {
+  KeyFrameView view;
+  view.image = cv::Mat(kHeight, kWidth, CV_8UC1, cv::Scalar(100));
+  view.depth = cv::Mat(kHeight, kWidth, CV_32F, cv::Scalar(10.0f));
+  if (!box.empty()) view.depth(box).setTo(6.0f);
+  view.camera = Camera();
+  view.pose = pose;
+  view.range_sigma_per_m2 = 1.0 / (230.0 * 1.5);
+  return view;
+}
+
+TEST(RouteDepth, ASurfaceTheOtherPatrolSawThroughIsChangedAndNothingElse) {
+  const cv::Rect box(150, 100, 60, 50);
+  const KeyFrameView empty = WithDepth(At(0.0), cv::Rect()), with_box = WithDepth(At(0.0), box);
+  const cv::Mat inside = cv::Mat::zeros(kHeight, kWidth, CV_8U);
+  for (const auto& [prior, current] : {std::make_pair(&with_box, &empty), std::make_pair(&empty, &with_box)}) {
+    const cv::Mat marks = VisibilityChange(*prior, *current, RouteDepthOptions{});
+    ASSERT_FALSE(marks.empty());
+    EXPECT_GT(cv::countNonZero(marks(box)), box.area() * 9 / 10);
+    EXPECT_EQ(cv::countNonZero(marks) - cv::countNonZero(marks(box)), 0);
+  }
+  EXPECT_EQ(cv::countNonZero(VisibilityChange(with_box, with_box, RouteDepthOptions{})), 0);
+  // A wall 0.3 m farther is within the matching's error: no change.
+  KeyFrameView farther = empty;
+  farther.depth = empty.depth + 0.3;
+  EXPECT_EQ(cv::countNonZero(VisibilityChange(empty, farther, RouteDepthOptions{})), 0);
+  EXPECT_EQ(cv::countNonZero(VisibilityChange(farther, empty, RouteDepthOptions{})), 0);
+  // Seen from 1 m to the side, the box's surface is where it was: no change.
+  const KeyFrameView aside = WithDepth(At(1.0), cv::Rect());
+  EXPECT_EQ(cv::countNonZero(VisibilityChange(aside, empty, RouteDepthOptions{})), 0);
+  KeyFrameView no_depth = empty;
+  no_depth.depth.release();
+  EXPECT_TRUE(VisibilityChange(no_depth, empty, RouteDepthOptions{}).empty());
+}
+
+}  // namespace
+}  // namespace patrolmap::change
