@@ -16,6 +16,7 @@
 #include "patrolmap/change/geometry_objects.h"
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/change/route_compare.h"
+#include "patrolmap/change/route_depth.h"
 #include "patrolmap/sim/objects.h"
 #include "patrolmap/sim/renderer.h"
 #include "patrolmap/sim/village.h"
@@ -206,9 +207,39 @@ RouteFrame RouteFrameAt(double x, const std::vector<sim::WorldObject>& objects, 
                         double seconds) {
   RouteFrame frame;
   frame.timestamp_ns = SecondsToNs(seconds);
-  cv::imencode(".jpg", Render(x, objects, lighting).image, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  const View view = Render(x, objects, lighting);
+  cv::imencode(".jpg", view.image, frame.jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  frame.pose = view.sample;
   return frame;
 }
+
+// Depth of one route frame from the frames 1.3 m before and after it (two stereo matchings): once per frame of
+// either route when change.route.depth is on. Counters: the share of pixels given depth, and of those the share
+// within 5 % of the rendered depth.
+void BM_RouteMotionDepth(benchmark::State& state) {
+  const std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
+  const View here = Render(20.0, objects, {});
+  const View before = Render(18.7, objects, {}), after = Render(21.3, objects, {});
+  const std::vector<change::RouteNeighbour> neighbours = {{before.image, before.sample}, {after.image, after.sample}};
+  change::KeyFrameView view;
+  for (auto _ : state) {
+    view = change::KeyFrameView();
+    view.image = here.image;
+    change::AddMotionDepth(neighbours, kCamera, here.sample, change::RouteDepthOptions{}, &view);
+  }
+  int known = 0, within = 0;
+  for (int y = 0; y < view.depth.rows; ++y) {
+    for (int x = 0; x < view.depth.cols; ++x) {
+      const float z = view.depth.at<float>(y, x), truth = here.depth_m.at<float>(y, x);
+      if (!(z > 0.0f)) continue;
+      ++known;
+      within += std::abs(z - truth) <= 0.05f * truth;
+    }
+  }
+  state.counters["known_share"] = static_cast<double>(known) / view.depth.total();
+  state.counters["within_5_percent"] = known > 0 ? static_cast<double>(within) / known : 0.0;
+}
+BENCHMARK(BM_RouteMotionDepth)->Unit(benchmark::kMillisecond);
 
 // Decoding one route frame and finding its SIFT features: done once per frame of either route.
 void BM_RouteFrameFeatures(benchmark::State& state) {
@@ -251,7 +282,7 @@ void BM_RouteComparedPair(benchmark::State& state) {
 BENCHMARK(BM_RouteComparedPair)->Unit(benchmark::kMillisecond);
 
 // A whole route of 20 frames 1.3 m apart (a 20 s flight at the simulator's speed), aligned with one anchor,
-// compared and voted; per frame = time / 20.
+// compared and voted; per frame = time / 20. Argument: change.route.depth on (1) or off (0).
 void BM_RouteOfTwentyFrames(benchmark::State& state) {
   std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
   const double x0 = objects[SouthObject(objects)].centre.x() - 13.0;
@@ -259,15 +290,17 @@ void BM_RouteOfTwentyFrames(benchmark::State& state) {
   for (int i = 0; i < 20; ++i) prior.push_back(RouteFrameAt(x0 + 1.3 * i, objects, {}, i));
   objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(SouthObject(objects)));
   for (int i = 0; i < 20; ++i) current.push_back(RouteFrameAt(x0 + 0.4 + 1.3 * i, objects, sim::DrawLighting(1, 2), i));
+  change::RouteCompareOptions options;
+  options.depth.enabled = state.range(0) != 0;
   change::RouteComparison comparison;
   for (auto _ : state) {
     comparison =
-        change::CompareRoutes(prior, current, {{0, 0}}, change::RouteCompareOptions{}, change::AppearanceOptions{});
+        change::CompareRoutes(prior, current, {{0, 0}}, options, change::AppearanceOptions{}, {kCamera, kCamera, true});
   }
   state.counters["pairs"] = static_cast<double>(comparison.pairs.size());
   state.counters["changes"] = static_cast<double>(comparison.changes.size());
 }
-BENCHMARK(BM_RouteOfTwentyFrames)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RouteOfTwentyFrames)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
