@@ -194,6 +194,10 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
           << Number(100.0 * report.route.ComparedShare(), 0) << " %), "
           << Counted(static_cast<long long>(report.route.changes.size()), "appearance change", "appearance changes")
           << ".";
+    if (report.route.current_depth_frames > 0) {
+      *html << " Depth from the route's own frames (motion stereo) for " << report.route.current_depth_frames << " of "
+            << Counted(report.route.current_frames, "frame", "frames") << ".";
+    }
   }
   if (report.objects_compared) {
     *html << " Objects: " << report.ObjectsIn(ObjectState::kNew) << " new, " << report.ObjectsIn(ObjectState::kRemoved)

@@ -70,6 +70,8 @@ json RouteJson(const ChangeReport& report, const graph::TopoMap& map, const std:
   return {{"frames", report.route.current_frames},
           {"compared_pairs", report.route.pairs.size()},
           {"compared_share", report.route.ComparedShare()},
+          {"frames_with_depth",
+           {{"prior", report.route.prior_depth_frames}, {"current", report.route.current_depth_frames}}},
           {"changes", changes}};
 }
 

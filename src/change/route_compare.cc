@@ -252,14 +252,15 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
 }
 
 // Gives each route frame with a pose depth from the frames with poses before and after it, each matched with it as a
-// stereo pair (route_depth.h). Each frame's depth is its own: the same whatever the threads.
-void AddRouteDepth(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats,
-                   const CameraIntrinsics& camera, const RouteDepthOptions& options, std::vector<KeyFrameView>* views) {
+// stereo pair (route_depth.h). Each frame's depth is its own: the same whatever the threads. Returns the frames
+// given depth.
+int AddRouteDepth(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats,
+                  const CameraIntrinsics& camera, const RouteDepthOptions& options, std::vector<KeyFrameView>* views) {
   std::vector<int> usable;
   for (std::size_t k = 0; k < route.size(); ++k) {
     if (!repeats[k] && route[k].pose && !(*views)[k].image.empty()) usable.push_back(static_cast<int>(k));
   }
-  if (usable.size() < 2 || !camera.valid()) return;
+  if (usable.size() < 2 || !camera.valid()) return 0;
   cv::parallel_for_(cv::Range(0, static_cast<int>(usable.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const int k = usable[i];
@@ -275,6 +276,8 @@ void AddRouteDepth(const std::vector<RouteFrame>& route, const std::vector<bool>
       AddMotionDepth(neighbours, scaled, *route[k].pose, options, &view);
     }
   });
+  return static_cast<int>(
+      std::count_if(usable.begin(), usable.end(), [&](int k) { return !(*views)[k].depth.empty(); }));
 }
 
 }  // namespace
@@ -334,8 +337,9 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
     }
   });
   if (options.depth.enabled && cameras.poses_comparable) {
-    AddRouteDepth(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
-    AddRouteDepth(current, current_repeats, cameras.current, options.depth, &current_views);
+    comparison.prior_depth_frames = AddRouteDepth(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
+    comparison.current_depth_frames =
+        AddRouteDepth(current, current_repeats, cameras.current, options.depth, &current_views);
   }
   std::vector<Alignment> alignments;
   for (std::size_t c = 0; c < current.size(); ++c) {  // in order: each predicts the next one's partner

@@ -89,6 +89,38 @@ TEST(RouteCompare, EveryFrameIsAlignedAndALightingChangeGivesNoChange) {
   EXPECT_TRUE(comparison.changes.empty());
 }
 
+// The camera flying along the facade as Route shows it: kStepPx of image motion a second is a wall
+// kWallDistanceM away at kStepM a second (f = 230 px).
+constexpr double kStepM = 1.0, kFocalPx = 230.0, kWallDistanceM = kFocalPx * kStepM / kStepPx;
+
+// Route's frames with the poses that fly them (world axes = the camera's), the first at `offset_px`.
+std::vector<RouteFrame> WithPoses(std::vector<RouteFrame> route, int offset_px) {
+  for (std::size_t i = 0; i < route.size(); ++i) {
+    CameraPoseSample pose;
+    pose.timestamp_ns = route[i].timestamp_ns;
+    pose.position.x() = (offset_px + static_cast<double>(i) * kStepPx) * kWallDistanceM / kFocalPx;
+    route[i].pose = pose;
+  }
+  return route;
+}
+
+TEST(RouteCompare, FramesWithPosesGetDepthAndAWallSeenAgainStaysUnchanged) {
+  const cv::Mat facade = Facade(3);
+  const std::vector<RouteFrame> prior = WithPoses(Route(facade, 0, 1.0, 0.0), 0);
+  const std::vector<RouteFrame> current = WithPoses(Route(facade, 12, 0.7, 25.0), 12);
+  const CameraIntrinsics camera{kFocalPx, kFocalPx, 187.5, 119.5, kFrameWidth, kFrameHeight};
+  const RouteComparison comparison =
+      CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{}, {camera, camera, true});
+  EXPECT_EQ(comparison.prior_depth_frames, kFrames);
+  EXPECT_EQ(comparison.current_depth_frames, kFrames);
+  EXPECT_EQ(static_cast<int>(comparison.pairs.size()), kFrames);
+  EXPECT_TRUE(comparison.changes.empty());
+  // Poses the two patrols do not share (GPS fixes) give no depth.
+  const RouteComparison apart =
+      CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{}, {camera, camera, false});
+  EXPECT_EQ(apart.prior_depth_frames + apart.current_depth_frames, 0);
+}
+
 TEST(RouteCompare, AnObjectSeenFromSeveralFramesIsFoundWithTheirVotes) {
   const cv::Mat facade = Facade(4);
   cv::Mat changed = facade.clone();

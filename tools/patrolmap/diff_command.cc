@@ -73,8 +73,8 @@ void PrintChangeSummary(const change::ChangeReport& report, const std::string& o
   std::printf("changes %s -> %s: %zu places compared, %d with appearance changes", report.prior_flight.c_str(),
               report.current_flight.c_str(), report.places.size(), report.ChangedPlaces());
   if (report.route.compared) {
-    std::printf("; route: %zu of %d frames compared, %zu appearance changes", report.route.pairs.size(),
-                report.route.current_frames, report.route.changes.size());
+    std::printf("; route: %zu of %d frames compared (%d with depth), %zu appearance changes", report.route.pairs.size(),
+                report.route.current_frames, report.route.current_depth_frames, report.route.changes.size());
   }
   if (report.objects_compared) {
     std::printf("; objects: %d new, %d removed, %d moved, %d persistent, %d unobserved",

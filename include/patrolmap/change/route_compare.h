@@ -49,8 +49,10 @@ struct RouteChange {
 };
 
 struct RouteComparison {
-  bool compared = false;         // both patrols kept frames along their routes
-  int current_frames = 0;        // frames the current patrol kept
+  bool compared = false;   // both patrols kept frames along their routes
+  int current_frames = 0;  // frames the current patrol kept
+  // Frames given depth from their neighbours (RouteCameras; 0 with change.route.depth off or without poses).
+  int prior_depth_frames = 0, current_depth_frames = 0;
   std::vector<RoutePair> pairs;  // the aligned pairs, in the current route's order
   std::vector<RouteChange> changes;
   // The share of the current route that was aligned and compared.
