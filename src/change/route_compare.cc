@@ -251,33 +251,103 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
   return changes;
 }
 
-// Gives each route frame with a pose depth from the frames with poses before and after it, each matched with it as a
-// stereo pair (route_depth.h). Each frame's depth is its own: the same whatever the threads. Returns the frames
-// given depth.
-int AddRouteDepth(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats,
-                  const CameraIntrinsics& camera, const RouteDepthOptions& options, std::vector<KeyFrameView>* views) {
-  std::vector<int> usable;
-  for (std::size_t k = 0; k < route.size(); ++k) {
-    if (!repeats[k] && route[k].pose && !(*views)[k].image.empty()) usable.push_back(static_cast<int>(k));
-  }
-  if (usable.size() < 2 || !camera.valid()) return 0;
-  cv::parallel_for_(cv::Range(0, static_cast<int>(usable.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) {
-      const int k = usable[i];
-      std::vector<RouteNeighbour> neighbours;
-      for (const int j : {i - 1, i + 1}) {
-        if (j < 0 || j >= static_cast<int>(usable.size())) continue;
-        neighbours.push_back({(*views)[usable[j]].image, *route[usable[j]].pose});
-      }
-      KeyFrameView& view = (*views)[k];
-      CameraIntrinsics scaled = camera.Scaled(static_cast<double>(view.image.cols) / camera.width);
-      scaled.width = view.image.cols;
-      scaled.height = view.image.rows;
-      AddMotionDepth(neighbours, scaled, *route[k].pose, options, &view);
+// Depth for one route's frames (route_depth.h): each frame with a pose is matched with the frames with poses before
+// and after it. Depth is computed when a block of pairs needs it and released when the next block does not, so a long
+// flight's depth images are never all held at once. A frame's depth is its own: the same whatever the threads and
+// blocks.
+class RouteDepths {
+ public:
+  RouteDepths(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats, const CameraIntrinsics& camera,
+              const RouteDepthOptions& options, std::vector<KeyFrameView>* views)
+      : route_(route),
+        camera_(camera),
+        options_(options),
+        views_(views),
+        held_(route.size(), false),
+        given_(route.size(), false) {
+    for (std::size_t k = 0; k < route.size(); ++k) {
+      if (!repeats[k] && route[k].pose && !(*views)[k].image.empty()) usable_.push_back(static_cast<int>(k));
     }
-  });
-  return static_cast<int>(
-      std::count_if(usable.begin(), usable.end(), [&](int k) { return !(*views)[k].depth.empty(); }));
+    if (!camera.valid()) usable_.clear();
+  }
+
+  // Gives each frame of `wanted` its depth (where it can have any) and releases every other frame's.
+  void Keep(const std::set<int>& wanted) {
+    std::vector<int> missing;  // positions in usable_
+    for (std::size_t i = 0; i < usable_.size(); ++i) {
+      const int k = usable_[i];
+      if (wanted.count(k) == 0) {
+        (*views_)[k].depth.release();
+        held_[k] = false;
+      } else if (!held_[k]) {
+        missing.push_back(static_cast<int>(i));
+      }
+    }
+    cv::parallel_for_(cv::Range(0, static_cast<int>(missing.size())), [&](const cv::Range& range) {
+      for (int m = range.start; m < range.end; ++m) Compute(missing[m]);
+    });
+    for (const int i : missing) {
+      held_[usable_[i]] = true;
+      if (!(*views_)[usable_[i]].depth.empty()) given_[usable_[i]] = true;
+    }
+  }
+
+  // The frames given depth so far.
+  int frames_given() const { return static_cast<int>(std::count(given_.begin(), given_.end(), true)); }
+
+ private:
+  void Compute(int i) const {
+    std::vector<RouteNeighbour> neighbours;
+    for (const int j : {i - 1, i + 1}) {
+      if (j < 0 || j >= static_cast<int>(usable_.size())) continue;
+      neighbours.push_back({(*views_)[usable_[j]].image, *route_[usable_[j]].pose});
+    }
+    KeyFrameView& view = (*views_)[usable_[i]];
+    CameraIntrinsics scaled = camera_.Scaled(static_cast<double>(view.image.cols) / camera_.width);
+    scaled.width = view.image.cols;
+    scaled.height = view.image.rows;
+    AddMotionDepth(neighbours, scaled, *route_[usable_[i]].pose, options_, &view);
+  }
+
+  const std::vector<RouteFrame>& route_;
+  const CameraIntrinsics camera_;
+  const RouteDepthOptions options_;
+  std::vector<KeyFrameView>* views_;
+  std::vector<int> usable_;  // the frames with a pose and an image, in route order
+  std::vector<bool> held_, given_;
+};
+
+// Aligned pairs compared at a time: with depth, the depth of at most this many current frames and their prior
+// frames is held (0.36 MB a 376x240 frame). The results do not depend on it.
+constexpr std::size_t kPairsPerBlock = 32;
+
+// Compares the aligned pairs, block by block, the frames of each block given depth first when `depths` are given.
+void CompareBlocks(const std::vector<Alignment>& alignments, const std::vector<KeyFrameView>& prior_views,
+                   const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
+                   const AppearanceOptions& appearance, RouteDepths* prior_depths, RouteDepths* current_depths,
+                   std::vector<RoutePair>* pairs) {
+  pairs->resize(alignments.size());
+  for (std::size_t start = 0; start < alignments.size(); start += kPairsPerBlock) {
+    const std::size_t end = std::min(alignments.size(), start + kPairsPerBlock);
+    if (prior_depths != nullptr && current_depths != nullptr) {
+      std::set<int> prior_wanted, current_wanted;
+      for (std::size_t i = start; i < end; ++i) {
+        current_wanted.insert(alignments[i].current);
+        for (const auto& registered : alignments[i].registered) prior_wanted.insert(registered.second);
+      }
+      prior_depths->Keep(prior_wanted);
+      current_depths->Keep(current_wanted);
+    }
+    cv::parallel_for_(cv::Range(static_cast<int>(start), static_cast<int>(end)), [&](const cv::Range& range) {
+      for (int i = range.start; i < range.end; ++i) {
+        (*pairs)[i] = ComparePair(alignments[i], prior_views, current_views, options, appearance);
+      }
+    });
+  }
+  if (prior_depths != nullptr && current_depths != nullptr) {
+    prior_depths->Keep({});
+    current_depths->Keep({});
+  }
 }
 
 }  // namespace
@@ -336,11 +406,6 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
       }
     }
   });
-  if (options.depth.enabled && cameras.poses_comparable) {
-    comparison.prior_depth_frames = AddRouteDepth(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
-    comparison.current_depth_frames =
-        AddRouteDepth(current, current_repeats, cameras.current, options.depth, &current_views);
-  }
   std::vector<Alignment> alignments;
   for (std::size_t c = 0; c < current.size(); ++c) {  // in order: each predicts the next one's partner
     if (current_repeats[c]) continue;
@@ -357,12 +422,16 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
       alignments.push_back(std::move(alignment));
     }
   }
-  comparison.pairs.resize(alignments.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(alignments.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) {
-      comparison.pairs[i] = ComparePair(alignments[i], prior_views, current_views, options, appearance);
-    }
-  });
+  if (options.depth.enabled && cameras.poses_comparable) {
+    RouteDepths prior_depths(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
+    RouteDepths current_depths(current, current_repeats, cameras.current, options.depth, &current_views);
+    CompareBlocks(alignments, prior_views, current_views, options, appearance, &prior_depths, &current_depths,
+                  &comparison.pairs);
+    comparison.prior_depth_frames = prior_depths.frames_given();
+    comparison.current_depth_frames = current_depths.frames_given();
+  } else {
+    CompareBlocks(alignments, prior_views, current_views, options, appearance, nullptr, nullptr, &comparison.pairs);
+  }
   std::vector<int> next(current.size(), -1);  // per frame: the next frame that is no repeat
   for (int c = static_cast<int>(current.size()) - 2; c >= 0; --c)
     next[c] = current_repeats[c + 1] ? next[c + 1] : c + 1;
