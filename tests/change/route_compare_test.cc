@@ -189,13 +189,20 @@ TEST(RouteCompare, OneThreadOrSeveralGiveTheSameComparison) {
   const cv::Mat facade = Facade(7);
   cv::Mat changed = facade.clone();
   changed(cv::Rect(420, 60, 50, 90)).setTo(40);
-  const std::vector<RouteFrame> prior = Route(facade, 0, 1.0, 0.0), current = Route(changed, 6, 0.9, 10.0);
+  // With poses, so each frame's depth is computed too.
+  const std::vector<RouteFrame> prior = WithPoses(Route(facade, 0, 1.0, 0.0), 0),
+                                current = WithPoses(Route(changed, 6, 0.9, 10.0), 6);
+  const CameraIntrinsics camera{kFocalPx, kFocalPx, 187.5, 119.5, kFrameWidth, kFrameHeight};
   const int threads = cv::getNumThreads();
   cv::setNumThreads(1);
-  const RouteComparison one = CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{});
+  const RouteComparison one =
+      CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{}, {camera, camera, true});
   cv::setNumThreads(std::max(2, threads));
-  const RouteComparison several = CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{});
+  const RouteComparison several =
+      CompareRoutes(prior, current, {}, RouteCompareOptions{}, AppearanceOptions{}, {camera, camera, true});
   cv::setNumThreads(threads);
+  EXPECT_GT(one.current_depth_frames, 0);
+  EXPECT_EQ(one.current_depth_frames, several.current_depth_frames);
   ASSERT_EQ(one.pairs.size(), several.pairs.size());
   for (std::size_t i = 0; i < one.pairs.size(); ++i) {
     EXPECT_EQ(one.pairs[i].prior, several.pairs[i].prior);
