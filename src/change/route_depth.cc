@@ -63,8 +63,60 @@ void MarkSeenThrough(const KeyFrameView& from, const KeyFrameView& into, const c
   }
 }
 
+// The image mirrored, transposed or turned so that a baseline in camera axes points along +x: a stereo pair must stand
+// side by side, the other camera to the right. The matching keeps the image's rows where it can (a mirror rather than
+// a half turn for a neighbour to the left): semi-global matching's paths run one way down the image.
+struct SideBySide {
+  enum Kind { kAsIs, kMirrored, kTransposed, kTurned } kind = kAsIs;  // kTurned: a clockwise quarter turn
+
+  static SideBySide Towards(const Eigen::Vector3d& baseline) {
+    const double along[4] = {baseline.x(), -baseline.x(), baseline.y(), -baseline.y()};
+    return {static_cast<Kind>(std::max_element(along, along + 4) - along)};
+  }
+  // Camera axes after (x' = axes * x).
+  Eigen::Matrix3d Axes() const {
+    Eigen::Matrix3d axes;
+    switch (kind) {
+      case kAsIs: axes << 1, 0, 0, 0, 1, 0, 0, 0, 1; break;
+      case kMirrored: axes << -1, 0, 0, 0, 1, 0, 0, 0, 1; break;
+      case kTransposed: axes << 0, 1, 0, 1, 0, 0, 0, 0, 1; break;
+      case kTurned: axes << 0, -1, 0, 1, 0, 0, 0, 0, 1; break;
+    }
+    return axes;
+  }
+  CameraIntrinsics Camera(const CameraIntrinsics& c) const {
+    CameraIntrinsics t = c;
+    if (kind == kMirrored) t.cx = c.width - 1 - c.cx;
+    if (kind == kTransposed || kind == kTurned) {
+      t.fx = c.fy, t.fy = c.fx, t.cx = c.cy, t.cy = c.cx, t.width = c.height, t.height = c.width;
+      if (kind == kTurned) t.cx = c.height - 1 - c.cy;  // u' = (height - 1) - v, v' = u
+    }
+    return t;
+  }
+  // `image` as matched, into a new image (never the caller's pixels).
+  cv::Mat Image(const cv::Mat& image) const {
+    cv::Mat out;
+    switch (kind) {
+      case kAsIs: return image;
+      case kMirrored: cv::flip(image, out, 1); break;
+      case kTransposed: cv::transpose(image, out); break;
+      case kTurned: cv::rotate(image, out, cv::ROTATE_90_CLOCKWISE); break;
+    }
+    return out;
+  }
+  // A matched image brought back.
+  cv::Mat Back(const cv::Mat& image) const {
+    if (kind != kTurned) return Image(image);  // mirroring and transposing undo themselves
+    cv::Mat out;
+    cv::rotate(image, out, cv::ROTATE_90_COUNTERCLOCKWISE);
+    return out;
+  }
+};
+
 // Depth of the frame seen from `pose` by matching it against `other` (seen from `other_pose`); the range error per
-// squared metre into `sigma_per_m2`. Empty when the two stand too close or along the optical axis.
+// squared metre into `sigma_per_m2`. Empty when the two stand too close or along the optical axis. Whichever way
+// across the optical axis the other camera stands (a camera looking sideways that flies forward or back, or one
+// looking down), the pair is matched side by side (SideBySide).
 cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const CameraIntrinsics& camera,
                   const CameraPoseSample& pose, const RouteDepthOptions& options, double* sigma_per_m2) {
   const Eigen::Vector3d baseline = pose.ToCamera(other.pose.position);  // the other camera, seen from this one
@@ -73,28 +125,20 @@ cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const Camer
       std::hypot(baseline.x(), baseline.y()) < options.min_sideways_share * length) {
     return cv::Mat();
   }
-  // The other camera must stand to the right; when it stands to the left, both images (and the x axis) are mirrored.
-  const bool mirrored = baseline.x() < 0.0;
-  const Eigen::Matrix3d mirror = Eigen::Vector3d(mirrored ? -1.0 : 1.0, 1.0, 1.0).asDiagonal();
+  const SideBySide turn = SideBySide::Towards(baseline);
+  const Eigen::Matrix3d axes = turn.Axes();
   StereoCalibration calibration;
-  calibration.left = calibration.right = camera;
-  if (mirrored) calibration.left.cx = calibration.right.cx = camera.width - 1 - camera.cx;
+  calibration.left = calibration.right = turn.Camera(camera);
   const Eigen::Matrix3d rotation = (other.pose.rotation.conjugate() * pose.rotation).toRotationMatrix();
-  calibration.right_from_left_rotation = mirror * rotation * mirror;
+  calibration.right_from_left_rotation = axes * rotation * axes.transpose();
   calibration.right_from_left_translation =
-      mirror * (other.pose.rotation.conjugate() * (pose.position - other.pose.position));
+      axes * (other.pose.rotation.conjugate() * (pose.position - other.pose.position));
   std::unique_ptr<depth::StereoDepth> stereo;
   if (!depth::StereoDepth::Create(calibration, MatchingOptions(options), &stereo).ok()) return cv::Mat();
-  cv::Mat left = image, right = other.image, depth_m;
-  if (mirrored) {  // into new images: `left` and `right` share the callers' pixels
-    left = cv::Mat(), right = cv::Mat();
-    cv::flip(image, left, 1);
-    cv::flip(other.image, right, 1);
-  }
-  if (!stereo->Compute(left, right, &depth_m).ok()) return cv::Mat();
-  if (mirrored) cv::flip(depth_m, depth_m, 1);
+  cv::Mat depth_m;
+  if (!stereo->Compute(turn.Image(image), turn.Image(other.image), &depth_m).ok()) return cv::Mat();
   *sigma_per_m2 = stereo->RangeSigma(1.0);
-  return depth_m;
+  return turn.Back(depth_m);
 }
 
 // `a` and `b` fused into `a`: averaged where both know the depth and agree within `sigmas` range errors (at least
