@@ -54,7 +54,7 @@ struct RouteDepthOptions {
   double min_sideways_share = 0.7;  // ... nor frames whose baseline runs less than this share across the optical axis
   int num_disparities = 128;        // disparity search range [px], a multiple of 16
   int block_size = 5;               // matched block side [px], odd
-  double disparity_sigma_px = 1.0;  // matching noise: the range error is z^2 * this / (f * baseline)
+  double disparity_sigma_px = 0.5;  // matching noise: the range error is z^2 * this / (f * baseline)
   double max_range_m = 30.0;        // depths beyond this are left unknown [m]
   // A surface counts as gone (or new) where the other patrol's depth along the ray lies beyond it by more than
   // this, and by more than sigmas times the two range errors.
