@@ -43,11 +43,9 @@ struct AppearanceOptions {
   bool both_ways = false;
 };
 
-// Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
-// prior patrol's, and voting over consecutive aligned pairs.
-// Depth along the route (route_depth.h): each route frame with a pose is matched against the next frame its own
-// patrol kept (motion stereo: one flight, so one light), and a compared pair's pixels also count as changed where one
-// patrol's surface lies in the space the other patrol saw through.
+// Depth along the route (route_depth.h): each route frame with a pose is matched against the frames before and after
+// it in its own patrol (motion stereo: one flight, so one light), and a compared pair's pixels also count as changed
+// where one patrol's surface lies in the space the other patrol saw through.
 struct RouteDepthOptions {
   bool enabled = true;              // needs poses both patrols place in one world frame (not GPS fixes)
   double min_baseline_m = 0.3;      // frames closer together than this give no depth [m]
@@ -62,6 +60,8 @@ struct RouteDepthOptions {
   double sigmas = 3.0;
 };
 
+// Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the
+// prior patrol's, and voting over consecutive aligned pairs.
 struct RouteCompareOptions {
   bool enabled = true;           // false: only the key frames of the places both patrols saw are compared
   double search_window_s = 4.0;  // a frame's partner is searched this far either side of its predicted time [s]

@@ -68,7 +68,8 @@ void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_siz
 
 // The cameras of the two patrols' route frames (PatrolRecord::camera, at the log's resolution), and whether the two
 // patrols' poses lie in one world frame. With change.route.depth on and such poses, each route frame with a pose
-// gets depth from the next frame of its patrol (route_depth.h), and each compared pair is also tested by visibility.
+// that a compared pair uses gets depth from the frames before and after it in its patrol (route_depth.h), and each
+// compared pair is also tested by visibility.
 struct RouteCameras {
   CameraIntrinsics prior, current;
   bool poses_comparable = false;

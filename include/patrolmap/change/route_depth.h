@@ -1,7 +1,7 @@
-// Depth along the route (issue 15): a route frame with a pose gets depth by semi-global matching against another
-// frame of its own patrol (motion stereo; depth::StereoDepth with the pair's relative pose as its calibration).
-// Both frames come from one flight, so they share the light, and depth tells what brightness cannot: a small face
-// lit otherwise from a small object.
+// Depth along the route (issue 15): a route frame with a pose gets depth by semi-global matching against the frames
+// before and after it in its own patrol (motion stereo; depth::StereoDepth with the pair's relative pose as its
+// calibration). Both frames come from one flight, so they share the light, and depth tells what brightness cannot: a
+// small face lit otherwise from a small object.
 //
 // Two patrols' frames with depth are then compared by visibility: a current surface that the prior camera saw
 // through (its depth along that ray lies well beyond the surface) is new, and a prior surface the current camera
