@@ -225,7 +225,7 @@ void BM_RouteMotionDepth(benchmark::State& state) {
   for (auto _ : state) {
     view = change::KeyFrameView();
     view.image = here.image;
-    change::AddMotionDepth(neighbours, kCamera, here.sample, change::RouteDepthOptions{}, &view);
+    change::AddMotionDepth(neighbours, depth::Lens(kCamera), here.sample, change::RouteDepthOptions{}, &view);
   }
   int known = 0, within = 0;
   for (int y = 0; y < view.depth.rows; ++y) {

@@ -6,6 +6,7 @@
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/rate_gate.h"
 #include "patrolmap/core/types.h"
 #include "test_util.h"
@@ -62,6 +63,35 @@ TEST(CameraIntrinsics, ScalingKeepsPixelCentresAligned) {
   EXPECT_DOUBLE_EQ(half.cy, 119.5);
   EXPECT_EQ(half.width, 376);
   EXPECT_EQ(half.height, 240);
+}
+
+// OpenCV's radial-tangential model, worked by hand for one point: x = 0.5, y = -0.25 (r^2 = 0.3125).
+TEST(Distortion, RadialAndTangentialTermsAsOpenCvDefinesThem) {
+  const Eigen::Vector2d point(0.5, -0.25);
+  EXPECT_TRUE(Distorted(Distortion{}, point).isApprox(point));
+  // radial 1 - 0.2 * 0.3125 + 0.05 * 0.09765625 = 0.942382812; x: 0.471191406 + 2 * 0.01 * (-0.125) +
+  // 0.02 * (0.3125 + 0.5) = 0.484941406; y: -0.235595703 + 0.01 * (0.3125 + 0.125) + 2 * 0.02 * (-0.125) =
+  // -0.236220703.
+  bool folded = true;
+  const Eigen::Vector2d seen = Distorted({-0.2, 0.05, 0.01, 0.02}, point, &folded);
+  EXPECT_FALSE(folded);
+  EXPECT_NEAR(seen.x(), 0.484941406, 1e-9);
+  EXPECT_NEAR(seen.y(), -0.236220703, 1e-9);
+  // k1 -0.5: the radial term stops growing at r^2 = 2/3; a point beyond is returned as it was.
+  EXPECT_TRUE(Distorted({-0.5, 0.0, 0.0, 0.0}, Eigen::Vector2d(1.0, 0.0), &folded).isApprox(Eigen::Vector2d(1, 0)));
+  EXPECT_TRUE(folded);
+}
+
+// A box beside the optical axis lands nearer the centre through a barrel lens (k1 < 0) than through a pinhole.
+TEST(Distortion, ProjectedCornersFollowTheLens) {
+  const CameraIntrinsics camera{400.0, 400.0, 320.0, 240.0, 640, 480};
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int i = 0; i < 8; ++i) corners[i] = Eigen::Vector3d(2.0 + (i & 1), -0.5 + ((i >> 1) & 1), 5.0 + (i >> 2));
+  const cv::Rect2d pinhole = ProjectCorners(camera, CameraPoseSample(), corners);
+  const cv::Rect2d barrel = ProjectCorners(camera, CameraPoseSample(), corners, {-0.28, 0.07, 0.0, 0.0});
+  EXPECT_NEAR(pinhole.x, 320.0 + 400.0 * 2.0 / 6.0, 1e-9);  // the nearest left corner at x 2, z 6
+  EXPECT_LT(barrel.br().x, pinhole.br().x - 10.0);
+  EXPECT_LT(barrel.x, pinhole.x);
 }
 
 TEST(Time, SecondsAndNanosecondsRoundTrip) {

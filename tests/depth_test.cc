@@ -1,5 +1,5 @@
 // The depth stage: stereo matching against Middlebury's true disparity (Debian's opencv-doc), stereo depth
-// of a synthetic pair whose geometry is known exactly, and the fusion of depth frames along a flight.
+// of a synthetic pair whose geometry is known exactly, the fusion of depth frames along a flight, and the lens.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/depth/fusion.h"
+#include "patrolmap/depth/lens.h"
 #include "patrolmap/depth/stereo.h"
 
 namespace patrolmap::depth {
@@ -475,6 +476,78 @@ TEST(DepthFusion, WithoutFramesKeptDepthIsUntouched) {
   for (int frame = 0; frame < 3; ++frame) fusion.Fuse(At(0.5 * frame), 4, &depth, &scale);
   EXPECT_EQ(ViewsAt(scale, 2, 2), 1);
   EXPECT_EQ(cv::countNonZero(depth != 20.0f), 0);
+}
+
+// EuRoC's cam0 (MH_01's sensor.yaml): 752x480, k1 -0.28.
+const CameraIntrinsics kEurocCamera{458.654, 457.296, 367.215, 248.375, 752, 480};
+const Distortion kEurocDistortion{-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+
+TEST(Lens, ARawPixelsRayProjectsBackOntoIt) {
+  const Lens lens(kEurocCamera, kEurocDistortion);
+  ASSERT_TRUE(lens.distorted());
+  double worst = 0.0;
+  for (int v = 0; v < kEurocCamera.height; v += 7) {
+    for (int u = 0; u < kEurocCamera.width; u += 7) {
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(lens.Project(4.0 * lens.Ray(u, v), &pixel)) << u << " " << v;
+      worst = std::max(worst, (pixel - Eigen::Vector2d(u, v)).norm());
+    }
+  }
+  EXPECT_LT(worst, 0.01);
+  // The corner's ray leans out farther than a pinhole's would: the lens compresses the edge.
+  const Eigen::Vector3d corner = lens.Ray(0, 0);
+  EXPECT_LT(corner.x(), -1.2 * kEurocCamera.cx / kEurocCamera.fx);
+  // Behind the camera, or beyond the widest ray (where k1 < 0 would fold the point back into the image): nowhere.
+  Eigen::Vector2d pixel;
+  EXPECT_FALSE(lens.Project({0.0, 0.0, -1.0}, &pixel));
+  EXPECT_FALSE(lens.Project({3.0, 0.0, 1.0}, &pixel));
+}
+
+TEST(Lens, WithoutDistortionItIsAPinholeAndTheImageIsLeftAlone) {
+  const Lens lens(kEurocCamera);
+  EXPECT_FALSE(lens.distorted());
+  EXPECT_TRUE(lens.pinhole_at().empty());
+  const Eigen::Vector3d ray = lens.Ray(100, 50);
+  EXPECT_NEAR(ray.x(), (100 - kEurocCamera.cx) / kEurocCamera.fx, 1e-12);
+  EXPECT_NEAR(ray.y(), (50 - kEurocCamera.cy) / kEurocCamera.fy, 1e-12);
+  const cv::Mat image(480, 752, CV_32F, cv::Scalar(3.0f));
+  EXPECT_EQ(lens.ToRaw(image).data, image.data);
+}
+
+TEST(Lens, ToRawTakesEachRawPixelFromItsUndistortedPlace) {
+  const Lens lens(kEurocCamera, kEurocDistortion);
+  cv::Mat pinhole(480, 752, CV_32F);  // each pixel holds its column
+  for (int v = 0; v < pinhole.rows; ++v)
+    for (int u = 0; u < pinhole.cols; ++u) pinhole.at<float>(v, u) = static_cast<float>(u);
+  const cv::Mat raw = lens.ToRaw(pinhole);
+  // At the left edge's middle the raw pixel's undistorted place lies left of the image: nothing there.
+  EXPECT_EQ(raw.at<float>(248, 0), 0.0f);
+  const cv::Vec2f inner = lens.pinhole_at().at<cv::Vec2f>(248, 60);
+  EXPECT_LT(inner[0], 60.0f);  // pulled outwards
+  EXPECT_EQ(raw.at<float>(248, 60), std::round(inner[0]));
+  EXPECT_NEAR(raw.at<float>(248, 367), 367.0f, 1.0f);  // the centre stays
+}
+
+// Mirroring, transposing or turning an image changes its lens's tangential terms: a point projects through the
+// changed lens where the changed image shows it.
+TEST(Lens, AMirroredTransposedOrTurnedImageHasItsOwnTangentialTerms) {
+  const Distortion d{-0.2, 0.05, 0.01, -0.02};
+  const CameraIntrinsics c{400.0, 400.0, 0.0, 0.0, 600, 400};  // centre at the origin: the turns need no shift
+  const Lens lens(c, d);
+  const Lens mirrored(c, MirroredDistortion(d)), transposed(c, TransposedDistortion(d)), turned(c, TurnedDistortion(d));
+  for (const Eigen::Vector3d& point : {Eigen::Vector3d(0.3, -0.2, 1.0), Eigen::Vector3d(-0.25, 0.35, 1.0)}) {
+    Eigen::Vector2d seen, other;
+    ASSERT_TRUE(lens.Project(point, &seen));
+    ASSERT_TRUE(mirrored.Project({-point.x(), point.y(), point.z()}, &other));
+    EXPECT_NEAR(other.x(), -seen.x(), 1e-9);
+    EXPECT_NEAR(other.y(), seen.y(), 1e-9);
+    ASSERT_TRUE(transposed.Project({point.y(), point.x(), point.z()}, &other));
+    EXPECT_NEAR(other.x(), seen.y(), 1e-9);
+    EXPECT_NEAR(other.y(), seen.x(), 1e-9);
+    ASSERT_TRUE(turned.Project({-point.y(), point.x(), point.z()}, &other));  // x' = -y, y' = x
+    EXPECT_NEAR(other.x(), -seen.y(), 1e-9);
+    EXPECT_NEAR(other.y(), seen.x(), 1e-9);
+  }
 }
 
 }  // namespace

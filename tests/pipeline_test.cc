@@ -477,6 +477,23 @@ TEST(RouteStrip, KeepsAFrameAnIntervalWhateverTheCameraRate) {
   EXPECT_EQ(due, 100);
 }
 
+// The lens goes into the record, which the map keeps, whether or not the log can feed objects and geometry.
+TEST(PatrolRecorder, TheRecordKeepsTheLogsLensDistortion) {
+  io::LogInfo info;
+  info.camera = CameraIntrinsics{40.0, 40.0, 31.5, 23.5, 64, 48};
+  info.camera_distortion = {-0.28, 0.07, 0.0002, 0.00002};
+  for (const bool poses : {false, true}) {
+    info.has_poses = info.has_depth = poses;
+    PatrolRecorder recorder(Config{}, info);
+    EXPECT_EQ(recorder.active(), poses);
+    PatrolRecord record;
+    PatrolRecordStats stats;
+    recorder.Finish(&record, &stats);
+    EXPECT_EQ(record.distortion, info.camera_distortion);
+  }
+  EXPECT_EQ(CameraOnlyRecord(info).distortion, info.camera_distortion);
+}
+
 TEST(PatrolRecorder, AnObjectFrameTakesOnlyTheDepthImageOfItsOwnTime) {
   io::LogInfo info;
   info.camera = CameraIntrinsics{40.0, 40.0, 31.5, 23.5, 64, 48};

@@ -74,7 +74,7 @@ std::optional<Sighting> BestSighting(const PatrolRecord& record, const Eigen::Ve
   for (const RouteFrame& frame : record.route) {
     if (without_grid && (frame.timestamp_ns < window.first || frame.timestamp_ns > window.last)) continue;
     if (!frame.pose || (frame.pose->position - centre).norm() > options.max_view_range_m) continue;
-    const cv::Rect2d box = ProjectCorners(record.camera, *frame.pose, corners);
+    const cv::Rect2d box = ProjectCorners(record.camera, *frame.pose, corners, record.distortion);
     if (box.area() <= 0.0) continue;
     const double inside = (box & image).area() / box.area();
     const cv::Point2d off((box.x + box.width / 2.0) / image.width - 0.5,

@@ -258,17 +258,20 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
 class RouteDepths {
  public:
   RouteDepths(const std::vector<RouteFrame>& route, const std::vector<bool>& repeats, const CameraIntrinsics& camera,
-              const RouteDepthOptions& options, std::vector<KeyFrameView>* views)
-      : route_(route),
-        camera_(camera),
-        options_(options),
-        views_(views),
-        held_(route.size(), false),
-        given_(route.size(), false) {
+              const Distortion& distortion, const RouteDepthOptions& options, std::vector<KeyFrameView>* views)
+      : route_(route), options_(options), views_(views), held_(route.size(), false), given_(route.size(), false) {
     for (std::size_t k = 0; k < route.size(); ++k) {
       if (!repeats[k] && route[k].pose && !(*views)[k].image.empty()) usable_.push_back(static_cast<int>(k));
     }
     if (!camera.valid()) usable_.clear();
+    for (const int k : usable_) {  // one lens per size of frame (a patrol's route frames share one)
+      const cv::Size size = (*views)[k].image.size();
+      if (lenses_.count({size.width, size.height}) > 0) continue;
+      CameraIntrinsics scaled = camera.Scaled(static_cast<double>(size.width) / camera.width);
+      scaled.width = size.width;
+      scaled.height = size.height;
+      lenses_.emplace(std::make_pair(size.width, size.height), depth::Lens(scaled, distortion));
+    }
   }
 
   // Gives each frame of `wanted` its depth (where it can have any) and releases every other frame's.
@@ -303,17 +306,15 @@ class RouteDepths {
       neighbours.push_back({(*views_)[usable_[j]].image, *route_[usable_[j]].pose});
     }
     KeyFrameView& view = (*views_)[usable_[i]];
-    CameraIntrinsics scaled = camera_.Scaled(static_cast<double>(view.image.cols) / camera_.width);
-    scaled.width = view.image.cols;
-    scaled.height = view.image.rows;
-    AddMotionDepth(neighbours, scaled, *route_[usable_[i]].pose, options_, &view);
+    const depth::Lens& lens = lenses_.at({view.image.cols, view.image.rows});
+    AddMotionDepth(neighbours, lens, *route_[usable_[i]].pose, options_, &view);
   }
 
   const std::vector<RouteFrame>& route_;
-  const CameraIntrinsics camera_;
   const RouteDepthOptions options_;
   std::vector<KeyFrameView>* views_;
-  std::vector<int> usable_;  // the frames with a pose and an image, in route order
+  std::vector<int> usable_;                            // the frames with a pose and an image, in route order
+  std::map<std::pair<int, int>, depth::Lens> lenses_;  // by frame width and height
   std::vector<bool> held_, given_;
 };
 
@@ -423,8 +424,10 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
     }
   }
   if (options.depth.enabled && cameras.poses_comparable) {
-    RouteDepths prior_depths(prior, prior_repeats, cameras.prior, options.depth, &prior_views);
-    RouteDepths current_depths(current, current_repeats, cameras.current, options.depth, &current_views);
+    RouteDepths prior_depths(prior, prior_repeats, cameras.prior, cameras.prior_distortion, options.depth,
+                             &prior_views);
+    RouteDepths current_depths(current, current_repeats, cameras.current, cameras.current_distortion, options.depth,
+                               &current_views);
     CompareBlocks(alignments, prior_views, current_views, options, appearance, &prior_depths, &current_depths,
                   &comparison.pairs);
     comparison.prior_depth_frames = prior_depths.frames_given();

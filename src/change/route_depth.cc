@@ -37,17 +37,14 @@ void MarkSeenThrough(const KeyFrameView& from, const KeyFrameView& into, const c
                      const RouteDepthOptions& options, bool at_source, cv::Mat* marks) {
   const Eigen::Matrix3d rotation = (into.pose.rotation.conjugate() * from.pose.rotation).toRotationMatrix();
   const Eigen::Vector3d translation = into.pose.rotation.conjugate() * (from.pose.position - into.pose.position);
-  const CameraIntrinsics& a = from.camera;
-  const CameraIntrinsics& b = into.camera;
   for (int v = 0; v < from.depth.rows; ++v) {
     const float* z = from.depth.ptr<float>(v);
     for (int u = 0; u < from.depth.cols; ++u) {
       if (!(z[u] > 0.0f)) continue;
-      const Eigen::Vector3d point(z[u] * (u - a.cx) / a.fx, z[u] * (v - a.cy) / a.fy, z[u]);
-      const Eigen::Vector3d in_into = rotation * point + translation;
-      if (!(in_into.z() > 0.0)) continue;
-      const int ub = static_cast<int>(std::lround(b.fx * in_into.x() / in_into.z() + b.cx));
-      const int vb = static_cast<int>(std::lround(b.fy * in_into.y() / in_into.z() + b.cy));
+      const Eigen::Vector3d in_into = rotation * (z[u] * from.lens.Ray(u, v)) + translation;
+      Eigen::Vector2d pixel;
+      if (!into.lens.Project(in_into, &pixel)) continue;
+      const int ub = static_cast<int>(std::lround(pixel.x())), vb = static_cast<int>(std::lround(pixel.y()));
       if (ub < 0 || vb < 0 || ub >= into_nearest.cols || vb >= into_nearest.rows) continue;
       const double seen = into_nearest.at<float>(vb, ub);
       if (!(seen > 0.0)) continue;
@@ -93,6 +90,15 @@ struct SideBySide {
     }
     return t;
   }
+  Distortion Lens(const Distortion& d) const {
+    switch (kind) {
+      case kAsIs: return d;
+      case kMirrored: return depth::MirroredDistortion(d);
+      case kTransposed: return depth::TransposedDistortion(d);
+      case kTurned: return depth::TurnedDistortion(d);
+    }
+    return d;
+  }
   // `image` as matched, into a new image (never the caller's pixels).
   cv::Mat Image(const cv::Mat& image) const {
     cv::Mat out;
@@ -113,11 +119,11 @@ struct SideBySide {
   }
 };
 
-// Depth of the frame seen from `pose` by matching it against `other` (seen from `other_pose`); the range error per
-// squared metre into `sigma_per_m2`. Empty when the two stand too close or along the optical axis. Whichever way
-// across the optical axis the other camera stands (a camera looking sideways that flies forward or back, or one
-// looking down), the pair is matched side by side (SideBySide).
-cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const CameraIntrinsics& camera,
+// Depth of the frame seen from `pose` by matching it against `other` (seen from `other_pose`), on the lens's
+// undistorted grid; the range error per squared metre into `sigma_per_m2`. Empty when the two stand too close or along
+// the optical axis. Whichever way across the optical axis the other camera stands (a camera looking sideways that flies
+// forward or back, or one looking down), the pair is matched side by side (SideBySide).
+cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const depth::Lens& lens,
                   const CameraPoseSample& pose, const RouteDepthOptions& options, double* sigma_per_m2) {
   const Eigen::Vector3d baseline = pose.ToCamera(other.pose.position);  // the other camera, seen from this one
   const double length = baseline.norm();
@@ -128,7 +134,8 @@ cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const Camer
   const SideBySide turn = SideBySide::Towards(baseline);
   const Eigen::Matrix3d axes = turn.Axes();
   StereoCalibration calibration;
-  calibration.left = calibration.right = turn.Camera(camera);
+  calibration.left = calibration.right = turn.Camera(lens.camera());
+  calibration.left_distortion = calibration.right_distortion = turn.Lens(lens.distortion());
   const Eigen::Matrix3d rotation = (other.pose.rotation.conjugate() * pose.rotation).toRotationMatrix();
   calibration.right_from_left_rotation = axes * rotation * axes.transpose();
   calibration.right_from_left_translation =
@@ -162,8 +169,9 @@ void Fuse(const cv::Mat& b, double sigma_a, double sigma_b, const RouteDepthOpti
 
 }  // namespace
 
-bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraIntrinsics& camera,
+bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const depth::Lens& lens,
                     const CameraPoseSample& pose, const RouteDepthOptions& options, KeyFrameView* view) {
+  const CameraIntrinsics& camera = lens.camera();
   if (view->image.empty() || !camera.valid() || camera.width != view->image.cols || camera.height != view->image.rows) {
     return false;
   }
@@ -171,7 +179,7 @@ bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraI
   double fused_sigma = 0.0;
   for (const RouteNeighbour& other : neighbours) {
     double sigma = 0.0;
-    const cv::Mat depth_m = PairDepth(view->image, other, camera, pose, options, &sigma);
+    const cv::Mat depth_m = PairDepth(view->image, other, lens, pose, options, &sigma);
     if (depth_m.empty()) continue;
     if (fused.empty()) {
       fused = depth_m, fused_sigma = sigma;
@@ -181,8 +189,8 @@ bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraI
     }
   }
   if (fused.empty()) return false;
-  view->depth = fused;
-  view->camera = camera;
+  view->depth = lens.ToRaw(fused);
+  view->lens = lens;
   view->pose = pose;
   view->range_sigma_per_m2 = fused_sigma;
   return true;

@@ -4,6 +4,17 @@
 
 namespace patrolmap {
 
+Eigen::Vector2d Distorted(const Distortion& d, const Eigen::Vector2d& point, bool* folded) {
+  const auto& [k1, k2, p1, p2] = d;
+  const double x = point.x(), y = point.y(), r2 = x * x + y * y;
+  const bool beyond = 1.0 + 3.0 * k1 * r2 + 5.0 * k2 * r2 * r2 <= 0.0;
+  if (folded != nullptr) *folded = beyond;
+  if (beyond) return point;
+  const double radial = 1.0 + k1 * r2 + k2 * r2 * r2;
+  return {x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+          y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y};
+}
+
 CameraIntrinsics CameraIntrinsics::Scaled(double scale) const {
   CameraIntrinsics scaled = *this;
   scaled.fx *= scale;

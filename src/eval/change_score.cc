@@ -347,8 +347,9 @@ bool SeenNear(const TruthObject& object, TimestampNs time_ns, double within_s) {
 }
 
 // The object's box projected into the image, clipped to it; empty when a corner lies behind the camera.
-cv::Rect2d ProjectTruthBox(const TruthObject& o, const CameraPoseSample& pose, const CameraIntrinsics& camera) {
-  return ProjectCorners(camera, pose, StandingBoxCorners(o.centre, o.yaw, o.length, o.width, o.height)) &
+cv::Rect2d ProjectTruthBox(const TruthObject& o, const CameraPoseSample& pose, const CameraIntrinsics& camera,
+                           const Distortion& distortion) {
+  return ProjectCorners(camera, pose, StandingBoxCorners(o.centre, o.yaw, o.length, o.width, o.height), distortion) &
          cv::Rect2d(0, 0, camera.width, camera.height);
 }
 
@@ -361,13 +362,14 @@ bool Overlaps(const cv::Rect2d& a, const cv::Rect2d& b, double min_overlap) {
 
 std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
                                           TimestampNs time_ns, const CameraPoseSample& pose,
-                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
+                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options,
+                                          const Distortion& distortion) {
   std::vector<VisibleChange> changes;
   for (const TruthObject& o : here) {
     const TruthObject* there = FindId(other, o.id);
     if (there != nullptr && (there->centre - o.centre).norm() <= kSamePlace) continue;  // unchanged
     if (!SeenNear(o, time_ns, options.visible_within_s)) continue;
-    const cv::Rect2d box = ProjectTruthBox(o, pose, camera);
+    const cv::Rect2d box = ProjectTruthBox(o, pose, camera, distortion);
     if (box.area() >= options.min_area_px) changes.push_back({o.id, box});
   }
   return changes;
@@ -375,9 +377,12 @@ std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, 
 
 std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
                                            TimestampNs time_ns, const CameraPoseSample& pose,
-                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options) {
+                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options,
+                                           const Distortion& distortion) {
   std::vector<cv::Rect2d> boxes;
-  for (const VisibleChange& c : VisibleChanges(here, other, time_ns, pose, camera, options)) boxes.push_back(c.box);
+  for (const VisibleChange& c : VisibleChanges(here, other, time_ns, pose, camera, options, distortion)) {
+    boxes.push_back(c.box);
+  }
   return boxes;
 }
 

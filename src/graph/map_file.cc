@@ -19,8 +19,8 @@ constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
 // 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
 // 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit;
-// 9: where the patrol's camera poses came from
-constexpr std::uint32_t kVersion = 9;
+// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion
+constexpr std::uint32_t kVersion = 10;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
@@ -281,6 +281,7 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     WriteRoute(p.route, &w);
     w.Value<std::uint8_t>(p.timed ? 1 : 0);
     w.String(p.pose_source);
+    for (double k : p.distortion) w.Value(k);
   }
 }
 
@@ -431,13 +432,17 @@ bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
   return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore);
 }
 
-// A patrol's camera as the pipeline records it (valid, or all zero for a log without one), and views
-// with valid times, finite positions and rotations of about unit norm.
+// A pose with a valid time, a finite position and a rotation of about unit norm.
 bool ValidPose(const CameraPoseSample& v) {
   const double norm = v.rotation.coeffs().norm();
   return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
 }
 
+// Distortion coefficients beyond this are no lens's (EuRoC's k1 is -0.28, fisheye lenses are another model).
+constexpr double kMaxDistortion = 10.0;
+
+// A patrol's camera as the pipeline records it (valid, or all zero for a log without one), its lens distortion
+// (finite and bounded), and valid views.
 bool ValidCameraAndViews(const PatrolRecord& p) {
   const CameraIntrinsics& c = p.camera;
   constexpr int kMaxImageSide = 100000;
@@ -445,6 +450,11 @@ bool ValidCameraAndViews(const PatrolRecord& p) {
   const bool camera_ok = unknown || (Finite({c.fx, c.fy, c.cx, c.cy}) && c.valid() && c.width <= kMaxImageSide &&
                                      c.height <= kMaxImageSide);
   if (!camera_ok || p.feature_image_width < 0 || p.feature_image_width > kMaxImageSide) return false;
+  const auto& [k1, k2, p1, p2] = p.distortion;
+  if (!Finite({k1, k2, p1, p2}) || std::abs(k1) > kMaxDistortion || std::abs(k2) > kMaxDistortion ||
+      std::abs(p1) > kMaxDistortion || std::abs(p2) > kMaxDistortion) {
+    return false;
+  }
   return std::all_of(p.views.begin(), p.views.end(), ValidPose);
 }
 
@@ -558,6 +568,8 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     if (version >= 6) p.route = ReadRoute(r);
     if (version >= 7) p.timed = r->Value<std::uint8_t>() != 0;
     if (version >= 9) p.pose_source = r->String();
+    if (version >= 10)
+      for (double& k : p.distortion) k = r->Value<double>();
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);

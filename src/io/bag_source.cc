@@ -605,19 +605,26 @@ CameraIntrinsics IntrinsicsOf(const rosmsg::CameraInfoMessage& info) {
   return {info.k[0], info.k[4], info.k[2], info.k[5], static_cast<int>(info.width), static_cast<int>(info.height)};
 }
 
+// A camera info's distortion (plumb_bob: k1, k2, p1, p2); fails naming a model or a term that is not undone.
+Status DistortionOf(const rosmsg::CameraInfoMessage& camera, Distortion* distortion) {
+  const std::string& model = camera.distortion_model;
+  if (!model.empty() && model != "plumb_bob" && model != "radial-tangential") {
+    return Status::InvalidArgument("distortion model '" + model + "' is not plumb_bob, the only one undone");
+  }
+  if (camera.distortion.size() > 4 && std::abs(camera.distortion[4]) > 1e-9) {
+    return Status::InvalidArgument("a k3 distortion term, which is not undone");
+  }
+  for (std::size_t i = 0; i < 4; ++i) (*distortion)[i] = i < camera.distortion.size() ? camera.distortion[i] : 0.0;
+  return Status::Ok();
+}
+
 // A stereo pair's calibration from the two cameras' CameraInfo (ROS's stereo convention: R rotates each
 // camera into the rectified frame, the right P holds -fx * baseline); fails saying why it cannot be used.
 Status StereoFromCameraInfo(const rosmsg::CameraInfoMessage& left, const rosmsg::CameraInfoMessage& right,
                             StereoCalibration* pair) {
-  const std::array<const rosmsg::CameraInfoMessage*, 2> cameras = {&left, &right};
-  for (const rosmsg::CameraInfoMessage* camera : cameras) {
-    const std::string& model = camera->distortion_model;
-    if (!model.empty() && model != "plumb_bob" && model != "radial-tangential") {
-      return Status::InvalidArgument("distortion model '" + model + "' is not plumb_bob, the only one undone");
-    }
-    if (camera->distortion.size() > 4 && std::abs(camera->distortion[4]) > 1e-9) {
-      return Status::InvalidArgument("a k3 distortion term, which stereo matching does not undo");
-    }
+  PATROLMAP_RETURN_IF_ERROR(DistortionOf(left, &pair->left_distortion));
+  PATROLMAP_RETURN_IF_ERROR(DistortionOf(right, &pair->right_distortion));
+  for (const rosmsg::CameraInfoMessage* camera : {&left, &right}) {
     if (!IntrinsicsOf(*camera).valid()) return Status::InvalidArgument("camera info without intrinsics");
   }
   if (!(right.p[0] > 0.0) || !(std::abs(right.p[3]) > 0.0)) {
@@ -625,10 +632,6 @@ Status StereoFromCameraInfo(const rosmsg::CameraInfoMessage& left, const rosmsg:
   }
   pair->left = IntrinsicsOf(left);
   pair->right = IntrinsicsOf(right);
-  for (std::size_t i = 0; i < 4; ++i) {
-    pair->left_distortion[i] = i < left.distortion.size() ? left.distortion[i] : 0.0;
-    pair->right_distortion[i] = i < right.distortion.size() ? right.distortion[i] : 0.0;
-  }
   using RowMajor = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   const Eigen::Matrix3d left_rectified = Eigen::Map<const RowMajor>(left.r.data());
   const Eigen::Matrix3d right_rectified = Eigen::Map<const RowMajor>(right.r.data());
@@ -733,6 +736,14 @@ void SetCalibration(const BagFile& bag, const std::string& path, const BagRoles&
     if (camera.valid()) info->camera = camera;
     if (!camera.valid()) {
       spdlog::warn("{}, topic {}: camera info without intrinsics", path, bag.topics()[roles.camera_info].name);
+    }
+    // image_proc's undistorted images (image_rect, image_rect_color) come with the raw camera's info.
+    const bool rectified = bag.topics()[roles.camera].name.find("image_rect") != std::string::npos;
+    const Status lens = rectified ? Status::Ok() : DistortionOf(first.camera_info, &info->camera_distortion);
+    if (!lens.ok()) {
+      info->camera_distortion = Distortion{};
+      spdlog::warn("{}, topic {}: {}; route frames are matched as undistorted", path,
+                   bag.topics()[roles.camera_info].name, lens.message());
     }
   }
   if (roles.right < 0) return;

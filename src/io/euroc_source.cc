@@ -115,10 +115,32 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
   return Status::Ok();
 }
 
+// A sensor.yaml's radial-tangential distortion (k1, k2, p1, p2; none when absent). Another distortion model is
+// valid but not undone: `unsupported` receives why, and `distortion` stays zero.
+Status ReadDistortion(const std::string& path, const YAML::Node& root, Distortion* distortion,
+                      std::string* unsupported) {
+  if (root["distortion_model"]) {
+    const std::string model = root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "";
+    if (model != "radial-tangential" && model != "radtan") {
+      *unsupported = path + ": distortion_model '" + model + "' is not radial-tangential, the only one undone";
+      return Status::Ok();
+    }
+  }
+  if (!root["distortion_coefficients"]) return Status::Ok();
+  std::vector<double> coefficients;
+  PATROLMAP_RETURN_IF_ERROR(
+      ReadNumbers(path, root["distortion_coefficients"], "distortion_coefficients", 4, &coefficients));
+  for (int i = 0; i < 4; ++i) {
+    if (!std::isfinite(coefficients[i])) return Status::DataLoss(path + ": distortion_coefficients must be finite");
+    (*distortion)[i] = coefficients[i];
+  }
+  return Status::Ok();
+}
+
 // A camera of a stereo pair: its intrinsics, distortion and pose in the body frame.
 struct StereoCamera {
   CameraIntrinsics intrinsics;
-  std::array<double, 4> distortion{};
+  Distortion distortion{};
   Eigen::Matrix3d body_rotation;
   Eigen::Vector3d body_translation;
 };
@@ -128,7 +150,7 @@ struct StereoCamera {
 Status ReadStereoCamera(const std::string& path, StereoCamera* camera, std::string* unsupported) {
   YAML::Node root;
   PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
-  std::vector<double> intrinsics, resolution, distortion(4, 0.0);
+  std::vector<double> intrinsics, resolution;
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
   camera->intrinsics = {intrinsics[0],
@@ -138,21 +160,7 @@ Status ReadStereoCamera(const std::string& path, StereoCamera* camera, std::stri
                         static_cast<int>(resolution[0]),
                         static_cast<int>(resolution[1])};
   if (!camera->intrinsics.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
-  if (root["distortion_model"]) {
-    const std::string model = root["distortion_model"].IsScalar() ? root["distortion_model"].Scalar() : "";
-    if (model != "radial-tangential" && model != "radtan") {
-      *unsupported =
-          path + ": distortion_model '" + model + "' is not radial-tangential, the only one stereo matching undoes";
-    }
-  }
-  if (root["distortion_coefficients"]) {
-    PATROLMAP_RETURN_IF_ERROR(
-        ReadNumbers(path, root["distortion_coefficients"], "distortion_coefficients", 4, &distortion));
-  }
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(distortion[i])) return Status::DataLoss(path + ": distortion_coefficients must be finite");
-    camera->distortion[i] = distortion[i];
-  }
+  PATROLMAP_RETURN_IF_ERROR(ReadDistortion(path, root, &camera->distortion, unsupported));
   return ReadBodyFromSensor(path, root, &camera->body_rotation, &camera->body_translation);
 }
 
@@ -212,6 +220,9 @@ Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d*
                           static_cast<int>(resolution[1])};
   if (!camera.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
   info->camera = camera;
+  std::string unsupported;
+  PATROLMAP_RETURN_IF_ERROR(ReadDistortion(path, root, &info->camera_distortion, &unsupported));
+  if (!unsupported.empty()) spdlog::warn("{}: route frames are matched as undistorted", unsupported);
   PATROLMAP_RETURN_IF_ERROR(ReadRate(path, root, "rate_hz", &info->frame_rate_hz));
   return ReadBodyFromSensor(path, root, body_from_camera);
 }

@@ -18,7 +18,11 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 // put one patrol's surfaces where the other saw through.
 change::RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& current) {
   const auto comparable = [](const std::string& source) { return !source.empty() && source != kPosesFromGps; };
-  return {prior.camera, current.camera, comparable(prior.pose_source) && comparable(current.pose_source)};
+  change::RouteCameras cameras;
+  cameras.prior = prior.camera, cameras.current = current.camera;
+  cameras.poses_comparable = comparable(prior.pose_source) && comparable(current.pose_source);
+  cameras.prior_distortion = prior.distortion, cameras.current_distortion = current.distortion;
+  return cameras;
 }
 
 }  // namespace

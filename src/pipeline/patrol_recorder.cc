@@ -48,6 +48,7 @@ PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
   base_.timed = info.timed;
   if (info.has_poses) base_.pose_source = info.pose_source;
   if (info.camera) base_.camera = *info.camera;
+  base_.distortion = info.camera_distortion;
   if (!info.has_poses || !info.camera) return;
   base_.has_objects = info.has_detections;
   ChooseDepth(config, info);
@@ -268,6 +269,7 @@ PatrolRecord CameraOnlyRecord(const io::LogInfo& info) {
   record.flight = info.flight_id;
   record.timed = info.timed;
   if (info.camera) record.camera = *info.camera;
+  record.distortion = info.camera_distortion;
   return record;
 }
 

@@ -114,9 +114,9 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   EXPECT_NE(LoadBytes(flipped).find("corrupt map (checksum of section"), std::string::npos);
   EXPECT_NE(LoadBytes("%PDF-1.4 something else").find("not a patrolmap map file"), std::string::npos);
   std::string newer = bytes_;
-  const std::uint32_t version = 10;
+  const std::uint32_t version = 11;
   std::memcpy(newer.data() + 8, &version, 4);
-  EXPECT_NE(LoadBytes(newer).find("version 10 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(newer).find("version 11 is newer"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
   // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
   TopoMap unsorted = TwoFlights();
@@ -270,9 +270,9 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
 TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
   testing::TempDir dir;
   // The evicted-voxel count (8 bytes), the depth source ("stereo": a 4-byte length and 6 characters) and the
-  // route frames (none: a 4-byte count), whether the log was timed (1 byte) and the pose source (empty: its
-  // 4-byte length).
-  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 27);
+  // route frames (none: a 4-byte count), whether the log was timed (1 byte), the pose source (empty: its
+  // 4-byte length) and the lens distortion (4 doubles).
+  std::ofstream(dir / "v3.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 3, 59);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v3.pmap", &map).ok()) << LoadMap(dir / "v3.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -283,7 +283,7 @@ TEST(MapFile, VersionThreePatrolRecordsStillLoad) {
 
 TEST(MapFile, VersionFourPatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 19);
+  std::ofstream(dir / "v4.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 4, 51);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v4.pmap", &map).ok()) << LoadMap(dir / "v4.pmap", &map).message();
   ASSERT_NE(map.Patrol("b"), nullptr);
@@ -366,7 +366,7 @@ TEST(MapFile, DamagedRouteFramesAreNamed) {
 // A version-5 map (before the route frames) loads without them.
 TEST(MapFile, VersionFivePatrolRecordsStillLoad) {
   testing::TempDir dir;
-  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 9);
+  std::ofstream(dir / "v5.pmap", std::ios::binary) << OlderPatrolSection(TwoFlights(), dir / "m.pmap", 5, 41);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v5.pmap", &map).ok()) << LoadMap(dir / "v5.pmap", &map).message();
   EXPECT_EQ(map.Patrol("b")->depth_source, "stereo");
@@ -380,7 +380,7 @@ TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
   PatrolRecord record = *untimed.Patrol("b");
   record.timed = false;
   untimed.SetPatrol(record);
-  std::ofstream(dir / "v6.pmap", std::ios::binary) << OlderPatrolSection(untimed, dir / "m.pmap", 6, 5);
+  std::ofstream(dir / "v6.pmap", std::ios::binary) << OlderPatrolSection(untimed, dir / "m.pmap", 6, 37);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v6.pmap", &map).ok()) << LoadMap(dir / "v6.pmap", &map).message();
   EXPECT_TRUE(map.Patrol("b")->timed);
@@ -392,7 +392,7 @@ TEST(MapFile, VersionSixPatrolRecordsLoadAsTimed) {
 TEST(MapFile, VersionSevenKeypointRecordsLoadAsPositions) {
   testing::TempDir dir;
   const TopoMap original = TwoFlights();
-  std::ofstream(dir / "v7.pmap", std::ios::binary) << OlderPatrolSection(original, dir / "m.pmap", 7, 4);
+  std::ofstream(dir / "v7.pmap", std::ios::binary) << OlderPatrolSection(original, dir / "m.pmap", 7, 36);
   TopoMap map;
   ASSERT_TRUE(LoadMap(dir / "v7.pmap", &map).ok()) << LoadMap(dir / "v7.pmap", &map).message();
   ASSERT_EQ(map.node_count(), original.node_count());
@@ -415,13 +415,35 @@ TEST(MapFile, ThePoseSourceRoundTripsAndAnUnknownOneIsRefused) {
   TopoMap loaded;
   ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
   EXPECT_EQ(loaded.Patrol("b")->pose_source, "gps_attitude");
-  std::ofstream(dir / "v8.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 8, 16);
+  std::ofstream(dir / "v8.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 8, 48);
   ASSERT_TRUE(LoadMap(dir / "v8.pmap", &loaded).ok()) << LoadMap(dir / "v8.pmap", &loaded).message();
   EXPECT_EQ(loaded.Patrol("b")->pose_source, "");
   record.pose_source = "gyroscope";
   map.SetPatrol(record);
   ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
   EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("pose source of b"), std::string::npos);
+}
+
+// The lens distortion is kept (format 10); a version-9 map has none, and coefficients no lens has are refused.
+TEST(MapFile, TheLensDistortionRoundTripsAndAnImpossibleOneIsRefused) {
+  testing::TempDir dir;
+  TopoMap map = TwoFlights();
+  PatrolRecord record = *map.Patrol("b");
+  record.distortion = {-0.28, 0.07, 0.0002, 0.00002};  // EuRoC's cam0
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  EXPECT_EQ(loaded.Patrol("b")->distortion, record.distortion);
+  std::ofstream(dir / "v9.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 9, 32);
+  ASSERT_TRUE(LoadMap(dir / "v9.pmap", &loaded).ok()) << LoadMap(dir / "v9.pmap", &loaded).message();
+  EXPECT_EQ(loaded.Patrol("b")->distortion, Distortion{});
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), 11.0}) {
+    record.distortion[1] = bad;
+    map.SetPatrol(record);
+    ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+    EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("camera or views of patrol b"), std::string::npos);
+  }
 }
 
 // Feature positions must be finite, and descriptors one of the stored kinds (vocab/descriptors.h).

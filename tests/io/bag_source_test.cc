@@ -43,10 +43,10 @@ std::vector<std::uint8_t> Image(std::int64_t t, std::uint32_t width, std::uint32
   return w.bytes();
 }
 
-std::vector<std::uint8_t> CameraInfo(double baseline) {
+std::vector<std::uint8_t> CameraInfo(double baseline, double k1 = 0.0) {
   WireWriter w(Wire::kCdr);
   w.Header(0, 0, "cam").Put<std::uint32_t>(2).Put<std::uint32_t>(4).String("plumb_bob");
-  w.Put<std::uint32_t>(5).Doubles({0, 0, 0, 0, 0});
+  w.Put<std::uint32_t>(5).Doubles({k1, 0, 0, 0.001, 0});
   w.Doubles({100, 0, 2, 0, 100, 1, 0, 0, 1}).Doubles({1, 0, 0, 0, 1, 0, 0, 0, 1});
   w.Doubles({100, 0, 2, -100 * baseline, 0, 100, 1, 0, 0, 0, 1, 0});
   w.Put<std::uint32_t>(0).Put<std::uint32_t>(0).Put<std::uint32_t>(0).Put<std::uint32_t>(0);
@@ -124,7 +124,7 @@ class BagSourceTest : public ::testing::Test {
                {"/tf_static", "tf2_msgs/msg/TFMessage"}};
     std::vector<Message>& messages = messages_;
     messages = {{"/tf_static", kSecond / 2, Transforms()},
-                {"/cam/camera_info", kSecond / 2, CameraInfo(0.0)},
+                {"/cam/camera_info", kSecond / 2, CameraInfo(0.0, -0.2)},
                 {"/right/camera_info", kSecond / 2, CameraInfo(0.5)}};
     for (int i = 0; i < 3; ++i) {
       const std::int64_t t = kSecond + i * kSecond / 10;
@@ -211,6 +211,9 @@ TEST_F(BagSourceTest, FramesAreTimedByHeaderStampsAndTurnedGrey) {
   EXPECT_EQ(frames[0].image.at<std::uint8_t>(0, 0), 60);
   ASSERT_TRUE(info.camera.has_value());
   EXPECT_DOUBLE_EQ(info.camera->fx, 100.0);
+  // image_raw's lens, from its camera info's D (k1, k2, p1, p2).
+  EXPECT_DOUBLE_EQ(info.camera_distortion[0], -0.2);
+  EXPECT_DOUBLE_EQ(info.camera_distortion[3], 0.001);
 }
 
 TEST_F(BagSourceTest, ImuSamplesUpToEachFrame) {

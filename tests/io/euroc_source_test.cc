@@ -40,6 +40,7 @@ TEST(Euroc, ReadsFramesImuAndSensorYaml) {
   EXPECT_EQ(info.frame_count, 4);
   ASSERT_TRUE(info.camera.has_value());
   EXPECT_DOUBLE_EQ(info.camera->fy, 31.0);
+  EXPECT_EQ(info.camera_distortion, Distortion{});  // none given
   ASSERT_TRUE(info.camera_from_imu.has_value());
   EXPECT_NEAR((*info.camera_from_imu)(0, 1), 1.0, 1e-12);  // transpose of T_BS's rotation
   Status end;
@@ -358,6 +359,7 @@ TEST(Euroc, Cam1MakesStereoPairsAtCam0sTimes) {
   EXPECT_NEAR(info.stereo->right_from_left_translation.x(), -0.11, 1e-12);
   EXPECT_DOUBLE_EQ(info.stereo->left_distortion[0], 0.01);
   EXPECT_DOUBLE_EQ(info.stereo->left_distortion[3], 0.0002);
+  EXPECT_EQ(info.camera_distortion, info.stereo->left_distortion);  // cam0's lens, for its route frames too
   Status end;
   const std::vector<Frame> frames = ReadAll(source.get(), &end);
   ASSERT_EQ(frames.size(), 3u);
@@ -381,6 +383,26 @@ TEST(Euroc, AStereoCameraOfAnotherModelIsLeftOutNamingItsFile) {
   EXPECT_FALSE(source->info().has_stereo);
   EXPECT_NE(capture.text().find("cam1/sensor.yaml: distortion_model 'equidistant'"), std::string::npos)
       << capture.text();
+}
+
+TEST(Euroc, Cam0OfAnotherModelIsTakenForUndistortedNamingItsFile) {
+  TempDir dir;
+  const std::string log = dir / "flight";
+  MakeEurocLog(log, 2);
+  WriteText(log + "/cam0/sensor.yaml",
+            "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\ndistortion_model: equidistant\n"
+            "distortion_coefficients: [0.1, 0.01, 0.001, 0.0001]\n");
+  testing::LogCapture capture;
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(log, {}, &source).ok());
+  EXPECT_EQ(source->info().camera_distortion, Distortion{});
+  EXPECT_NE(capture.text().find("cam0/sensor.yaml: distortion_model 'equidistant' is not radial-tangential"),
+            std::string::npos)
+      << capture.text();
+  WriteText(log + "/cam0/sensor.yaml",
+            "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\ndistortion_coefficients: [0.1, .nan, 0, 0]\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("cam0/sensor.yaml: distortion_coefficients must be finite"),
+            std::string::npos);
 }
 
 TEST(Euroc, RealSensorYamlFromSharedData) {

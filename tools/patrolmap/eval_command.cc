@@ -195,7 +195,7 @@ bool KeyFrameTruth(const graph::TopoMap& map, int node, const std::vector<eval::
   if (!pose) return false;
   const CameraIntrinsics thumbnail =
       patrol->camera.Scaled(static_cast<double>(n.thumbnail.cols) / patrol->camera.width);
-  *boxes = eval::VisibleChangeBoxes(here, other, n.timestamp_ns, *pose, thumbnail, options);
+  *boxes = eval::VisibleChangeBoxes(here, other, n.timestamp_ns, *pose, thumbnail, options, patrol->distortion);
   return true;
 }
 
@@ -248,7 +248,7 @@ bool RouteFrameTruth(const PatrolRecord& record, const RouteFrame& frame, const 
   if (image.empty() || !pose || !record.camera.valid()) return false;
   options.min_area_px = kVisibleShare * image.total();
   const CameraIntrinsics camera = record.camera.Scaled(static_cast<double>(image.cols) / record.camera.width);
-  *changes = eval::VisibleChanges(here, other, frame.timestamp_ns, *pose, camera, options);
+  *changes = eval::VisibleChanges(here, other, frame.timestamp_ns, *pose, camera, options, record.distortion);
   *size = image.size();
   return true;
 }

@@ -19,6 +19,7 @@
 
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/types.h"
+#include "patrolmap/depth/lens.h"
 
 namespace patrolmap::change {
 
@@ -31,9 +32,9 @@ struct KeyFrameView {
   cv::Mat descriptors;              // float, 8-bit or packed 4-bit rows (vocab/descriptors.h)
   double feature_scale = 1.0;
   // Route frames only, when their depth is known (route_depth.h): depth [m] on the image's grid (CV_32F, 0 =
-  // unknown), the camera at the image's size and its pose, and the range error per squared metre of depth.
+  // unknown), the camera and its lens at the image's size, its pose, and the range error per squared metre of depth.
   cv::Mat depth;
-  CameraIntrinsics camera;
+  depth::Lens lens;
   CameraPoseSample pose;
   double range_sigma_per_m2 = 0.0;
 };

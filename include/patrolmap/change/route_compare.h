@@ -66,13 +66,15 @@ struct RouteComparison {
 void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
                       AppearanceChange* change);
 
-// The cameras of the two patrols' route frames (PatrolRecord::camera, at the log's resolution), and whether the two
-// patrols' poses lie in one world frame. With change.route.depth on and such poses, each route frame with a pose
+// The cameras of the two patrols' route frames (PatrolRecord::camera, at the log's resolution) and their lenses'
+// distortion (PatrolRecord::distortion; route frames are kept raw), and whether the two patrols' poses lie in one
+// world frame. With change.route.depth on and such poses, each route frame with a pose
 // that a compared pair uses gets depth from the frames before and after it in its patrol (route_depth.h), and each
 // compared pair is also tested by visibility.
 struct RouteCameras {
   CameraIntrinsics prior, current;
   bool poses_comparable = false;
+  Distortion prior_distortion{}, current_distortion{};
 };
 
 // The route frame decoded (grey), with its SIFT features; feature_scale 1.

@@ -15,6 +15,7 @@
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/types.h"
+#include "patrolmap/depth/lens.h"
 
 namespace patrolmap::change {
 
@@ -24,12 +25,13 @@ struct RouteNeighbour {
   CameraPoseSample pose;
 };
 
-// Gives `view` (a route frame decoded, of camera `camera` at its own size, seen from `pose`) depth from its
+// Gives `view` (a route frame decoded, seen through `lens` at its own size from `pose`) depth from its
 // neighbours: each one standing far enough, across the optical axis (RouteDepthOptions), is matched as a stereo pair.
 // Where two give depth they must agree within the matching's range errors (repeated texture, a brick wall, matches
 // a wrong period at a depth that depends on the baseline) and are averaged; elsewhere the one depth is kept. False,
-// and `view` left without depth, when no neighbour gives any.
-bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const CameraIntrinsics& camera,
+// and `view` left without depth, when no neighbour gives any. A distorting lens is undone in the matching; the depth
+// comes back on the raw image's grid.
+bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const depth::Lens& lens,
                     const CameraPoseSample& pose, const RouteDepthOptions& options, KeyFrameView* view);
 
 // The pixels of `current` (CV_8U, 255 = changed) where one patrol's surface stands in the space the other patrol

@@ -19,10 +19,10 @@
 
 namespace patrolmap {
 
-// The image box around `corners` seen from `pose` through `camera` (not clipped to the image); empty when
-// any of them lies less than 0.1 m in front of the camera.
+// The image box around `corners` seen from `pose` through `camera` and its lens (not clipped to the image); empty
+// when any of them lies less than 0.1 m in front of the camera.
 cv::Rect2d ProjectCorners(const CameraIntrinsics& camera, const CameraPoseSample& pose,
-                          const std::array<Eigen::Vector3d, 8>& corners);
+                          const std::array<Eigen::Vector3d, 8>& corners, const Distortion& distortion = {});
 
 // One object of a patrol's object map (paper 000): detections associated
 // across frames, with the label-confidence and label-count accumulators.
@@ -110,6 +110,7 @@ inline bool KnownPoseSource(const std::string& source) {
 struct PatrolRecord {
   std::string flight;
   CameraIntrinsics camera;              // of the images the views and detections refer to
+  Distortion distortion{};              // of the camera's lens; its raw images (route frames) keep it
   int feature_image_width = 0;          // width of the images its key-frame features were found in
   std::vector<CameraPoseSample> views;  // camera poses sampled along the flight
   bool has_objects = false;             // the log had detections

@@ -64,12 +64,22 @@ struct ObjectObservation {
   std::optional<Eigen::Vector3d> centroid_camera;  // 3D centroid in the camera frame, when the detector gives one
 };
 
+// The radial-tangential lens distortion of a camera's raw images (k1, k2, p1, p2: OpenCV's and EuRoC's model);
+// all zero for a pinhole camera.
+using Distortion = std::array<double, 4>;
+
+// Where a normalized image point (x/z, y/z) lands through the lens: k1, k2 bend it radially, p1, p2 tangentially.
+// Beyond the radius where the radial term stops growing (r^2 with 1 + 3 k1 r^2 + 5 k2 r^4 <= 0) the polynomial
+// folds back towards the centre; `folded` (when given) then says so, and the point is returned undistorted (it lies
+// off any image the lens makes).
+Eigen::Vector2d Distorted(const Distortion& d, const Eigen::Vector2d& point, bool* folded = nullptr);
+
 // A calibrated stereo pair (EuRoC cam0 and cam1 with their sensor.yaml): the intrinsics and the
-// radial-tangential distortion (k1, k2, p1, p2) of each camera, and where the right camera sits in the left
+// distortion of each camera, and where the right camera sits in the left
 // one's frame: x_right = right_from_left_rotation * x_left + right_from_left_translation [m].
 struct StereoCalibration {
   CameraIntrinsics left, right;
-  std::array<double, 4> left_distortion{}, right_distortion{};
+  Distortion left_distortion{}, right_distortion{};
   Eigen::Matrix3d right_from_left_rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d right_from_left_translation = Eigen::Vector3d::Zero();
 };

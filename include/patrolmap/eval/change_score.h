@@ -127,10 +127,12 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
                             const std::vector<TruthObject>& after, const ChangeScoreOptions& options);
 
 // The boxes, in a key frame of the flight whose objects are `here`, of the objects changed with respect to
-// `other` that the key frame shows. `camera` is the thumbnail's camera, `pose` the key frame's.
+// `other` that the key frame shows. `camera` is the thumbnail's camera (with its lens's `distortion`), `pose` the key
+// frame's.
 std::vector<cv::Rect2d> VisibleChangeBoxes(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
                                            TimestampNs time_ns, const CameraPoseSample& pose,
-                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options);
+                                           const CameraIntrinsics& camera, const ChangeScoreOptions& options,
+                                           const Distortion& distortion = {});
 
 struct VisibleChange {
   int id = 0;  // the object's
@@ -139,7 +141,8 @@ struct VisibleChange {
 // VisibleChangeBoxes with the objects' ids.
 std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
                                           TimestampNs time_ns, const CameraPoseSample& pose,
-                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options);
+                                          const CameraIntrinsics& camera, const ChangeScoreOptions& options,
+                                          const Distortion& distortion = {});
 
 // Whether `to_other` (a homography) maps the box's centre inside a width x height image.
 bool CentreMapsInside(const Eigen::Matrix3d& to_other, int width, int height, const cv::Rect2d& box);

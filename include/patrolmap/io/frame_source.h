@@ -28,6 +28,7 @@ struct LogInfo {
   std::string kind;                        // "euroc", "image-folder", "image-pattern", "video"
   std::string flight_id;                   // from meta.yaml, else the folder name
   std::optional<CameraIntrinsics> camera;  // from cam0/sensor.yaml when present
+  Distortion camera_distortion{};          // of cam0's lens (sensor.yaml, a bag's camera info); zero when unknown
   // Rotation taking IMU-frame vectors into the camera frame, when both
   // extrinsics are known (EuRoC T_BS of cam0 and imu0).
   std::optional<Eigen::Matrix3d> camera_from_imu;
