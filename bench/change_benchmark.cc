@@ -17,6 +17,7 @@
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/change/route_compare.h"
 #include "patrolmap/change/route_depth.h"
+#include "patrolmap/depth/lens.h"
 #include "patrolmap/sim/objects.h"
 #include "patrolmap/sim/renderer.h"
 #include "patrolmap/sim/village.h"
@@ -213,25 +214,42 @@ RouteFrame RouteFrameAt(double x, const std::vector<sim::WorldObject>& objects, 
   return frame;
 }
 
+// EuRoC cam0's lens (k1 -0.28), as a route frame's lens in BM_RouteMotionDepth/1 and BM_RouteFrameLens.
+constexpr Distortion kEurocDistortion{-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+
+// `image` as seen through `lens`: each raw pixel shows what its undistorted place shows.
+cv::Mat ThroughLens(const depth::Lens& lens, const cv::Mat& image, int interpolation) {
+  if (!lens.distorted()) return image;
+  cv::Mat raw;
+  cv::remap(image, raw, lens.pinhole_at(), cv::noArray(), interpolation, cv::BORDER_CONSTANT, cv::Scalar());
+  return raw;
+}
+
 // Depth of one route frame from the frames 1.3 m before and after it (two stereo matchings): once per frame of
-// either route when change.route.depth is on. Counters: the share of pixels given depth, and of those the share
-// within 5 % of the rendered depth.
+// either route when change.route.depth is on. /0: a pinhole camera; /1: the frames seen through EuRoC cam0's lens,
+// undone in the matching. Counters: the share of pixels given depth, and of those the share within 5 % of the
+// rendered depth.
 void BM_RouteMotionDepth(benchmark::State& state) {
+  const depth::Lens lens(kCamera, state.range(0) == 1 ? kEurocDistortion : Distortion{});
   const std::vector<sim::WorldObject> objects = sim::PlaceObjects(30, 1);
   const View here = Render(20.0, objects, {});
   const View before = Render(18.7, objects, {}), after = Render(21.3, objects, {});
-  const std::vector<change::RouteNeighbour> neighbours = {{before.image, before.sample}, {after.image, after.sample}};
+  const std::vector<change::RouteNeighbour> neighbours = {
+      {ThroughLens(lens, before.image, cv::INTER_LINEAR), before.sample},
+      {ThroughLens(lens, after.image, cv::INTER_LINEAR), after.sample}};
+  const cv::Mat image = ThroughLens(lens, here.image, cv::INTER_LINEAR);
+  const cv::Mat truth_m = ThroughLens(lens, here.depth_m, cv::INTER_NEAREST);
   change::KeyFrameView view;
   for (auto _ : state) {
     view = change::KeyFrameView();
-    view.image = here.image;
-    change::AddMotionDepth(neighbours, depth::Lens(kCamera), here.sample, change::RouteDepthOptions{}, &view);
+    view.image = image;
+    change::AddMotionDepth(neighbours, lens, here.sample, change::RouteDepthOptions{}, &view);
   }
   int known = 0, within = 0;
   for (int y = 0; y < view.depth.rows; ++y) {
     for (int x = 0; x < view.depth.cols; ++x) {
-      const float z = view.depth.at<float>(y, x), truth = here.depth_m.at<float>(y, x);
-      if (!(z > 0.0f)) continue;
+      const float z = view.depth.at<float>(y, x), truth = truth_m.at<float>(y, x);
+      if (!(z > 0.0f) || !(truth > 0.0f)) continue;
       ++known;
       within += std::abs(z - truth) <= 0.05f * truth;
     }
@@ -239,7 +257,13 @@ void BM_RouteMotionDepth(benchmark::State& state) {
   state.counters["known_share"] = static_cast<double>(known) / view.depth.total();
   state.counters["within_5_percent"] = known > 0 ? static_cast<double>(within) / known : 0.0;
 }
-BENCHMARK(BM_RouteMotionDepth)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RouteMotionDepth)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// A route's lens at 376x240 (each pixel's undistorted place): once per patrol compared, when its lens distorts.
+void BM_RouteFrameLens(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(depth::Lens(kCamera, kEurocDistortion).pinhole_at().data);
+}
+BENCHMARK(BM_RouteFrameLens)->Unit(benchmark::kMillisecond);
 
 // Decoding one route frame and finding its SIFT features: done once per frame of either route.
 void BM_RouteFrameFeatures(benchmark::State& state) {

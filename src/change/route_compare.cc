@@ -383,6 +383,15 @@ KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features) {
   return view;
 }
 
+RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& current) {
+  const auto comparable = [](const std::string& source) { return !source.empty() && source != kPosesFromGps; };
+  RouteCameras cameras;
+  cameras.prior = prior.camera, cameras.current = current.camera;
+  cameras.poses_comparable = comparable(prior.pose_source) && comparable(current.pose_source);
+  cameras.prior_distortion = prior.distortion, cameras.current_distortion = current.distortion;
+  return cameras;
+}
+
 RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
                               const AppearanceOptions& appearance, const RouteCameras& cameras) {

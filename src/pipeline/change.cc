@@ -14,17 +14,6 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Route frames get depth only from poses both patrols place in one world frame: a GPS fix's bias (metres) would
-// put one patrol's surfaces where the other saw through.
-change::RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& current) {
-  const auto comparable = [](const std::string& source) { return !source.empty() && source != kPosesFromGps; };
-  change::RouteCameras cameras;
-  cameras.prior = prior.camera, cameras.current = current.camera;
-  cameras.poses_comparable = comparable(prior.pose_source) && comparable(current.pose_source);
-  cameras.prior_distortion = prior.distortion, cameras.current_distortion = current.distortion;
-  return cameras;
-}
-
 }  // namespace
 
 Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const std::string& current,
@@ -72,7 +61,7 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   }
   if (along_route) {
     report->route = change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route,
-                                          options.appearance, RouteCamerasOf(*prior_record, *current_record));
+                                          options.appearance, change::RouteCamerasOf(*prior_record, *current_record));
   }
   report->seconds_appearance = SecondsSince(start);
   if (prior_record == nullptr || current_record == nullptr) return Status::Ok();

@@ -121,6 +121,25 @@ TEST(RouteCompare, FramesWithPosesGetDepthAndAWallSeenAgainStaysUnchanged) {
   EXPECT_EQ(apart.prior_depth_frames + apart.current_depth_frames, 0);
 }
 
+// Each patrol's lens goes with its frames; poses from GPS fixes (metres of bias) or none give no depth.
+TEST(RouteCompare, TheRouteCamerasCarryEachLensAndComparePosesOfOneWorldFrameOnly) {
+  PatrolRecord prior, current;
+  prior.camera = current.camera = CameraIntrinsics{229.0, 229.0, 187.5, 119.5, 376, 240};
+  prior.distortion = {-0.28, 0.07, 0.0, 0.0};
+  current.distortion = {-0.1, 0.0, 0.001, 0.0};
+  prior.pose_source = kPosesFromStateEstimate;
+  current.pose_source = kPosesFromFile;
+  RouteCameras cameras = RouteCamerasOf(prior, current);
+  EXPECT_TRUE(cameras.poses_comparable);
+  EXPECT_EQ(cameras.prior_distortion, prior.distortion);
+  EXPECT_EQ(cameras.current_distortion, current.distortion);
+  EXPECT_EQ(cameras.current.fx, 229.0);
+  current.pose_source = kPosesFromGps;
+  EXPECT_FALSE(RouteCamerasOf(prior, current).poses_comparable);
+  current.pose_source.clear();
+  EXPECT_FALSE(RouteCamerasOf(prior, current).poses_comparable);
+}
+
 TEST(RouteCompare, AnObjectSeenFromSeveralFramesIsFoundWithTheirVotes) {
   const cv::Mat facade = Facade(4);
   cv::Mat changed = facade.clone();

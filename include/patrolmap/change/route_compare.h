@@ -77,6 +77,11 @@ struct RouteCameras {
   Distortion prior_distortion{}, current_distortion{};
 };
 
+// The route cameras of two patrols. Their poses count as lying in one world frame when both come from a state
+// estimate, a pose topic or a pose file: a GPS fix's bias (metres) would put one patrol's surfaces where the other saw
+// through.
+RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& current);
+
 // The route frame decoded (grey), with its SIFT features; feature_scale 1.
 KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features);
 
