@@ -46,6 +46,13 @@ expect "map sample" 0 "1 log: 3 nodes" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/map"
 [[ -s "$work/map/nodes.csv" && -s "$work/map/loop_closures.csv" ]] || { echo "FAIL map outputs missing"; failures=$((failures + 1)); }
 expect "info" 0 "map.pmap: .* KB, 1 flight, 3 nodes, 2 traversals" -- "$bin" info "$work/map/map.pmap"
+# An image folder has no calibration of its own: --camera gives it one (a EuRoC sensor.yaml); a wrong one is named.
+printf 'intrinsics: [97.4, 97.4, 79.5, 50.6]\nresolution: [320, 204]\n' >"$work/cam_wrong.yaml"
+expect "camera file of another size" 1 "cam_wrong.yaml: resolution 320x204, but .*0.png is 160x102" -- \
+  "$bin" map "$source_dir/flight_logs/sample/cam0/data" --fps 10 --camera "$work/cam_wrong.yaml" --out "$work/cammap"
+expect "camera file" 0 "1 log: " -- "$bin" map "$source_dir/flight_logs/sample/cam0/data" --fps 10 \
+  --camera "$source_dir/flight_logs/sample/cam0/sensor.yaml" --vocabulary "$source_dir/vocab/default.pmvoc" \
+  --out "$work/cammap"
 "$bin" -q simulate --route street --walls 3 --speed 4 --resolution 160x102 --plain-lighting --seed 2 --out "$work/second" >/dev/null
 expect "patrol" 0 "1 log: 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"

@@ -12,6 +12,7 @@
 #include "image_list_source.h"
 #include "image_times.h"
 #include "patrolmap/core/csv.h"
+#include "patrolmap/io/camera_file.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/io/yaml_file.h"
@@ -115,6 +116,21 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
   return Status::Ok();
 }
 
+// A sensor.yaml's intrinsics and resolution.
+Status ReadIntrinsics(const std::string& path, const YAML::Node& root, CameraIntrinsics* camera) {
+  std::vector<double> intrinsics, resolution;
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
+  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
+  *camera = {intrinsics[0],
+             intrinsics[1],
+             intrinsics[2],
+             intrinsics[3],
+             static_cast<int>(resolution[0]),
+             static_cast<int>(resolution[1])};
+  if (!camera->valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
+  return Status::Ok();
+}
+
 // A sensor.yaml's radial-tangential distortion (k1, k2, p1, p2; none when absent). Another distortion model is
 // valid but not undone: `unsupported` receives why, and `distortion` stays zero.
 Status ReadDistortion(const std::string& path, const YAML::Node& root, Distortion* distortion,
@@ -150,16 +166,7 @@ struct StereoCamera {
 Status ReadStereoCamera(const std::string& path, StereoCamera* camera, std::string* unsupported) {
   YAML::Node root;
   PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
-  std::vector<double> intrinsics, resolution;
-  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
-  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
-  camera->intrinsics = {intrinsics[0],
-                        intrinsics[1],
-                        intrinsics[2],
-                        intrinsics[3],
-                        static_cast<int>(resolution[0]),
-                        static_cast<int>(resolution[1])};
-  if (!camera->intrinsics.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
+  PATROLMAP_RETURN_IF_ERROR(ReadIntrinsics(path, root, &camera->intrinsics));
   PATROLMAP_RETURN_IF_ERROR(ReadDistortion(path, root, &camera->distortion, unsupported));
   return ReadBodyFromSensor(path, root, &camera->body_rotation, &camera->body_translation);
 }
@@ -209,16 +216,8 @@ Status ReadStereoPairs(const std::string& log, const std::vector<ImageEntry>& le
 Status ReadCameraSensor(const std::string& path, LogInfo* info, Eigen::Matrix3d* body_from_camera) {
   YAML::Node root;
   PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
-  std::vector<double> intrinsics, resolution;
-  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
-  PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
-  CameraIntrinsics camera{intrinsics[0],
-                          intrinsics[1],
-                          intrinsics[2],
-                          intrinsics[3],
-                          static_cast<int>(resolution[0]),
-                          static_cast<int>(resolution[1])};
-  if (!camera.valid()) return Status::DataLoss(path + ": intrinsics or resolution not positive");
+  CameraIntrinsics camera;
+  PATROLMAP_RETURN_IF_ERROR(ReadIntrinsics(path, root, &camera));
   info->camera = camera;
   std::string unsupported;
   PATROLMAP_RETURN_IF_ERROR(ReadDistortion(path, root, &info->camera_distortion, &unsupported));
@@ -303,6 +302,16 @@ void PosesFromFixes(const std::string& log, const LogInfo& info, const std::vect
 }
 
 }  // namespace
+
+Status ReadCameraFile(const std::string& path, CameraIntrinsics* camera, Distortion* distortion) {
+  YAML::Node root;
+  PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(path, &root));
+  PATROLMAP_RETURN_IF_ERROR(ReadIntrinsics(path, root, camera));
+  std::string unsupported;
+  *distortion = Distortion{};
+  PATROLMAP_RETURN_IF_ERROR(ReadDistortion(path, root, distortion, &unsupported));
+  return unsupported.empty() ? Status::Ok() : Status::InvalidArgument(unsupported);
+}
 
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source) {
   std::string log = folder;

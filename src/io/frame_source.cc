@@ -22,6 +22,11 @@ Status FrameSource::UsePoseFile(const std::string& path) {
                                  info().kind);
 }
 
+Status FrameSource::UseCameraFile(const std::string& path) {
+  return Status::InvalidArgument(path + ": a camera file calibrates an image folder, pattern or EuRoC log, not a " +
+                                 info().kind);
+}
+
 void FrameSource::RecordSkipped(std::int64_t index, std::string reason) {
   spdlog::warn("skipping frame {}: {}", index, reason);
   skipped_.push_back({index, std::move(reason)});

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "patrolmap/io/camera_file.h"
 #include "patrolmap/io/pose_file.h"
 
 namespace patrolmap::io {
@@ -38,6 +39,27 @@ Status ImageListSource::UsePoseFile(const std::string& path) {
   sensors_.poses = std::move(poses);
   info_.has_poses = true;
   info_.pose_source = kPosesFromFile;
+  return Status::Ok();
+}
+
+Status ImageListSource::UseCameraFile(const std::string& path) {
+  CameraIntrinsics camera;
+  Distortion distortion;
+  PATROLMAP_RETURN_IF_ERROR(ReadCameraFile(path, &camera, &distortion));
+  // The resolution must be the images': the first readable one is decoded to see.
+  for (const ImageEntry& entry : entries_) {
+    const cv::Mat image = cv::imread(entry.path, cv::IMREAD_UNCHANGED);
+    if (image.empty()) continue;
+    if (image.cols != camera.width || image.rows != camera.height) {
+      return Status::InvalidArgument(path + ": resolution " + std::to_string(camera.width) + "x" +
+                                     std::to_string(camera.height) + ", but " + entry.path + " is " +
+                                     std::to_string(image.cols) + "x" + std::to_string(image.rows));
+    }
+    break;
+  }
+  if (info_.camera) spdlog::info("{}: camera calibration from {}, not the log's own", info_.path, path);
+  info_.camera = camera;
+  info_.camera_distortion = distortion;
   return Status::Ok();
 }
 

@@ -30,6 +30,7 @@ class ImageListSource : public FrameSource {
   Status Next(bool decode_image, Frame* frame) override;
   const LogInfo& info() const override { return info_; }
   Status UsePoseFile(const std::string& path) override;
+  Status UseCameraFile(const std::string& path) override;
 
  private:
   void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);

@@ -234,8 +234,12 @@ std::vector<std::string> FlightWarnings(const io::LogInfo& info, const Config& c
                        "not used: appearance change only");
   } else if (change_data && !info.camera) {
     warnings.push_back(info.path +
-                       ": no camera intrinsics (cam0/sensor.yaml), so its detections and depth are not used: "
-                       "appearance change only");
+                       ": no camera intrinsics (cam0/sensor.yaml; --camera FILE), so its detections and depth are not "
+                       "used: appearance change only");
+  } else if (info.has_poses && !info.camera) {
+    warnings.push_back(info.path +
+                       ": camera poses but no camera intrinsics (cam0/sensor.yaml; --camera FILE), so its route "
+                       "frames get no depth: appearance change from brightness only");
   }
   if (result.stats.lost_key_frames > 0) {
     warnings.push_back(info.path + ": " +

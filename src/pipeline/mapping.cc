@@ -109,6 +109,7 @@ Status MapSource(const MappingRequest& request, const std::string& spec, const C
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(spec, config.input, &source));
   if (!request.poses.empty()) PATROLMAP_RETURN_IF_ERROR(source->UsePoseFile(request.poses));
+  if (!request.camera.empty()) PATROLMAP_RETURN_IF_ERROR(source->UseCameraFile(request.camera));
   const io::LogInfo& info = source->info();
   if (request.pass.node_every > 0 && !info.timed) {
     spdlog::warn(

@@ -214,5 +214,49 @@ TEST(Video, GarbageFileFails) {
   EXPECT_NE(status.message().find("junk.mp4"), std::string::npos);
 }
 
+// An image folder has no calibration of its own; --camera gives it one (a EuRoC sensor.yaml), lens and all.
+TEST(ImageFolder, TakesItsCameraFromACameraFile) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "images");
+  for (int i : {1, 2}) cv::imwrite(dir / ("images/" + std::to_string(i) + ".png"), TestImage(i));  // 32x24
+  const std::string intrinsics = "intrinsics: [30.0, 31.0, 15.5, 11.5]\n";
+  WriteText(dir / "cam.yaml", intrinsics +
+                                  "resolution: [32, 24]\ndistortion_model: radial-tangential\n"
+                                  "distortion_coefficients: [-0.28, 0.07, 0.0002, 0.00002]\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenImageFolder(dir / "images", {10.0, {}}, &source).ok());
+  EXPECT_FALSE(source->info().camera.has_value());
+  ASSERT_TRUE(source->UseCameraFile(dir / "cam.yaml").ok());
+  ASSERT_TRUE(source->info().camera.has_value());
+  EXPECT_DOUBLE_EQ(source->info().camera->fy, 31.0);
+  EXPECT_EQ(source->info().camera_distortion, (Distortion{-0.28, 0.07, 0.0002, 0.00002}));
+  const auto refused = [&](const std::string& text) {
+    WriteText(dir / "bad.yaml", text);
+    return source->UseCameraFile(dir / "bad.yaml").message();
+  };
+  EXPECT_NE(refused(intrinsics + "resolution: [64, 48]\n").find("bad.yaml: resolution 64x48, but "), std::string::npos);
+  EXPECT_NE(refused(intrinsics + "resolution: [32, 24]\ndistortion_model: equidistant\n")
+                .find("bad.yaml: distortion_model 'equidistant' is not radial-tangential"),
+            std::string::npos);
+  EXPECT_NE(refused("resolution: [32, 24]\n").find("bad.yaml"), std::string::npos);
+  EXPECT_NE(refused(intrinsics + "resolution: [32, 24]\ndistortion_coefficients: [0.1, 0.2]\n").find("bad.yaml"),
+            std::string::npos);
+  EXPECT_FALSE(source->UseCameraFile(dir / "missing.yaml").ok());
+  EXPECT_DOUBLE_EQ(source->info().camera->fy, 31.0);  // a refused file leaves the camera as it was
+}
+
+TEST(Video, RefusesACameraFile) {
+  TempDir dir;
+  const std::string video = dir / "clip.avi";
+  cv::VideoWriter writer(video, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10, cv::Size(32, 24), false);
+  if (!writer.isOpened()) GTEST_SKIP() << "no MJPG writer";
+  for (int i = 0; i < 3; ++i) writer.write(TestImage(10 * i));
+  writer.release();
+  WriteText(dir / "cam.yaml", "intrinsics: [30, 30, 15.5, 11.5]\nresolution: [32, 24]\n");
+  std::unique_ptr<FrameSource> source;
+  ASSERT_TRUE(OpenLog(video, {}, &source).ok());
+  EXPECT_NE(source->UseCameraFile(dir / "cam.yaml").message().find("not a video"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace patrolmap::io

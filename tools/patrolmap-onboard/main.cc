@@ -94,6 +94,10 @@ int main(int argc, char** argv) {
                  "camera poses of the log from a file: TUM (t tx ty tz qx qy qz qw per line) or KITTI (a 3x4 "
                  "matrix per image); replaces the log's state estimate")
       ->check(CLI::ExistingFile);
+  app.add_option("--camera", arguments.request.camera,
+                 "the camera's calibration, as a EuRoC sensor.yaml (intrinsics, resolution, optional "
+                 "radial-tangential distortion), for image folders and patterns; replaces a EuRoC log's own")
+      ->check(CLI::ExistingFile);
   app.add_option(
          "--topic", arguments.request.topics,
          "a ROS bag's topic for a role, as ROLE=TOPIC (camera, camera_info, imu, gps, pose, depth, right); repeatable")

@@ -32,6 +32,9 @@ void AddTopicOption(CLI::App* app, std::vector<std::string>* topics);
 // --poses: the camera poses of the log from a TUM or KITTI pose file (change detection needs them).
 void AddPosesOption(CLI::App* app, std::string* poses);
 
+// --camera: the camera's calibration for logs without one (image folders and patterns), as a EuRoC sensor.yaml.
+void AddCameraOption(CLI::App* app, std::string* camera);
+
 // Prints one line on what changed between the report's flights (diff and patrol).
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out);
 

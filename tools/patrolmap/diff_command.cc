@@ -69,6 +69,13 @@ void AddPosesOption(CLI::App* app, std::string* poses) {
       ->check(CLI::ExistingFile);
 }
 
+void AddCameraOption(CLI::App* app, std::string* camera) {
+  app->add_option("--camera", *camera,
+                  "the camera's calibration, as a EuRoC sensor.yaml (intrinsics, resolution, optional "
+                  "radial-tangential distortion), for image folders and patterns; replaces a EuRoC log's own")
+      ->check(CLI::ExistingFile);
+}
+
 void PrintChangeSummary(const change::ChangeReport& report, const std::string& out) {
   std::printf("changes %s -> %s: %zu places compared, %d with appearance changes", report.prior_flight.c_str(),
               report.current_flight.c_str(), report.places.size(), report.ChangedPlaces());

@@ -59,6 +59,7 @@ Command AddPatrolCommand(CLI::App* app) {
   AddFpsOption(app, &arguments->request.fps);
   AddTopicOption(app, &arguments->request.topics);
   AddPosesOption(app, &arguments->request.poses);
+  AddCameraOption(app, &arguments->request.camera);
   app->footer(
       "Closes loops of the new flight against every earlier flight of the map and writes the extended map to "
       "OUT/map.pmap, the new nodes and loop closures to OUT/nodes.csv and OUT/loop_closures.csv, and what changed "
@@ -81,6 +82,7 @@ Command AddMapCommand(CLI::App* app) {
   AddFpsOption(app, &arguments->request.fps);
   AddTopicOption(app, &arguments->request.topics);
   AddPosesOption(app, &arguments->request.poses);
+  AddCameraOption(app, &arguments->request.camera);
   app->add_flag("--every-frame", arguments->every_frame,
                 "make every image a node, without key-location detection (image collections, place recognition "
                 "alone); without timestamps 'recent' is counted in images (place.exclude_recent_images)");

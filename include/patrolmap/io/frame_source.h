@@ -75,6 +75,11 @@ class FrameSource {
   // Next(). Sources whose frame times are not known in advance (videos, cameras) refuse it.
   virtual Status UsePoseFile(const std::string& path);
 
+  // Takes the camera's calibration from a file (io/camera_file.h) instead of the log's own, before the first Next():
+  // image folders and patterns have none. Fails naming the file when it cannot be read or its resolution is not the
+  // images'; sources that are not lists of image files (videos, bags, cameras) refuse it.
+  virtual Status UseCameraFile(const std::string& path);
+
   const std::vector<SkippedFrame>& skipped() const { return skipped_; }
 
   // Whether the next decoded frame should also keep its colour image (Frame::colour). Image folders, EuRoC

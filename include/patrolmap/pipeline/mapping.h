@@ -33,6 +33,7 @@ struct MappingRequest {
   double fps = 0.0;                  // rate of logs without timestamps [Hz] (0: their own)
   std::vector<std::string> topics;   // a bag's topics as ROLE=NAME (io::ParseTopicChoice)
   std::string poses;                 // camera poses of the (one) log from a TUM or KITTI file (io/pose_file.h)
+  std::string camera;                // the logs' camera calibration from a file (io/camera_file.h)
   FlightPassOptions pass;
   DriveOptions drive;  // a live camera is never paced (it paces itself)
   // With a prior map that has a flight: append each change found while flying to OUT/events.jsonl.
