@@ -514,6 +514,22 @@ TEST(Lens, WithoutDistortionItIsAPinholeAndTheImageIsLeftAlone) {
   EXPECT_EQ(lens.ToRaw(image).data, image.data);
 }
 
+// The largest coefficients a map may hold: the undistortion may not converge, but nothing is left undefined.
+TEST(Lens, AnExtremeLensLeavesNoPixelUndefined) {
+  const CameraIntrinsics camera{100.0, 100.0, 31.5, 23.5, 64, 48};
+  const Lens lens(camera, {0.0, 0.0, 9.9, 9.9});  // OpenCV gives most pixels no finite undistorted place
+  ASSERT_TRUE(lens.distorted());
+  const cv::Mat raw = lens.ToRaw(cv::Mat(48, 64, CV_32F, cv::Scalar(5.0f)));
+  EXPECT_EQ(cv::countNonZero(raw != raw), 0);  // no NaN
+  for (int v = 0; v < camera.height; v += 5) {
+    for (int u = 0; u < camera.width; u += 5) {
+      ASSERT_TRUE(lens.Ray(u, v).allFinite());
+      Eigen::Vector2d pixel;
+      if (lens.Project(lens.Ray(u, v), &pixel)) ASSERT_TRUE(pixel.allFinite());
+    }
+  }
+}
+
 TEST(Lens, ToRawTakesEachRawPixelFromItsUndistortedPlace) {
   const Lens lens(kEurocCamera, kEurocDistortion);
   cv::Mat pinhole(480, 752, CV_32F);  // each pixel holds its column

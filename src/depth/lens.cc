@@ -1,6 +1,7 @@
 #include "patrolmap/depth/lens.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <opencv2/calib3d.hpp>
@@ -28,11 +29,15 @@ Lens::Lens(const CameraIntrinsics& camera, const Distortion& distortion) : camer
   cv::undistortPoints(
       raw, pinhole, k, cv::Mat(distortion), cv::noArray(), k,
       cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, kUndistortIterations, kUndistortEpsilon));
-  pinhole_at_ = cv::Mat(pinhole, true).reshape(2, camera.height);
-  for (const cv::Point2f& p : pinhole) {
+  for (cv::Point2f& p : pinhole) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) {  // the fixed point diverged: a pixel no ray reaches
+      p = cv::Point2f(-1.0f, -1.0f);
+      continue;
+    }
     const double x = (p.x - camera.cx) / camera.fx, y = (p.y - camera.cy) / camera.fy;
     widest_squared_ = std::max(widest_squared_, x * x + y * y);
   }
+  pinhole_at_ = cv::Mat(pinhole, true).reshape(2, camera.height);
 }
 
 Eigen::Vector3d Lens::Ray(int u, int v) const {

@@ -438,9 +438,6 @@ bool ValidPose(const CameraPoseSample& v) {
   return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
 }
 
-// Distortion coefficients beyond this are no lens's (EuRoC's k1 is -0.28, fisheye lenses are another model).
-constexpr double kMaxDistortion = 10.0;
-
 // A patrol's camera as the pipeline records it (valid, or all zero for a log without one), its lens distortion
 // (finite and bounded), and valid views.
 bool ValidCameraAndViews(const PatrolRecord& p) {
@@ -450,11 +447,7 @@ bool ValidCameraAndViews(const PatrolRecord& p) {
   const bool camera_ok = unknown || (Finite({c.fx, c.fy, c.cx, c.cy}) && c.valid() && c.width <= kMaxImageSide &&
                                      c.height <= kMaxImageSide);
   if (!camera_ok || p.feature_image_width < 0 || p.feature_image_width > kMaxImageSide) return false;
-  const auto& [k1, k2, p1, p2] = p.distortion;
-  if (!Finite({k1, k2, p1, p2}) || std::abs(k1) > kMaxDistortion || std::abs(k2) > kMaxDistortion ||
-      std::abs(p1) > kMaxDistortion || std::abs(p2) > kMaxDistortion) {
-    return false;
-  }
+  if (!PlausibleDistortion(p.distortion)) return false;
   return std::all_of(p.views.begin(), p.views.end(), ValidPose);
 }
 

@@ -614,7 +614,13 @@ Status DistortionOf(const rosmsg::CameraInfoMessage& camera, Distortion* distort
   if (camera.distortion.size() > 4 && std::abs(camera.distortion[4]) > 1e-9) {
     return Status::InvalidArgument("a k3 distortion term, which is not undone");
   }
-  for (std::size_t i = 0; i < 4; ++i) (*distortion)[i] = i < camera.distortion.size() ? camera.distortion[i] : 0.0;
+  Distortion read{};
+  for (std::size_t i = 0; i < 4; ++i) read[i] = i < camera.distortion.size() ? camera.distortion[i] : 0.0;
+  if (!PlausibleDistortion(read)) {
+    return Status::InvalidArgument("distortion coefficients that are not finite or beyond " +
+                                   std::to_string(static_cast<int>(kMaxDistortionCoefficient)));
+  }
+  *distortion = read;
   return Status::Ok();
 }
 

@@ -146,10 +146,13 @@ Status ReadDistortion(const std::string& path, const YAML::Node& root, Distortio
   std::vector<double> coefficients;
   PATROLMAP_RETURN_IF_ERROR(
       ReadNumbers(path, root["distortion_coefficients"], "distortion_coefficients", 4, &coefficients));
-  for (int i = 0; i < 4; ++i) {
-    if (!std::isfinite(coefficients[i])) return Status::DataLoss(path + ": distortion_coefficients must be finite");
-    (*distortion)[i] = coefficients[i];
+  Distortion read;
+  std::copy(coefficients.begin(), coefficients.begin() + 4, read.begin());
+  if (!PlausibleDistortion(read)) {
+    return Status::DataLoss(path + ": distortion_coefficients must be finite numbers of magnitude at most " +
+                            std::to_string(static_cast<int>(kMaxDistortionCoefficient)));
   }
+  *distortion = read;
   return Status::Ok();
 }
 

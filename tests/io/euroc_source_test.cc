@@ -403,6 +403,10 @@ TEST(Euroc, Cam0OfAnotherModelIsTakenForUndistortedNamingItsFile) {
             "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\ndistortion_coefficients: [0.1, .nan, 0, 0]\n");
   EXPECT_NE(OpenLog(log, {}, &source).message().find("cam0/sensor.yaml: distortion_coefficients must be finite"),
             std::string::npos);
+  // A coefficient no lens of this model has (the map file would refuse it).
+  WriteText(log + "/cam0/sensor.yaml",
+            "resolution: [32, 24]\nintrinsics: [30.0, 30.0, 15.5, 11.5]\ndistortion_coefficients: [11, 0, 0, 0]\n");
+  EXPECT_NE(OpenLog(log, {}, &source).message().find("of magnitude at most 10"), std::string::npos);
 }
 
 TEST(Euroc, RealSensorYamlFromSharedData) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -67,6 +68,16 @@ struct ObjectObservation {
 // The radial-tangential lens distortion of a camera's raw images (k1, k2, p1, p2: OpenCV's and EuRoC's model);
 // all zero for a pinhole camera.
 using Distortion = std::array<double, 4>;
+
+// Coefficients beyond this are no lens's of that model (EuRoC's k1 is -0.28; fisheye lenses have a model of their
+// own): readers refuse them, and a map file holding one is corrupt.
+inline constexpr double kMaxDistortionCoefficient = 10.0;
+inline bool PlausibleDistortion(const Distortion& d) {
+  for (const double k : d) {
+    if (!(std::abs(k) <= kMaxDistortionCoefficient)) return false;  // NaN fails too
+  }
+  return true;
+}
 
 // Where a normalized image point (x/z, y/z) lands through the lens: k1, k2 bend it radially, p1, p2 tangentially.
 // Beyond the radius where the radial term stops growing (r^2 with 1 + 3 k1 r^2 + 5 k2 r^4 <= 0) the polynomial
