@@ -30,8 +30,8 @@ class Lens {
   // beyond the widest ray the image holds (where the distortion polynomial folds back).
   bool Project(const Eigen::Vector3d& point, Eigen::Vector2d* pixel) const;
 
-  // The same image undistorted: depth on the pinhole grid brought onto the raw grid (nearest; 0 off the grid).
-  // `pinhole` is returned as it is when the lens does not distort.
+  // An image on the undistorted grid (depth from stereo) brought onto the raw grid: each raw pixel takes the value
+  // nearest its undistorted place, 0 where that lies off the grid. `pinhole` itself when the lens does not distort.
   cv::Mat ToRaw(const cv::Mat& pinhole) const;
 
  private:
