@@ -53,6 +53,12 @@ expect "camera file of another size" 1 "cam_wrong.yaml: resolution 320x204, but 
 expect "camera file" 0 "1 log: " -- "$bin" map "$source_dir/flight_logs/sample/cam0/data" --fps 10 \
   --camera "$source_dir/flight_logs/sample/cam0/sensor.yaml" --vocabulary "$source_dir/vocab/default.pmvoc" \
   --out "$work/cammap"
+printf 'intrinsics: [97.4, 97.4, 79.5, 50.6]\nresolution: [160, 102]\ndistortion_coefficients: [-0.2, 0.05, 0, 0]\n' \
+  >"$work/cam_lens.yaml"
+"$bin" -q map "$source_dir/flight_logs/sample/cam0/data" --fps 10 --camera "$work/cam_lens.yaml" \
+  --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/lensmap" >/dev/null 2>&1
+expect "info names the camera and its lens" 0 "camera 160x102 \(fx 97.4\) through a lens \(k1 -0.2, k2 0.05, p1 0, p2 0\)" \
+  -- "$bin" info "$work/lensmap/map.pmap"
 "$bin" -q simulate --route street --walls 3 --speed 4 --resolution 160x102 --plain-lighting --seed 2 --out "$work/second" >/dev/null
 expect "patrol" 0 "1 log: 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"

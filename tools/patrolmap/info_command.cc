@@ -29,6 +29,16 @@ int RunBagInfo(const std::string& path) {
   return 0;
 }
 
+// A patrol's camera, its lens when it distorts, and where its poses came from, as far as the log gave them.
+void PrintCamera(const PatrolRecord& record) {
+  if (record.camera.valid()) {
+    std::printf(", camera %dx%d (fx %.1f)", record.camera.width, record.camera.height, record.camera.fx);
+  }
+  const Distortion& d = record.distortion;
+  if (d != Distortion{}) std::printf(" through a lens (k1 %.4g, k2 %.4g, p1 %.4g, p2 %.4g)", d[0], d[1], d[2], d[3]);
+  if (!record.pose_source.empty()) std::printf(", poses from %s", record.pose_source.c_str());
+}
+
 int RunInfo(const std::string& path, bool verbose) {
   if (io::IsBag(path)) return RunBagInfo(path);
   graph::TopoMap map;
@@ -76,6 +86,7 @@ int RunInfo(const std::string& path, bool verbose) {
       std::printf(", %s along the route (%.1f MB)",
                   Counted(static_cast<long long>(record->route.size()), "frame", "frames").c_str(), bytes / 1048576.0);
     }
+    if (record != nullptr) PrintCamera(*record);
     std::printf("\n");
     if (record == nullptr || !verbose) continue;
     for (const MapObject& o : record->objects) {
