@@ -90,7 +90,7 @@ struct SideBySide {
     }
     return t;
   }
-  Distortion Lens(const Distortion& d) const {
+  Distortion LensOf(const Distortion& d) const {
     switch (kind) {
       case kAsIs: return d;
       case kMirrored: return depth::MirroredDistortion(d);
@@ -135,7 +135,7 @@ cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const depth
   const Eigen::Matrix3d axes = turn.Axes();
   StereoCalibration calibration;
   calibration.left = calibration.right = turn.Camera(lens.camera());
-  calibration.left_distortion = calibration.right_distortion = turn.Lens(lens.distortion());
+  calibration.left_distortion = calibration.right_distortion = turn.LensOf(lens.distortion());
   const Eigen::Matrix3d rotation = (other.pose.rotation.conjugate() * pose.rotation).toRotationMatrix();
   calibration.right_from_left_rotation = axes * rotation * axes.transpose();
   calibration.right_from_left_translation =
