@@ -116,11 +116,22 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
   return Status::Ok();
 }
 
-// A sensor.yaml's intrinsics and resolution.
+// Image sides beyond this are no camera's (the map file refuses them too).
+constexpr double kMaxImageSide = 100000.0;
+
+// A sensor.yaml's intrinsics (finite) and resolution (whole numbers of pixels up to kMaxImageSide).
 Status ReadIntrinsics(const std::string& path, const YAML::Node& root, CameraIntrinsics* camera) {
   std::vector<double> intrinsics, resolution;
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["intrinsics"], "intrinsics", 4, &intrinsics));
   PATROLMAP_RETURN_IF_ERROR(ReadNumbers(path, root["resolution"], "resolution", 2, &resolution));
+  if (!std::all_of(intrinsics.begin(), intrinsics.end(), [](double v) { return std::isfinite(v); })) {
+    return Status::DataLoss(path + ": 'intrinsics' holds a value that is not a finite number");
+  }
+  for (const double side : resolution) {
+    if (!(side >= 1.0 && side <= kMaxImageSide && side == std::floor(side))) {
+      return Status::DataLoss(path + ": 'resolution' must be whole numbers of pixels from 1 to 100000");
+    }
+  }
   *camera = {intrinsics[0],
              intrinsics[1],
              intrinsics[2],

@@ -239,6 +239,10 @@ TEST(ImageFolder, TakesItsCameraFromACameraFile) {
                 .find("bad.yaml: distortion_model 'equidistant' is not radial-tangential"),
             std::string::npos);
   EXPECT_NE(refused("resolution: [32, 24]\n").find("bad.yaml"), std::string::npos);
+  EXPECT_NE(refused(intrinsics + "resolution: [1e12, 24]\n").find("bad.yaml: 'resolution' must be whole numbers"),
+            std::string::npos);
+  EXPECT_NE(refused("intrinsics: [.inf, 30, 15.5, 11.5]\nresolution: [32, 24]\n").find("not a finite number"),
+            std::string::npos);
   EXPECT_NE(refused(intrinsics + "resolution: [32, 24]\ndistortion_coefficients: [0.1, 0.2]\n").find("bad.yaml"),
             std::string::npos);
   EXPECT_FALSE(source->UseCameraFile(dir / "missing.yaml").ok());
