@@ -63,6 +63,21 @@ expect "info names the camera and its lens" 0 "camera 160x102 \(fx 97.4\) throug
 expect "patrol" 0 "1 log: 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"
 expect "patrol extends the map" 0 "2 flights, 6 nodes" -- "$bin" info "$work/patrol/map.pmap"
+# A patrol too short for a key location (30 images, 1 s) is still a flight: its route frames are compared with the
+# map's and kept, so the next patrol or `diff` can compare against it.
+mkdir -p "$work/short"
+for image in $(ls "$source_dir/flight_logs/sample/cam0/data" | sed -n '100,129p'); do
+  cp "$source_dir/flight_logs/sample/cam0/data/$image" "$work/short/"
+done
+expect "patrol without a key location compares its route" 0 "changes street-1 -> short: .*route: 1 of 1 frames compared" \
+  -- "$bin" patrol "$work/short" --fps 30 --map "$work/map/map.pmap" --vocabulary "$source_dir/vocab/default.pmvoc" \
+  --out "$work/shortpatrol"
+expect "info lists the flight without nodes" 0 "flight short +0 nodes, 0.0-0.0 s, 1 frame along the route" -- \
+  "$bin" info "$work/shortpatrol/map.pmap"
+expect "diff compares the flight without nodes" 0 "street-1 -> short" -- \
+  "$bin" diff "$work/shortpatrol/map.pmap" --out "$work/shortdiff"
+expect "merge keeps the flight without nodes" 0 "1 map merged: 2 flights, 3 nodes" -- \
+  "$bin" merge "$work/shortpatrol/map.pmap" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/shortmerge"
 head -c 300 "$work/map/map.pmap" > "$work/cut.pmap"
 expect "truncated map" 1 "cut.pmap: truncated map" -- "$bin" patrol "$work/second" --map "$work/cut.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol2"

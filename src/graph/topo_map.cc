@@ -71,8 +71,21 @@ std::vector<int> TopoMap::Path(int from, int to) const {
 
 std::vector<std::string> TopoMap::Flights() const {
   std::vector<std::string> flights;
+  const auto listed = [&flights](const std::string& flight) {
+    return std::find(flights.begin(), flights.end(), flight) != flights.end();
+  };
   for (int i = 0; i < node_count(); ++i) {
-    if (std::find(flights.begin(), flights.end(), node(i).flight) == flights.end()) flights.push_back(node(i).flight);
+    if (!listed(node(i).flight)) flights.push_back(node(i).flight);
+  }
+  // A flight with a record but no node (a log too short for a key location) goes right after the flight
+  // recorded before it: records are kept in the order flown.
+  auto after = flights.begin();
+  for (const PatrolRecord& record : patrols_) {
+    if (listed(record.flight)) {
+      after = std::find(flights.begin(), flights.end(), record.flight) + 1;
+    } else {
+      after = flights.insert(after, record.flight) + 1;
+    }
   }
   return flights;
 }

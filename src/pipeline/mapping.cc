@@ -149,8 +149,9 @@ void AlignToMap(const graph::TopoMap& map, const change::GridAlignmentOptions& o
   spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference->flight));
 }
 
-// The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight that has nodes,
-// each aligned to the map's patrol before it.
+// The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight, each aligned to
+// the map's patrol before it. A flight too short for a key location keeps its record: its route frames, grid and
+// objects can still be compared.
 graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecognizer& recognizer,
                            const graph::TopoMap::VocabularyTag& tag, const change::GridAlignmentOptions& alignment,
                            MappingOutcome* outcome) {
@@ -158,9 +159,6 @@ graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecogn
   map.set_vocabulary(tag);
   for (FlightRun& run : outcome->flights) {
     PatrolRecord& record = run.result.record;
-    const bool has_nodes = std::any_of(outcome->places.nodes.begin(), outcome->places.nodes.end(),
-                                       [&record](const MapNode& node) { return node.flight == record.flight; });
-    if (!has_nodes) continue;
     AlignToMap(map, alignment, &record);
     map.SetPatrol(std::move(record));
   }

@@ -2,6 +2,7 @@
 #include "patrolmap/pipeline/merge.h"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 
 #include <spdlog/spdlog.h>
@@ -26,12 +27,11 @@ struct FlightPart {
 std::vector<FlightPart> FlightsOf(const graph::TopoMap& map, int index) {
   std::vector<FlightPart> parts;
   std::map<std::string, std::size_t> part_of;
-  for (int i = 0; i < map.node_count(); ++i) {
-    const std::string& flight = map.node(i).flight;
-    const auto [it, added] = part_of.emplace(flight, parts.size());
-    if (added) parts.push_back({flight, index, {}, map.Patrol(flight)});
-    parts[it->second].nodes.push_back(i);
+  for (const std::string& flight : map.Flights()) {  // a flight may have a record and no node
+    part_of.emplace(flight, parts.size());
+    parts.push_back({flight, index, {}, map.Patrol(flight)});
   }
+  for (int i = 0; i < map.node_count(); ++i) parts[part_of.at(map.node(i).flight)].nodes.push_back(i);
   return parts;
 }
 
@@ -58,11 +58,15 @@ Status ResolveClashes(const MergeRequest& request, std::vector<FlightPart>* part
   return Status::Ok();
 }
 
-// When a flight started: its first route frame (kept from the log's first frame on), else its first node.
+// When a flight started: its first route frame (kept from the log's first frame on) or its first node, whichever
+// is earlier; a flight with neither sorts first.
 TimestampNs StartOf(const std::vector<graph::TopoMap>& maps, const FlightPart& part) {
-  const TimestampNs first_node = maps[part.map].node(part.nodes.front()).timestamp_ns;
-  if (part.record == nullptr || part.record->route.empty()) return first_node;
-  return std::min(first_node, part.record->route.front().timestamp_ns);
+  TimestampNs start = std::numeric_limits<TimestampNs>::max();
+  if (!part.nodes.empty()) start = maps[part.map].node(part.nodes.front()).timestamp_ns;
+  if (part.record != nullptr && !part.record->route.empty()) {
+    start = std::min(start, part.record->route.front().timestamp_ns);
+  }
+  return start == std::numeric_limits<TimestampNs>::max() ? std::numeric_limits<TimestampNs>::min() : start;
 }
 
 // The merge order: by start, then by id.

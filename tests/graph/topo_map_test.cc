@@ -47,6 +47,40 @@ TEST(TopoMap, QueriesUsersNeed) {
   EXPECT_TRUE(split.Path(0, 1).empty());
 }
 
+// A log too short for a key location leaves a flight with a patrol record and no node: it is still a flight, in the
+// order flown (after the flight recorded before it), so a patrol can compare against it or be compared.
+TEST(TopoMap, AFlightWithARecordButNoNodeIsListedInTheOrderFlown) {
+  TopoMap map = TwoFlights();  // records: b
+  PatrolRecord late;
+  late.flight = "c";
+  map.SetPatrol(late);
+  EXPECT_EQ(map.Flights(), (std::vector<std::string>{"a", "b", "c"}));
+  TopoMap early;
+  for (const char* flight : {"x", "y"}) {
+    PatrolRecord record;
+    record.flight = flight;
+    early.SetPatrol(record);
+  }
+  NodeData node;
+  node.flight = "z";
+  early.AddNode(node);
+  PatrolRecord z;
+  z.flight = "z";
+  early.SetPatrol(z);
+  PatrolRecord after_z;
+  after_z.flight = "w";
+  early.SetPatrol(after_z);
+  // x and y were recorded before z's record, w after it.
+  EXPECT_EQ(early.Flights(), (std::vector<std::string>{"x", "y", "z", "w"}));
+  TopoMap ordered = TwoFlights();  // b's record comes first, then a's: m goes after a
+  for (const char* flight : {"a", "m"}) {
+    PatrolRecord record;
+    record.flight = flight;
+    ordered.SetPatrol(record);
+  }
+  EXPECT_EQ(ordered.Flights(), (std::vector<std::string>{"a", "m", "b"}));
+}
+
 TEST(TopoMapDeathTest, LoopClosureOntoItselfAborts) {
   TopoMap map = TwoFlights();
   EXPECT_DEATH(map.AddEdge(2, 2, {EdgeKind::kLoopClosure, 0, 0, 0}), "check failed");

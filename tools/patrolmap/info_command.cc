@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "common.h"
@@ -60,17 +61,20 @@ int RunInfo(const std::string& path, bool verbose) {
               Counted(traversals, "traversal", "traversals").c_str(),
               Counted(within + across, "loop closure", "loop closures").c_str(), within, across);
   for (const std::string& flight : map.Flights()) {
+    const PatrolRecord* record = map.Patrol(flight);
     int nodes = 0;
-    double first = 0.0, last = 0.0;
+    std::vector<TimestampNs> times;  // of its nodes and route frames
     for (int i = 0; i < map.node_count(); ++i) {
       if (map.node(i).flight != flight) continue;
-      const double t = NsToSeconds(map.node(i).timestamp_ns);
-      if (nodes++ == 0) first = t;
-      last = t;
+      ++nodes;
+      times.push_back(map.node(i).timestamp_ns);
     }
-    std::printf("  flight %-24s %9s, %.1f-%.1f s", flight.c_str(), Counted(nodes, "node", "nodes").c_str(), first,
-                last);
-    const PatrolRecord* record = map.Patrol(flight);
+    for (std::size_t k = 0; record != nullptr && k < record->route.size(); ++k) {
+      times.push_back(record->route[k].timestamp_ns);
+    }
+    const auto [first, last] = std::minmax_element(times.begin(), times.end());
+    std::printf("  flight %-24s %9s, %.1f-%.1f s", flight.c_str(), Counted(nodes, "node", "nodes").c_str(),
+                times.empty() ? 0.0 : NsToSeconds(*first), times.empty() ? 0.0 : NsToSeconds(*last));
     if (record != nullptr && record->has_objects) {
       const auto confirmed =
           std::count_if(record->objects.begin(), record->objects.end(), [](const MapObject& o) { return o.confirmed; });

@@ -66,7 +66,9 @@ class TopoMap {
   std::vector<int> Neighbours(int id) const;      // ascending, each once
   std::vector<int> NodesOfPlace(int id) const;    // nodes joined to `id` by loop closures, `id` included, ascending
   std::vector<int> Path(int from, int to) const;  // fewest edges, both ends included; empty when unreachable
-  std::vector<std::string> Flights() const;       // in order of first node
+  // Every flight, in the order flown: by first node, and a flight with a patrol record but no node (too short
+  // for a key location) after the flight recorded before it.
+  std::vector<std::string> Flights() const;
 
   // What each patrol keeps for change detection (object map, evidence grid,
   // views); at most one record per flight, replaced when set again.
