@@ -152,6 +152,7 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
   const KeyFrameView& current = current_views[pair.current];
   const cv::Mat marks = VisibilityChange(prior_views[prior], current, options.depth);
   pair.appearance = CompareRegistered(prior_views[prior], current, registration, appearance, marks);
+  DropWhereDepthAgrees(prior_views[prior], current, marks, options.depth, &pair.appearance);
   if (alignment.registered.size() > 1 && !pair.appearance.regions.empty()) {
     const auto& [second_registration, second_prior] = alignment.registered[1];
     const AppearanceChange second =

@@ -58,6 +58,11 @@ struct RouteDepthOptions {
   // this, and by more than sigmas times the two range errors.
   double min_change_m = 0.5;
   double sigmas = 3.0;
+  // A region whose box both frames know the depth of over this share, and ...
+  double unchanged_known_share = 0.5;
+  // ... of which the visibility test marked under this share, lies on unchanged geometry and is dropped: light, but
+  // also paint, a stain or a crack. 0 (the default) drops none.
+  double unchanged_max_marked_share = 0.0;
 };
 
 // Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the

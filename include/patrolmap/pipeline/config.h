@@ -188,6 +188,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.depth.max_range_m", &change.route.depth.max_range_m);
   visitor->Field("change.route.depth.min_change_m", &change.route.depth.min_change_m);
   visitor->Field("change.route.depth.sigmas", &change.route.depth.sigmas);
+  visitor->Field("change.route.depth.unchanged_known_share", &change.route.depth.unchanged_known_share);
+  visitor->Field("change.route.depth.unchanged_max_marked_share", &change.route.depth.unchanged_max_marked_share);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);
