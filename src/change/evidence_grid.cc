@@ -5,6 +5,8 @@
 #include <limits>
 #include <optional>
 
+#include <Eigen/Eigenvalues>
+
 namespace patrolmap::change {
 namespace {
 
@@ -372,6 +374,23 @@ bool IsGroundSheet(const Eigen::Vector3i& low, const Eigen::Vector3i& high, cons
   return ground && *ground >= low.z() - 1;
 }
 
+// The spread of `members`' centres (of `centres`, in voxels of `size`) across their main horizontal axis: the
+// standard deviation along the horizontal direction they vary least in. 0 for voxels in one vertical plane.
+double HorizontalThickness(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3d>& centres,
+                           double size) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t m : members) mean += centres[m].head<2>() / size;
+  mean /= static_cast<double>(members.size());
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  for (std::size_t m : members) {
+    const Eigen::Vector2d d = centres[m].head<2>() / size - mean;
+    covariance += d * d.transpose();
+  }
+  covariance /= static_cast<double>(members.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, solver.eigenvalues()(0)));  // the smaller, first
+}
+
 // DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
 // `for_each_common` visits in `before`'s order.
 template <typename FindAfter, typename ForEachCommon>
@@ -420,6 +439,10 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
     const Eigen::Vector3d extent = region.data.box_max - region.data.box_min + Eigen::Vector3d::Constant(size);
     if (std::max(extent.x(), extent.y()) < options.min_region_width_m - 1e-9) continue;
+    if (region.data.appeared > 0 && region.data.vanished > 0 &&
+        HorizontalThickness(region.members, centres, size) < options.min_shift_thickness_voxels) {
+      continue;  // an edge seen a voxel off
+    }
     if (options.drop_ground_sheets && extent.z() < 1.5 * size) {
       const Eigen::Vector3i low = (region.data.box_min / size).array().round().cast<int>();
       const Eigen::Vector3i high = (region.data.box_max / size).array().round().cast<int>();

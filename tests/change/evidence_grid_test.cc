@@ -242,6 +242,40 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   EXPECT_EQ(change.compared_voxels, 48 + 10 + 1);
 }
 
+// A facade's edge seen from another angle: its voxels vanish at some heights and appear at others, all in one vertical
+// plane (along an axis, or diagonal). That is no change; a box whose voxels both vanish and appear is one, and so is a
+// new board one voxel thick.
+TEST(GeometryChange, AnEdgeSeenAVoxelOffIsNoRegionWhateverItsDirection) {
+  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  const auto shifted = [&](const Eigen::Vector3i& at, bool vanished) {
+    before.push_back({at, vanished ? std::make_pair(9, 0) : std::make_pair(0, 9)});
+    after.push_back({at, vanished ? std::make_pair(0, 9) : std::make_pair(9, 0)});
+  };
+  for (int i = 0; i < 4; ++i) {
+    for (int z = 1; z <= 6; ++z) {
+      shifted({10, i, z}, z <= 3);      // in the plane x = 10
+      shifted({30 + i, i, z}, z <= 3);  // in a diagonal plane
+    }
+  }
+  for (int x = 0; x < 3; ++x) {  // a box: its lower half gone, an upper half new (a crate swapped for a taller one)
+    for (int y = 50; y < 53; ++y) {
+      for (int z = 1; z <= 4; ++z) shifted({x, y, z}, z <= 2);
+    }
+  }
+  for (int y = 0; y < 4; ++y) {  // a new board, one voxel thick: it only appeared
+    for (int z = 1; z <= 3; ++z) shifted({70, y, z}, false);
+  }
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), SceneOfChanges(), &change));
+  ASSERT_EQ(change.regions.size(), 2u);
+  EXPECT_EQ(change.regions[0].voxels, 36);
+  EXPECT_EQ(change.regions[1].voxels, 12);
+  GeometryDiffOptions off = SceneOfChanges();
+  off.min_shift_thickness_voxels = 0.0;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), off, &change));
+  EXPECT_EQ(change.regions.size(), 4u);
+}
+
 // Two boxes seen solid in the second patrol. The first patrol saw one as free by many rays (it is new) and the other by
 // a handful only, where the other patrol has over a hundred returns: rays past an occluder, not free space.
 TEST(GeometryChange, AFewRaysThroughASurfaceSeenSolidAreNoFreeSpace) {

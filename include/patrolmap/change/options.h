@@ -201,6 +201,10 @@ struct GeometryDiffOptions {
   // roof or lid seen from above, with the ground lower around it, stays. Only where a patrol's poses came from GPS
   // (ForPoseSources), whose frame has z up.
   bool drop_ground_sheets = true;
+  // ... and so are regions holding both vanished and appeared voxels whose voxel centres spread across their main
+  // horizontal axis by under this (standard deviation, in voxels): one voxel thick, a facade's edge seen a voxel off
+  // from another angle, not a thing that came or left. 0 = off.
+  double min_shift_thickness_voxels = 0.4;
   // When more than this share of the surface voxels both patrols observed differ, the patrols' poses disagree
   // (GPS without RTK, another world frame): nothing is reported, and the report says why. 1 = never.
   double max_differing_share = 0.25;
