@@ -206,7 +206,9 @@ cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current,
 
 void DropWhereDepthAgrees(const KeyFrameView& prior, const KeyFrameView& current, const cv::Mat& marks,
                           const RouteDepthOptions& options, AppearanceChange* change) {
-  if (prior.depth.empty() || current.depth.empty() || marks.empty()) return;
+  if (options.unchanged_max_marked_share <= 0.0 || prior.depth.empty() || current.depth.empty() || marks.empty()) {
+    return;  // off (no share is under 0), or nothing to test
+  }
   const auto share = [](const cv::Mat& image, const cv::Rect& box) {  // of the box's pixels above 0
     const cv::Rect inside = box & cv::Rect(0, 0, image.cols, image.rows);
     return inside.area() > 0 ? static_cast<double>(cv::countNonZero(image(inside) > 0)) / inside.area() : 0.0;

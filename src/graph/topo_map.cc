@@ -71,23 +71,31 @@ std::vector<int> TopoMap::Path(int from, int to) const {
 
 std::vector<std::string> TopoMap::Flights() const {
   std::vector<std::string> flights;
-  const auto listed = [&flights](const std::string& flight) {
-    return std::find(flights.begin(), flights.end(), flight) != flights.end();
-  };
   for (int i = 0; i < node_count(); ++i) {
-    if (!listed(node(i).flight)) flights.push_back(node(i).flight);
+    if (std::find(flights.begin(), flights.end(), node(i).flight) == flights.end()) flights.push_back(node(i).flight);
   }
   // A flight with a record but no node (a log too short for a key location) goes right after the flight
   // recorded before it: records are kept in the order flown.
   auto after = flights.begin();
   for (const PatrolRecord& record : patrols_) {
-    if (listed(record.flight)) {
-      after = std::find(flights.begin(), flights.end(), record.flight) + 1;
-    } else {
-      after = flights.insert(after, record.flight) + 1;
-    }
+    const auto found = std::find(flights.begin(), flights.end(), record.flight);
+    after = found != flights.end() ? found + 1 : flights.insert(after, record.flight) + 1;
   }
   return flights;
+}
+
+std::optional<std::pair<TimestampNs, TimestampNs>> TopoMap::FlightSpan(const std::string& flight) const {
+  std::optional<std::pair<TimestampNs, TimestampNs>> span;
+  const auto extend = [&span](TimestampNs t) {
+    span = span ? std::make_pair(std::min(span->first, t), std::max(span->second, t)) : std::make_pair(t, t);
+  };
+  for (int i = 0; i < node_count(); ++i) {
+    if (node(i).flight == flight) extend(node(i).timestamp_ns);
+  }
+  if (const PatrolRecord* record = Patrol(flight)) {
+    for (const RouteFrame& frame : record->route) extend(frame.timestamp_ns);
+  }
+  return span;
 }
 
 void TopoMap::SetPatrol(PatrolRecord record) {

@@ -22,6 +22,9 @@ struct FlightPart {
   int map = 0;     // index of the input map
   std::vector<int> nodes;
   const PatrolRecord* record = nullptr;  // may be null (a map written before patrol records)
+  // When it started: its first node or route frame (kept from the log's first frame on); a flight with neither
+  // sorts first.
+  TimestampNs start = std::numeric_limits<TimestampNs>::min();
 };
 
 std::vector<FlightPart> FlightsOf(const graph::TopoMap& map, int index) {
@@ -30,6 +33,7 @@ std::vector<FlightPart> FlightsOf(const graph::TopoMap& map, int index) {
   for (const std::string& flight : map.Flights()) {  // a flight may have a record and no node
     part_of.emplace(flight, parts.size());
     parts.push_back({flight, index, {}, map.Patrol(flight)});
+    if (const auto span = map.FlightSpan(flight)) parts.back().start = span->first;
   }
   for (int i = 0; i < map.node_count(); ++i) parts[part_of.at(map.node(i).flight)].nodes.push_back(i);
   return parts;
@@ -58,22 +62,10 @@ Status ResolveClashes(const MergeRequest& request, std::vector<FlightPart>* part
   return Status::Ok();
 }
 
-// When a flight started: its first route frame (kept from the log's first frame on) or its first node, whichever
-// is earlier; a flight with neither sorts first.
-TimestampNs StartOf(const std::vector<graph::TopoMap>& maps, const FlightPart& part) {
-  TimestampNs start = std::numeric_limits<TimestampNs>::max();
-  if (!part.nodes.empty()) start = maps[part.map].node(part.nodes.front()).timestamp_ns;
-  if (part.record != nullptr && !part.record->route.empty()) {
-    start = std::min(start, part.record->route.front().timestamp_ns);
-  }
-  return start == std::numeric_limits<TimestampNs>::max() ? std::numeric_limits<TimestampNs>::min() : start;
-}
-
 // The merge order: by start, then by id.
-void SortFlights(const std::vector<graph::TopoMap>& maps, std::vector<FlightPart>* parts) {
-  std::stable_sort(parts->begin(), parts->end(), [&](const FlightPart& a, const FlightPart& b) {
-    const TimestampNs ta = StartOf(maps, a), tb = StartOf(maps, b);
-    if (ta != tb) return ta < tb;
+void SortFlights(std::vector<FlightPart>* parts) {
+  std::stable_sort(parts->begin(), parts->end(), [](const FlightPart& a, const FlightPart& b) {
+    if (a.start != b.start) return a.start < b.start;
     return io::NaturalLess(a.id, b.id);
   });
 }
@@ -162,7 +154,7 @@ Status RunMerge(const MergeRequest& request, MergeOutcome* outcome) {
     for (FlightPart& part : FlightsOf(maps[i], static_cast<int>(i))) parts.push_back(std::move(part));
   }
   PATROLMAP_RETURN_IF_ERROR(ResolveClashes(request, &parts, outcome));
-  SortFlights(maps, &parts);
+  SortFlights(&parts);
   graph::TopoMap merged = Replay(maps, parts, vocabulary, config.place, request, outcome);
   merged.set_vocabulary(TagOf(vocabulary, vocabulary_path));
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(request.out));

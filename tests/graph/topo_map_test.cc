@@ -55,6 +55,13 @@ TEST(TopoMap, AFlightWithARecordButNoNodeIsListedInTheOrderFlown) {
   late.flight = "c";
   map.SetPatrol(late);
   EXPECT_EQ(map.Flights(), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_EQ(map.FlightSpan("a"), std::make_pair(SecondsToNs(0.0), SecondsToNs(30.0)));  // nodes 0-3
+  EXPECT_FALSE(map.FlightSpan("c"));                                                    // neither nodes nor frames
+  late.route.resize(2);
+  late.route[0].timestamp_ns = SecondsToNs(95.0);
+  late.route[1].timestamp_ns = SecondsToNs(99.0);
+  map.SetPatrol(late);
+  EXPECT_EQ(map.FlightSpan("c"), std::make_pair(SecondsToNs(95.0), SecondsToNs(99.0)));
   TopoMap early;
   for (const char* flight : {"x", "y"}) {
     PatrolRecord record;

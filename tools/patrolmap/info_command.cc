@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "commands.h"
@@ -63,18 +64,10 @@ int RunInfo(const std::string& path, bool verbose) {
   for (const std::string& flight : map.Flights()) {
     const PatrolRecord* record = map.Patrol(flight);
     int nodes = 0;
-    std::vector<TimestampNs> times;  // of its nodes and route frames
-    for (int i = 0; i < map.node_count(); ++i) {
-      if (map.node(i).flight != flight) continue;
-      ++nodes;
-      times.push_back(map.node(i).timestamp_ns);
-    }
-    for (std::size_t k = 0; record != nullptr && k < record->route.size(); ++k) {
-      times.push_back(record->route[k].timestamp_ns);
-    }
-    const auto [first, last] = std::minmax_element(times.begin(), times.end());
+    for (int i = 0; i < map.node_count(); ++i) nodes += map.node(i).flight == flight;
+    const auto span = map.FlightSpan(flight).value_or(std::make_pair(TimestampNs{0}, TimestampNs{0}));
     std::printf("  flight %-24s %9s, %.1f-%.1f s", flight.c_str(), Counted(nodes, "node", "nodes").c_str(),
-                times.empty() ? 0.0 : NsToSeconds(*first), times.empty() ? 0.0 : NsToSeconds(*last));
+                NsToSeconds(span.first), NsToSeconds(span.second));
     if (record != nullptr && record->has_objects) {
       const auto confirmed =
           std::count_if(record->objects.begin(), record->objects.end(), [](const MapObject& o) { return o.confirmed; });

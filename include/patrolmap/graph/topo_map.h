@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -69,6 +70,8 @@ class TopoMap {
   // Every flight, in the order flown: by first node, and a flight with a patrol record but no node (too short
   // for a key location) after the flight recorded before it.
   std::vector<std::string> Flights() const;
+  // The first and last time of a flight's nodes and route frames; none when it has neither.
+  std::optional<std::pair<TimestampNs, TimestampNs>> FlightSpan(const std::string& flight) const;
 
   // What each patrol keeps for change detection (object map, evidence grid,
   // views); at most one record per flight, replaced when set again.
