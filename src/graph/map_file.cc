@@ -575,6 +575,8 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     }
     if (!ValidRoute(p.route)) return Corrupt(path, "route frames of " + p.flight);
     if (!KnownPoseSource(p.pose_source)) return Corrupt(path, "pose source of " + p.flight);
+    // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.
+    if (map->Patrol(p.flight) != nullptr) return Corrupt(path, "second patrol record of " + p.flight);
     map->SetPatrol(std::move(p));
   }
   return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();

@@ -172,6 +172,21 @@ TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
   patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = 1e-300; }, "evidence grid of b");
   patrol_refused([](PatrolRecord* p) { p->grid.evicted_voxels = -1; }, "evidence grid of b");
   patrol_refused([](PatrolRecord* p) { p->grid.voxel_size = std::nan(""); }, "evidence grid of b");
+  // Two records of one flight (a record's flight id rewritten): the second would silently replace the first.
+  TopoMap twice = TwoFlights();
+  for (const char* flight : {"zq7", "zq8"}) {  // flights with a record and no node
+    PatrolRecord record;
+    record.flight = flight;
+    twice.SetPatrol(record);
+  }
+  ASSERT_TRUE(SaveMap(twice, dir_ / "twice.pmap").ok());
+  std::string doubled = testing::ReadText(dir_ / "twice.pmap");
+  const std::size_t id = doubled.find("zq8");
+  ASSERT_NE(id, std::string::npos);
+  doubled[id + 2] = '7';
+  testing::RecomputeMapChecksums(&doubled);
+  EXPECT_NE(LoadBytes(doubled).find("x.pmap: corrupt map (second patrol record of zq7"), std::string::npos)
+      << LoadBytes(doubled);
   std::string version_zero = bytes_;
   const std::uint32_t zero = 0;
   std::memcpy(version_zero.data() + 8, &zero, 4);
