@@ -201,21 +201,47 @@ cv::Rect PriorBox(const cv::Rect& box, const cv::Mat& current_from_prior, const 
 }
 
 // The best normalised cross-correlation (free of gain and offset) of image `a`'s `box` with image `b` shifted by
-// up to `across` pixels horizontally and `radius` vertically: near 1 when the region of the current image shows
-// what the registered prior showed a little further on (parallax off the registered plane, or background the
-// prior shows beside a nearer edge that hides it here). With both_ways it must hold the other way too: the
+// `centre` and then up to `across` pixels horizontally and `radius` vertically: near 1 when the region of the current
+// image shows what the registered prior showed a little further on (parallax off the registered plane, or background
+// the prior shows beside a nearer edge that hides it here). With both_ways it must hold the other way too: the
 // background that replaced an object that left is found beside the object in the prior, but not the object in
 // the current image.
-double ShiftedSimilarity(const cv::Mat& a, const cv::Mat& b, const cv::Rect& box, int across, int radius) {
+double ShiftedSimilarity(const cv::Mat& a, const cv::Mat& b, const cv::Rect& box, const cv::Point& centre, int across,
+                         int radius) {
   const cv::Rect image(0, 0, a.cols, a.rows);
   const cv::Rect search =
-      cv::Rect(box.x - across, box.y - radius, box.width + 2 * across, box.height + 2 * radius) & image;
+      cv::Rect(box.x + centre.x - across, box.y + centre.y - radius, box.width + 2 * across, box.height + 2 * radius) &
+      image;
   if (box.width < 3 || box.height < 3 || search.width < box.width || search.height < box.height) return 0.0;
   cv::Mat scores;
   cv::matchTemplate(b(search), a(box), scores, cv::TM_CCOEFF_NORMED);
   double best = 0.0;
   cv::minMaxLoc(scores, nullptr, &best);
   return best;
+}
+
+// Whether the registered prior (through any of `warps`) shows the content of `current`'s `box` a little off
+// (ShiftedSimilarity): near the predicted shift where there is one and the box so shifted lies in the image, else
+// within the options' search.
+bool ShowsShiftedCopy(const cv::Mat& current, const std::vector<cv::Mat>& warps, const cv::Rect& box,
+                      const std::optional<ParallaxPrediction>& predicted, const AppearanceOptions& options) {
+  cv::Point centre(0, 0);
+  int across = std::max(options.parallax_search_px, options.horizontal_parallax_search_px);
+  int radius = options.parallax_search_px;
+  if (predicted) {
+    const cv::Point shift(static_cast<int>(std::lround(predicted->shift.x)),
+                          static_cast<int>(std::lround(predicted->shift.y)));
+    const int slack = predicted->slack_px;
+    const cv::Rect reach(box.x + shift.x - slack, box.y + shift.y - slack, box.width + 2 * slack,
+                         box.height + 2 * slack);
+    if ((reach & cv::Rect(0, 0, current.cols, current.rows)) == reach) centre = shift, across = radius = slack;
+  }
+  const auto shows = [&](const cv::Mat& a, const cv::Mat& b, const cv::Point& at) {
+    return ShiftedSimilarity(a, b, box, at, across, radius) > options.max_shifted_similarity;
+  };
+  return std::any_of(warps.begin(), warps.end(), [&](const cv::Mat& w) {
+    return shows(current, w, centre) && (!options.both_ways || shows(w, current, -centre));
+  });
 }
 
 }  // namespace
@@ -281,7 +307,7 @@ AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFram
 
 AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
                                    const Registration& registration, const AppearanceOptions& options,
-                                   const cv::Mat& also_changed) {
+                                   const cv::Mat& also_changed, const ParallaxPredictor& parallax) {
   AppearanceChange result;
   const std::vector<cv::DMatch>& matches = registration.matches;
   result.matches = static_cast<int>(matches.size());
@@ -365,15 +391,9 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       drop(DropReason::kFeaturesStillMatch);
       continue;
     }
-    const int across = std::max(options.parallax_search_px, options.horizontal_parallax_search_px);
-    const auto shows = [&](const cv::Mat& a, const cv::Mat& b) {
-      return ShiftedSimilarity(a, b, region.current_box, across, options.parallax_search_px) >
-             options.max_shifted_similarity;
-    };
-    const bool shifted = std::any_of(warps.begin(), warps.end(), [&](const cv::Mat& w) {
-      return shows(current_f, w) && (!options.both_ways || shows(w, current_f));
-    });
-    if (shifted) {
+    const std::optional<ParallaxPrediction> predicted =
+        parallax ? parallax(region.current_box) : std::optional<ParallaxPrediction>();
+    if (ShowsShiftedCopy(current_f, warps, region.current_box, predicted, options)) {
       drop(DropReason::kShiftedCopy);  // the same content a few pixels off: parallax, not change
       continue;
     }

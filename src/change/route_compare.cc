@@ -150,14 +150,21 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
   pair.prior = prior;
   pair.current = alignment.current;
   const KeyFrameView& current = current_views[pair.current];
+  const auto parallax = [&](int prior_frame, const Registration& r, const cv::Mat& marks) -> ParallaxPredictor {
+    return [&prior_views, &current, &r, &options, prior_frame, marks](const cv::Rect& box) {
+      return PredictParallax(prior_views[prior_frame], current, r.current_from_prior, marks, box, options.depth);
+    };
+  };
   const cv::Mat marks = VisibilityChange(prior_views[prior], current, options.depth);
-  pair.appearance = CompareRegistered(prior_views[prior], current, registration, appearance, marks);
+  pair.appearance = CompareRegistered(prior_views[prior], current, registration, appearance, marks,
+                                      parallax(prior, registration, marks));
   DropWhereDepthAgrees(prior_views[prior], current, marks, options.depth, &pair.appearance);
   if (alignment.registered.size() > 1 && !pair.appearance.regions.empty()) {
     const auto& [second_registration, second_prior] = alignment.registered[1];
+    const cv::Mat second_marks = VisibilityChange(prior_views[second_prior], current, options.depth);
     const AppearanceChange second =
-        CompareRegistered(prior_views[second_prior], current, second_registration, appearance,
-                          VisibilityChange(prior_views[second_prior], current, options.depth));
+        CompareRegistered(prior_views[second_prior], current, second_registration, appearance, second_marks,
+                          parallax(second_prior, second_registration, second_marks));
     if (second.registered) {
       KeepSeenFromBoth(second, prior_views[second_prior].image.size(), options.min_overlap, &pair.appearance);
     }

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/depth/stereo.h"
@@ -225,6 +226,43 @@ void DropWhereDepthAgrees(const KeyFrameView& prior, const KeyFrameView& current
     }
   }
   change->regions = std::move(kept);
+}
+
+std::optional<ParallaxPrediction> PredictParallax(const KeyFrameView& prior, const KeyFrameView& current,
+                                                  const cv::Mat& current_from_prior, const cv::Mat& marks,
+                                                  const cv::Rect& box, const RouteDepthOptions& options) {
+  if (prior.depth.empty() || current.depth.empty() || current_from_prior.empty() || marks.empty()) return std::nullopt;
+  const cv::Rect inside = box & cv::Rect(0, 0, current.depth.cols, current.depth.rows);
+  if (inside.area() == 0) return std::nullopt;
+  if (cv::countNonZero(marks(inside)) < options.parallax_min_marked_share * inside.area()) return std::nullopt;
+  const Eigen::Matrix3d rotation = (prior.pose.rotation.conjugate() * current.pose.rotation).toRotationMatrix();
+  const Eigen::Vector3d translation = prior.pose.rotation.conjugate() * (current.pose.position - prior.pose.position);
+  Eigen::Matrix3d homography;
+  cv::cv2eigen(current_from_prior, homography);
+  std::vector<double> dx, dy;
+  int known = 0;
+  for (int v = inside.y; v < inside.br().y; ++v) {
+    const float* z = current.depth.ptr<float>(v);
+    for (int u = inside.x; u < inside.br().x; ++u) {
+      if (!(z[u] > 0.0f)) continue;
+      ++known;
+      Eigen::Vector2d pixel;
+      if (!prior.lens.Project(rotation * (z[u] * current.lens.Ray(u, v)) + translation, &pixel)) continue;
+      const Eigen::Vector3d carried = homography * pixel.homogeneous();
+      if (!(carried.z() > 0.0)) continue;
+      dx.push_back(carried.x() / carried.z() - u);
+      dy.push_back(carried.y() / carried.z() - v);
+    }
+  }
+  if (known == 0 || known < options.parallax_known_share * inside.area() ||
+      2 * dx.size() < static_cast<std::size_t>(known)) {
+    return std::nullopt;
+  }
+  const auto median = [](std::vector<double>* values) {
+    std::nth_element(values->begin(), values->begin() + values->size() / 2, values->end());
+    return (*values)[values->size() / 2];
+  };
+  return ParallaxPrediction{cv::Point2d(median(&dx), median(&dy)), options.parallax_slack_px};
 }
 
 }  // namespace patrolmap::change

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -205,20 +206,27 @@ TEST(Appearance, ASecondPlaneRegistersANearerBlock) {
   EXPECT_TRUE(change.regions.empty());
 }
 
-// A block of the scene seen 18 px further left than the rest (a nearer facade, or background beside a nearer edge):
-// the prior shows its content 18 px off horizontally, beyond parallax_search_px but within
-// horizontal_parallax_search_px, so the shift test drops it; searched only 8 px, it is kept.
-TEST(Appearance, ContentThePriorShowsFurtherAlongTheRowIsParallax) {
-  cv::Mat scene = Scene(5);
-  cv::Mat current = scene.clone();
-  const cv::Rect block(60, 36, 40, 40);
-  scene(block + cv::Point(18, 0)).copyTo(current(block));
-  AppearanceOptions options;
-  options.min_unmatched_share = 0.0;  // only the shift test decides
-  const auto on_block = [&](const AppearanceChange& change) {
+// A scene and its view with `block` seen 18 px further left than the rest (a nearer facade, or background beside a
+// nearer edge): the prior shows the block's content 18 px off horizontally.
+struct ShiftedBlock {
+  cv::Mat scene = Scene(5), current = scene.clone();
+  cv::Rect block{60, 36, 40, 40};
+  ShiftedBlock() { scene(block + cv::Point(18, 0)).copyTo(current(block)); }
+  long RegionsOnBlock(const AppearanceChange& change) const {
     return std::count_if(change.regions.begin(), change.regions.end(),
                          [&](const AppearanceRegion& r) { return (r.current_box & block).area() > 0; });
-  };
+  }
+};
+
+// The shift is beyond parallax_search_px but within horizontal_parallax_search_px, so the shift test drops the block;
+// searched only 8 px, it is kept.
+TEST(Appearance, ContentThePriorShowsFurtherAlongTheRowIsParallax) {
+  const ShiftedBlock shifted;
+  const cv::Mat &scene = shifted.scene, &current = shifted.current;
+  const cv::Rect& block = shifted.block;
+  AppearanceOptions options;
+  options.min_unmatched_share = 0.0;  // only the shift test decides
+  const auto on_block = [&](const AppearanceChange& change) { return shifted.RegionsOnBlock(change); };
   const AppearanceChange defaults = DetectAppearanceChange(Describe(scene), Describe(current), options);
   ASSERT_TRUE(defaults.registered);
   EXPECT_EQ(on_block(defaults), 0);
@@ -227,6 +235,31 @@ TEST(Appearance, ContentThePriorShowsFurtherAlongTheRowIsParallax) {
   }));
   options.horizontal_parallax_search_px = 8;
   EXPECT_GT(on_block(DetectAppearanceChange(Describe(scene), Describe(current), options)), 0);
+}
+
+// The same block where depth predicts its parallax (route_depth.h): predicted 18 px off (or within the slack of it),
+// it is the shifted copy it looks; predicted on the registered plane, or 9 px off, the prior does not show it there
+// and it is a change (a thing that moved); predicted where the image ends, the wide search decides as before.
+TEST(Appearance, APredictedParallaxNarrowsTheShiftedCopySearch) {
+  const ShiftedBlock shifted;
+  AppearanceOptions options;
+  options.min_unmatched_share = 0.0;  // only the shift test decides
+  const KeyFrameView prior_view = Describe(shifted.scene), current_view = Describe(shifted.current);
+  const Registration registration = Register(prior_view, current_view, options);
+  const auto on_block = [&](const cv::Point2d& shift) {
+    const ParallaxPredictor predictor = [&](const cv::Rect&) {
+      return std::optional<ParallaxPrediction>(ParallaxPrediction{shift, 4});
+    };
+    const AppearanceChange change =
+        CompareRegistered(prior_view, current_view, registration, options, cv::Mat(), predictor);
+    EXPECT_TRUE(change.registered);
+    return shifted.RegionsOnBlock(change);
+  };
+  EXPECT_EQ(on_block({18.0, 0.0}), 0);
+  EXPECT_EQ(on_block({15.0, 2.0}), 0);
+  EXPECT_GT(on_block({0.0, 0.0}), 0);
+  EXPECT_GT(on_block({9.0, 0.0}), 0);
+  EXPECT_EQ(on_block({-100.0, 0.0}), 0);
 }
 
 TEST(Appearance, ARegionIsKeptAtItsUnmatchedShareAndDroppedBelowIt) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -363,6 +364,43 @@ TEST(RouteDepth, ARegionWhereBothDepthsAgreeIsLightAndDropped) {
   change = all;
   DropWhereDepthAgrees(prior, current, marks, RouteDepthOptions{}, &change);
   EXPECT_EQ(change.regions.size(), 4u);
+}
+
+// The current camera stands 1 m to the right of the prior one; the pair is registered on the wall 10 m away (the
+// prior 23 px to the right). A wall pixel then shows in the registered prior where it is, and the box 6 m away
+// 15.3 px further right (f * 1 m / 6 m - f * 1 m / 10 m). The prediction needs the box marked changed, its depth
+// known and the prior frame's depth.
+TEST(RouteDepth, DepthPredictsWhereTheRegisteredPriorShowsARegion) {
+  const cv::Rect box(150, 100, 60, 50), on_wall(20, 20, 40, 40);
+  const KeyFrameView prior = WithDepth(At(0.0), cv::Rect());
+  const KeyFrameView current = WithDepth(At(1.0), box);
+  const cv::Mat current_from_prior = (cv::Mat_<double>(3, 3) << 1, 0, -23.0, 0, 1, 0, 0, 0, 1);
+  const cv::Mat marks = VisibilityChange(prior, current, RouteDepthOptions{});
+  RouteDepthOptions options;
+  options.parallax_slack_px = 3;
+  const std::optional<ParallaxPrediction> at_box =
+      PredictParallax(prior, current, current_from_prior, marks, box, options);
+  ASSERT_TRUE(at_box.has_value());
+  EXPECT_NEAR(at_box->shift.x, 230.0 / 6.0 - 23.0, 0.2);
+  EXPECT_NEAR(at_box->shift.y, 0.0, 0.2);
+  EXPECT_EQ(at_box->slack_px, 3);
+  // The wall is marked nowhere: no prediction, the wide test decides. Marked, it shows where it is.
+  EXPECT_FALSE(PredictParallax(prior, current, current_from_prior, marks, on_wall, options).has_value());
+  const cv::Mat all_marked(marks.size(), CV_8U, cv::Scalar(255));
+  const std::optional<ParallaxPrediction> at_wall =
+      PredictParallax(prior, current, current_from_prior, all_marked, on_wall, options);
+  ASSERT_TRUE(at_wall.has_value());
+  EXPECT_NEAR(at_wall->shift.x, 0.0, 0.2);
+  // Under parallax_known_share of the box with depth, or a prior frame without depth: no prediction.
+  KeyFrameView blind = current;
+  blind.depth = current.depth.clone();
+  blind.depth(cv::Rect(box.x, box.y, box.width, box.height * 8 / 10)).setTo(0.0f);
+  EXPECT_FALSE(PredictParallax(prior, blind, current_from_prior, marks, box, options).has_value());
+  options.parallax_known_share = 0.1;
+  EXPECT_TRUE(PredictParallax(prior, blind, current_from_prior, marks, box, options).has_value());
+  KeyFrameView prior_blind = prior;
+  prior_blind.depth.release();
+  EXPECT_FALSE(PredictParallax(prior_blind, current, current_from_prior, marks, box, options).has_value());
 }
 
 // What a camera at `pose` (not turned) sees through `lens`: a wall 10 m away and, with `patch`, a patch 6 m away

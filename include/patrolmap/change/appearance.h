@@ -12,6 +12,8 @@
 // plane), not a change, and is dropped; featureless regions are kept.
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -94,12 +96,25 @@ struct Registration {
 };
 Registration Register(const KeyFrameView& prior, const KeyFrameView& current, const AppearanceOptions& options);
 
+// Where the registered prior shows a region's content if nothing changed there, as depth tells it (route_depth.h):
+// the shift from the region's box in the current image [pixels], and how far from it the content may lie.
+struct ParallaxPrediction {
+  cv::Point2d shift;
+  int slack_px = 0;
+};
+// Per region, by its box in the current image: the prediction, or none where depth does not tell.
+using ParallaxPredictor = std::function<std::optional<ParallaxPrediction>(const cv::Rect& current_box)>;
+
 // The changed regions of a registered pair (none when it has fewer than min_inliers inliers). `also_changed`
 // (CV_8U on the current image, 255 = changed; may be empty) holds pixels known changed by other means (the
-// visibility test of route_depth.h): they join the changed pixels before regions form.
+// visibility test of route_depth.h): they join the changed pixels before regions form. `parallax` (may be empty)
+// narrows the shifted-copy test: where it predicts a region's shift, and the box so shifted lies in the image, the
+// region is a shifted copy only if the prior shows its content within the slack of that shift, so a thing that
+// moved a few pixels stays a change; elsewhere the test searches as far as the options say.
 AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView& current,
                                    const Registration& registration, const AppearanceOptions& options,
-                                   const cv::Mat& also_changed = cv::Mat());
+                                   const cv::Mat& also_changed = cv::Mat(),
+                                   const ParallaxPredictor& parallax = nullptr);
 
 // Register, then CompareRegistered.
 AppearanceChange DetectAppearanceChange(const KeyFrameView& prior, const KeyFrameView& current,

@@ -63,6 +63,13 @@ struct RouteDepthOptions {
   // ... of which the visibility test marked under this share, lies on unchanged geometry and is dropped: light, but
   // also paint, a stain or a crack. 0 (the default) drops none.
   double unchanged_max_marked_share = 0.0;
+  // Where the visibility test marked at least parallax_min_marked_share of a region's box (the geometry changed)
+  // and the current frame knows the depth of over parallax_known_share of it, the depth predicts where the
+  // registered prior shows the region's content if nothing changed there (its parallax), and the shifted-copy test
+  // looks for it only within parallax_slack_px of that place: a thing that moved a few pixels is no parallax.
+  double parallax_min_marked_share = 0.02;
+  double parallax_known_share = 0.3;
+  int parallax_slack_px = 4;
 };
 
 // Appearance change along the route (RouteComparison): alignment of the current patrol's route frames to the

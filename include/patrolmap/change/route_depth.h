@@ -8,6 +8,7 @@
 // sees through is gone. Both need the two patrols' poses in one world frame.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -44,5 +45,16 @@ cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current,
 // view has no depth or `marks` is empty.
 void DropWhereDepthAgrees(const KeyFrameView& prior, const KeyFrameView& current, const cv::Mat& marks,
                           const RouteDepthOptions& options, AppearanceChange* change);
+
+// Where the prior view, registered onto the current one by `current_from_prior`, shows the content of the current
+// view's `box` if nothing changed there: each pixel of the box with depth is put in space, seen from the prior camera
+// and carried by the homography; the shift is the median over them, its slack `parallax_slack_px`. None where either
+// view has no depth, `marks` (VisibilityChange's) hold under `parallax_min_marked_share` of the box (nothing tells
+// that the geometry changed, and shade on unchanged surfaces must still find its wide shifted copy), the current view
+// knows the depth of under `parallax_known_share` of the box, or most of its points fall outside the prior camera's
+// view.
+std::optional<ParallaxPrediction> PredictParallax(const KeyFrameView& prior, const KeyFrameView& current,
+                                                  const cv::Mat& current_from_prior, const cv::Mat& marks,
+                                                  const cv::Rect& box, const RouteDepthOptions& options);
 
 }  // namespace patrolmap::change

@@ -191,6 +191,9 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.depth.sigmas", &change.route.depth.sigmas);
   visitor->Field("change.route.depth.unchanged_known_share", &change.route.depth.unchanged_known_share);
   visitor->Field("change.route.depth.unchanged_max_marked_share", &change.route.depth.unchanged_max_marked_share);
+  visitor->Field("change.route.depth.parallax_min_marked_share", &change.route.depth.parallax_min_marked_share);
+  visitor->Field("change.route.depth.parallax_known_share", &change.route.depth.parallax_known_share);
+  visitor->Field("change.route.depth.parallax_slack_px", &change.route.depth.parallax_slack_px);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);
