@@ -23,6 +23,15 @@ depth::StereoOptions MatchingOptions(const RouteDepthOptions& options) {
   return stereo;
 }
 
+// The rigid motion taking points from the axes of a camera at `from` into those of a camera at `into`.
+struct RelativePose {
+  Eigen::Matrix3d rotation;
+  Eigen::Vector3d translation;
+  RelativePose(const CameraPoseSample& from, const CameraPoseSample& into)
+      : rotation((into.rotation.conjugate() * from.rotation).toRotationMatrix()),
+        translation(into.rotation.conjugate() * (from.position - into.position)) {}
+};
+
 // The depth image with each pixel the least depth around it (one pixel each way), and unknown (0) wherever a pixel
 // around it is unknown: a ray that lands beside a depth edge is compared with the nearer surface.
 cv::Mat NearestAround(const cv::Mat& depth) {
@@ -36,13 +45,12 @@ cv::Mat NearestAround(const cv::Mat& depth) {
 // pixel of `from` itself (`at_source`) or the pixel of `into` it lands on.
 void MarkSeenThrough(const KeyFrameView& from, const KeyFrameView& into, const cv::Mat& into_nearest,
                      const RouteDepthOptions& options, bool at_source, cv::Mat* marks) {
-  const Eigen::Matrix3d rotation = (into.pose.rotation.conjugate() * from.pose.rotation).toRotationMatrix();
-  const Eigen::Vector3d translation = into.pose.rotation.conjugate() * (from.pose.position - into.pose.position);
+  const RelativePose into_from(from.pose, into.pose);
   for (int v = 0; v < from.depth.rows; ++v) {
     const float* z = from.depth.ptr<float>(v);
     for (int u = 0; u < from.depth.cols; ++u) {
       if (!(z[u] > 0.0f)) continue;
-      const Eigen::Vector3d in_into = rotation * (z[u] * from.lens.Ray(u, v)) + translation;
+      const Eigen::Vector3d in_into = into_from.rotation * (z[u] * from.lens.Ray(u, v)) + into_from.translation;
       Eigen::Vector2d pixel;
       if (!into.lens.Project(in_into, &pixel)) continue;
       const int ub = static_cast<int>(std::lround(pixel.x())), vb = static_cast<int>(std::lround(pixel.y()));
@@ -137,10 +145,9 @@ cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const depth
   StereoCalibration calibration;
   calibration.left = calibration.right = turn.Camera(lens.camera());
   calibration.left_distortion = calibration.right_distortion = turn.LensOf(lens.distortion());
-  const Eigen::Matrix3d rotation = (other.pose.rotation.conjugate() * pose.rotation).toRotationMatrix();
-  calibration.right_from_left_rotation = axes * rotation * axes.transpose();
-  calibration.right_from_left_translation =
-      axes * (other.pose.rotation.conjugate() * (pose.position - other.pose.position));
+  const RelativePose other_from(pose, other.pose);
+  calibration.right_from_left_rotation = axes * other_from.rotation * axes.transpose();
+  calibration.right_from_left_translation = axes * other_from.translation;
   std::unique_ptr<depth::StereoDepth> stereo;
   if (!depth::StereoDepth::Create(calibration, MatchingOptions(options), &stereo).ok()) return cv::Mat();
   cv::Mat depth_m;
@@ -235,8 +242,7 @@ std::optional<ParallaxPrediction> PredictParallax(const KeyFrameView& prior, con
   const cv::Rect inside = box & cv::Rect(0, 0, current.depth.cols, current.depth.rows);
   if (inside.area() == 0) return std::nullopt;
   if (cv::countNonZero(marks(inside)) < options.parallax_min_marked_share * inside.area()) return std::nullopt;
-  const Eigen::Matrix3d rotation = (prior.pose.rotation.conjugate() * current.pose.rotation).toRotationMatrix();
-  const Eigen::Vector3d translation = prior.pose.rotation.conjugate() * (current.pose.position - prior.pose.position);
+  const RelativePose prior_from(current.pose, prior.pose);
   Eigen::Matrix3d homography;
   cv::cv2eigen(current_from_prior, homography);
   std::vector<double> dx, dy;
@@ -247,7 +253,8 @@ std::optional<ParallaxPrediction> PredictParallax(const KeyFrameView& prior, con
       if (!(z[u] > 0.0f)) continue;
       ++known;
       Eigen::Vector2d pixel;
-      if (!prior.lens.Project(rotation * (z[u] * current.lens.Ray(u, v)) + translation, &pixel)) continue;
+      const Eigen::Vector3d in_prior = prior_from.rotation * (z[u] * current.lens.Ray(u, v)) + prior_from.translation;
+      if (!prior.lens.Project(in_prior, &pixel)) continue;
       const Eigen::Vector3d carried = homography * pixel.homogeneous();
       if (!(carried.z() > 0.0)) continue;
       dx.push_back(carried.x() / carried.z() - u);
