@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <set>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 
@@ -374,6 +376,25 @@ bool IsGroundSheet(const Eigen::Vector3i& low, const Eigen::Vector3i& high, cons
   return ground && *ground >= low.z() - 1;
 }
 
+// The columns of `members` (of `changed`) in which a voxel occupied in both patrols (`find_before`, `find_after`)
+// stands at most `reach` voxels above a member.
+template <typename FindBefore, typename FindAfter>
+int CappedColumns(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3i>& changed,
+                  const FindBefore& find_before, const FindAfter& find_after, int reach) {
+  std::set<std::pair<int, int>> capped;
+  VoxelEvidence before, after;
+  for (std::size_t m : members) {
+    const Eigen::Vector3i& v = changed[m];
+    for (int dz = 1; dz <= reach && capped.count({v.x(), v.y()}) == 0; ++dz) {
+      const Eigen::Vector3i above = v + Eigen::Vector3i(0, 0, dz);
+      if (find_before(above, &before) && IsOccupied(&before) && find_after(above, &after) && IsOccupied(&after)) {
+        capped.insert({v.x(), v.y()});
+      }
+    }
+  }
+  return static_cast<int>(capped.size());
+}
+
 // The spread of `members`' centres (of `centres`, in voxels of `size`) across their main horizontal axis: the
 // standard deviation along the horizontal direction they vary least in. 0 for voxels in one vertical plane.
 double HorizontalThickness(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3d>& centres,
@@ -443,6 +464,11 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
         HorizontalThickness(region.members, centres, size) < options.min_shift_thickness_voxels) {
       continue;  // an edge seen a voxel off
     }
+    if (options.min_capped_columns > 0 && (region.data.appeared == 0 || region.data.vanished == 0) &&
+        CappedColumns(region.members, changed, find_before, find_after, options.cap_search_voxels) >=
+            options.min_capped_columns) {
+      continue;  // the top of a thing still there: its lower part seen through
+    }
     if (options.drop_ground_sheets && extent.z() < 1.5 * size) {
       const Eigen::Vector3i low = (region.data.box_min / size).array().round().cast<int>();
       const Eigen::Vector3i high = (region.data.box_max / size).array().round().cast<int>();
@@ -493,9 +519,14 @@ bool PosesHaveZUp(const std::string& prior_source, const std::string& current_so
   return prior_source == kPosesFromGps || current_source == kPosesFromGps;
 }
 
+bool ZPointsUp(const std::string& prior_source, const std::string& current_source) {
+  return prior_source != kPosesFromFile && current_source != kPosesFromFile;
+}
+
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source) {
   options.drop_ground_sheets &= PosesHaveZUp(prior_source, current_source);
+  if (!ZPointsUp(prior_source, current_source)) options.min_capped_columns = 0;
   return options;
 }
 

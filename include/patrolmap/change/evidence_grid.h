@@ -127,7 +127,11 @@ struct GeometryChange {
 // share a frame with z up: one came from GPS (east, north, up), whose alignment leaves sheets of ground. Other
 // sources may not have z up (a KITTI pose file has y down).
 bool PosesHaveZUp(const std::string& prior_source, const std::string& current_source);
-// `options` for two such patrols: sheets of ground are dropped (drop_ground_sheets) only where PosesHaveZUp.
+// Whether z points up in the frame of such patrols: every pose source but a --poses file (a KITTI one has y down)
+// gives a frame with gravity along -z.
+bool ZPointsUp(const std::string& prior_source, const std::string& current_source);
+// `options` for two such patrols: sheets of ground are dropped (drop_ground_sheets) only where PosesHaveZUp, and
+// regions under a cap (min_capped_columns) only where ZPointsUp.
 GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::string& prior_source,
                                    const std::string& current_source);
 // The same for the class-agnostic objects (GeometryObjectOptions::drop_ground_sheets).

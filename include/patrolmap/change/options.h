@@ -212,6 +212,12 @@ struct GeometryDiffOptions {
   // horizontal axis by under this (standard deviation, in voxels): one voxel thick, a facade's edge seen a voxel off
   // from another angle, not a thing that came or left. 0 = off.
   double min_shift_thickness_voxels = 0.4;
+  // ... and so are regions whose voxels all appeared or all vanished when, in at least min_capped_columns of their
+  // columns, a voxel both patrols saw occupied stands at most cap_search_voxels above a changed one: the top of a
+  // thing still there, whose lower part one patrol's stereo saw through (a plain or dark side). Only where z points
+  // up (ForPoseSources: not with a --poses file). 0 = off.
+  int min_capped_columns = 2;
+  int cap_search_voxels = 3;
   // When more than this share of the surface voxels both patrols observed differ, the patrols' poses disagree
   // (GPS without RTK, another world frame): nothing is reported, and the report says why. 1 = never.
   double max_differing_share = 0.25;
