@@ -23,13 +23,14 @@ depth::StereoOptions MatchingOptions(const RouteDepthOptions& options) {
   return stereo;
 }
 
-// The rigid motion taking points from the axes of a camera at `from` into those of a camera at `into`.
+// The rigid motion taking points from the axes of a camera at `from` into those of a camera at `into`:
+// into.ToCamera(from.ToWorld(p)) as one matrix and one offset, for loops over every pixel.
 struct RelativePose {
   Eigen::Matrix3d rotation;
   Eigen::Vector3d translation;
   RelativePose(const CameraPoseSample& from, const CameraPoseSample& into)
       : rotation((into.rotation.conjugate() * from.rotation).toRotationMatrix()),
-        translation(into.rotation.conjugate() * (from.position - into.position)) {}
+        translation(into.ToCamera(from.position)) {}
 };
 
 // The depth image with each pixel the least depth around it (one pixel each way), and unknown (0) wherever a pixel
