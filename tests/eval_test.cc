@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -284,6 +285,31 @@ TEST(ChangeScore, GeometryCoreBandAndUnobservedVoxels) {
   EXPECT_EQ(score.voxels.false_positives, 1);
   EXPECT_EQ(score.voxels.false_negatives, 1);
   EXPECT_DOUBLE_EQ(score.Iou(), 0.5);
+}
+
+// A false voxel beside a changed object is a true change reported too wide; beside an object that stayed, or away
+// from every object, it is a change where there was none.
+TEST(ChangeScore, FalseVoxelsNearAChangedObjectAreCountedApart) {
+  // A 1 m crate (centre (1, 1), z 0..1) removed, and one at (5, 1) that stayed; 0.2 m voxels.
+  const std::vector<TruthObject> before = {Truth(1, "crate", 1.0, 1.0, 10), Truth(2, "crate", 5.0, 1.0, 10)};
+  const std::vector<TruthObject> after = {Truth(2, "crate", 5.0, 1.0, 10)};
+  EvidenceGridData a, b;
+  a.voxel_size = b.voxel_size = 0.2;
+  // Centres: (1.8, 1, 0.4) 0.3 m beyond the removed crate's face (at x 1.5); (1, 1, 1.2) 0.2 m above its top;
+  // (2.8, 1, 0.4) 1.3 m from it and 1.7 m from the other; (4.4, 1, 0.4) 0.1 m from the face of the crate that stayed.
+  const std::vector<Eigen::Vector3i> changed = {{9, 5, 2}, {5, 5, 6}, {14, 5, 2}, {22, 5, 2}};
+  for (const Eigen::Vector3i& v : changed) {  // each observed free in both flights: every one reported is false
+    a.voxels.push_back({v.x(), v.y(), v.z(), 0, 9});
+    b.voxels.push_back({v.x(), v.y(), v.z(), 0, 9});
+  }
+  std::sort(a.voxels.begin(), a.voxels.end(), VoxelBefore);
+  std::sort(b.voxels.begin(), b.voxels.end(), VoxelBefore);
+  const GeometryScore score = ScoreGeometry(changed, a, b, before, after, ChangeScoreOptions{});
+  EXPECT_EQ(score.voxels.false_positives, 4);
+  EXPECT_EQ(score.false_near_change, 2);
+  ChangeScoreOptions tight;
+  tight.near_change_m = 0.25;
+  EXPECT_EQ(ScoreGeometry(changed, a, b, before, after, tight).false_near_change, 1);
 }
 
 // A voxel touches a turned box when the two share a point: for a crate turned by 45 degrees a 0.2 m voxel reaches

@@ -175,6 +175,16 @@ void AddOutcomes(const std::string& state, const std::vector<TruthChange>& truth
   }
 }
 
+// The objects of `here` that are not where they stand in `other`: gone from it, or moved.
+std::vector<TruthObject> ChangedIn(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other) {
+  std::vector<TruthObject> changed;
+  for (const TruthObject& o : here) {
+    const TruthObject* there = FindId(other, o.id);
+    if (there == nullptr || (there->centre - o.centre).norm() > kSamePlace) changed.push_back(o);
+  }
+  return changed;
+}
+
 }  // namespace
 
 bool TruthObject::Contains(const Eigen::Vector3d& point, double margin) const {
@@ -320,6 +330,8 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     return touches(before, p, size / 2) != touches(after, p, size / 2) ||
            encloses(before, p, size / 2) != encloses(after, p, size / 2) || holds(before, p, 0) != holds(after, p, 0);
   };
+  std::vector<TruthObject> moved_or_gone = ChangedIn(before, after);
+  for (const TruthObject& o : ChangedIn(after, before)) moved_or_gone.push_back(o);
   std::vector<VoxelEvidence> predicted;
   for (const Eigen::Vector3i& v : changed) predicted.push_back({v.x(), v.y(), v.z(), 0, 0});
   std::sort(predicted.begin(), predicted.end(), VoxelBefore);
@@ -332,7 +344,10 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     const bool in_band = is_core || band(centre);
     const bool reported = std::binary_search(predicted.begin(), predicted.end(), a, VoxelBefore);
     if (reported && in_band) ++score.voxels.true_positives;
-    if (reported && !in_band) ++score.voxels.false_positives;
+    if (reported && !in_band) {
+      ++score.voxels.false_positives;
+      score.false_near_change += holds(moved_or_gone, centre, options.near_change_m);
+    }
     if (!reported && is_core) ++score.voxels.false_negatives;
   });
   return score;

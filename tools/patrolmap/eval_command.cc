@@ -178,6 +178,8 @@ void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& repo
   (*result)["geometry"] = CountsJson(score.voxels);
   (*result)["geometry"]["iou"] = score.Iou();
   (*result)["geometry"]["observed_voxels"] = score.observed_voxels;
+  (*result)["geometry"]["false_positives_near_change"] = score.false_near_change;
+  (*result)["geometry"]["near_change_m"] = options.near_change_m;
   (*result)["geometry"]["regions"] = report.geometry.regions.size();
   (*result)["geometry"]["surface_voxels"] = report.geometry.surface_voxels;
   (*result)["geometry"]["differing_voxels"] = report.geometry.differing_voxels;
@@ -451,6 +453,12 @@ void PrintChangeTable(const nlohmann::json& c) {
     std::printf("geometry: IoU %.2f over %lld voxels observed in both flights, %d regions\n",
                 c["geometry"]["iou"].get<double>(), c["geometry"]["observed_voxels"].get<long long>(),
                 c["geometry"]["regions"].get<int>());
+    if (c["geometry"].contains("false_positives_near_change")) {
+      std::printf(
+          "geometry: %lld of the false voxels lie within %.2g m of an object that changed (a change reported "
+          "too wide)\n",
+          c["geometry"]["false_positives_near_change"].get<long long>(), c["geometry"]["near_change_m"].get<double>());
+    }
   }
 }
 

@@ -110,6 +110,7 @@ struct ChangeScoreOptions {
   double visible_within_s = 0.25;
   double min_area_px = 100.0;  // thumbnail pixels
   double min_overlap = 0.3;
+  double near_change_m = 0.5;  // false voxels this close to a changed object's box are counted apart [m]
 };
 
 ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported,
@@ -119,6 +120,9 @@ ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported
 struct GeometryScore {
   Counts voxels;
   long long observed_voxels = 0;  // observed in both grids
+  // Of the false positives, those within ChangeScoreOptions::near_change_m of the box of an object that changed
+  // (either flight's): a true change reported too wide, not a change where there was none.
+  long long false_near_change = 0;
   double Iou() const;
 };
 
