@@ -95,6 +95,7 @@ out = sys.argv[1]
 lines = [json.loads(l) for l in open(out + "/lines.jsonl")]
 total = {}
 geo = [0, 0, 0]
+geo_near, near_m = 0, 0.5  # false voxels within eval's near_change_m of an object that changed: reported too wide
 app = [0, 0, 0, 0]  # regions, on a change, visible changes, found
 route = [0, 0, 0, 0, 0, 0]  # changes, on a change, visible, found, frames, compared pairs
 lighting_route = 0  # changes reported on lighting-only patrols
@@ -111,6 +112,8 @@ for r in lines:
     g = c.get("geometry", {})
     if g:
         geo[0] += g["true_positives"]; geo[1] += g["false_positives"]; geo[2] += g["false_negatives"]
+        geo_near += g.get("false_positives_near_change", 0)
+        near_m = g.get("near_change_m", near_m)
         row.append(f"voxels P {g['precision']:.2f} R {g['recall']:.2f} IoU {g['iou']:.2f} ({g['regions']} regions)")
     a = c.get("appearance")
     if a:
@@ -139,8 +142,9 @@ for s, (tp, fp, fn) in total.items():
     print(f"  {s:10s} {tp}/{fp}/{fn}  P {p:.2f} R {r:.2f} F1 {f:.2f}")
 p, r, f = prf(*geo)
 iou = geo[0] / sum(geo) if sum(geo) else 0.0
-summary["voxels"] = {"tp": geo[0], "fp": geo[1], "fn": geo[2], "precision": p, "recall": r, "f1": f, "iou": iou}
-print(f"  voxels     {geo[0]}/{geo[1]}/{geo[2]}  P {p:.2f} R {r:.2f} F1 {f:.2f} IoU {iou:.2f}")
+summary["voxels"] = {"tp": geo[0], "fp": geo[1], "fn": geo[2], "precision": p, "recall": r, "f1": f, "iou": iou,
+                     "fp_near_change": geo_near}
+print(f"  voxels     {geo[0]}/{geo[1]}/{geo[2]}  P {p:.2f} R {r:.2f} F1 {f:.2f} IoU {iou:.2f}, {geo_near} of the false within {near_m:g} m of a change")
 p = app[1] / app[0] if app[0] else 0.0
 r = app[3] / app[2] if app[2] else 0.0
 summary["appearance"] = {"regions": app[0], "regions_on_change": app[1], "changes": app[2], "changes_found": app[3],
