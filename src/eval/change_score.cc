@@ -175,12 +175,19 @@ void AddOutcomes(const std::string& state, const std::vector<TruthChange>& truth
   }
 }
 
-// The objects of `here` that are not where they stand in `other`: gone from it, or moved.
-std::vector<TruthObject> ChangedIn(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other) {
+// Whether `o` stands in `other` too, where it stood: neither gone nor moved.
+bool StaysIn(const TruthObject& o, const std::vector<TruthObject>& other) {
+  const TruthObject* there = FindId(other, o.id);
+  return there != nullptr && (there->centre - o.centre).norm() <= kSamePlace;
+}
+
+// The objects of either flight that changed: gone from the other flight, come in it, or moved (both places).
+std::vector<TruthObject> MovedOrGone(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after) {
   std::vector<TruthObject> changed;
-  for (const TruthObject& o : here) {
-    const TruthObject* there = FindId(other, o.id);
-    if (there == nullptr || (there->centre - o.centre).norm() > kSamePlace) changed.push_back(o);
+  for (const auto& [here, other] : {std::pair(&before, &after), std::pair(&after, &before)}) {
+    for (const TruthObject& o : *here) {
+      if (!StaysIn(o, *other)) changed.push_back(o);
+    }
   }
   return changed;
 }
@@ -330,8 +337,7 @@ GeometryScore ScoreGeometry(const std::vector<Eigen::Vector3i>& changed, const E
     return touches(before, p, size / 2) != touches(after, p, size / 2) ||
            encloses(before, p, size / 2) != encloses(after, p, size / 2) || holds(before, p, 0) != holds(after, p, 0);
   };
-  std::vector<TruthObject> moved_or_gone = ChangedIn(before, after);
-  for (const TruthObject& o : ChangedIn(after, before)) moved_or_gone.push_back(o);
+  const std::vector<TruthObject> moved_or_gone = MovedOrGone(before, after);
   std::vector<VoxelEvidence> predicted;
   for (const Eigen::Vector3i& v : changed) predicted.push_back({v.x(), v.y(), v.z(), 0, 0});
   std::sort(predicted.begin(), predicted.end(), VoxelBefore);
@@ -381,8 +387,7 @@ std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, 
                                           const Distortion& distortion) {
   std::vector<VisibleChange> changes;
   for (const TruthObject& o : here) {
-    const TruthObject* there = FindId(other, o.id);
-    if (there != nullptr && (there->centre - o.centre).norm() <= kSamePlace) continue;  // unchanged
+    if (StaysIn(o, other)) continue;  // unchanged
     if (!SeenNear(o, time_ns, options.visible_within_s)) continue;
     const cv::Rect2d box = ProjectTruthBox(o, pose, camera, distortion);
     if (box.area() >= options.min_area_px) changes.push_back({o.id, box});

@@ -453,12 +453,10 @@ void PrintChangeTable(const nlohmann::json& c) {
     std::printf("geometry: IoU %.2f over %lld voxels observed in both flights, %d regions\n",
                 c["geometry"]["iou"].get<double>(), c["geometry"]["observed_voxels"].get<long long>(),
                 c["geometry"]["regions"].get<int>());
-    if (c["geometry"].contains("false_positives_near_change")) {
-      std::printf(
-          "geometry: %lld of the false voxels lie within %.2g m of an object that changed (a change reported "
-          "too wide)\n",
-          c["geometry"]["false_positives_near_change"].get<long long>(), c["geometry"]["near_change_m"].get<double>());
-    }
+    std::printf(
+        "geometry: %lld of the false voxels lie within %.2g m of an object that changed (a change reported "
+        "too wide)\n",
+        c["geometry"]["false_positives_near_change"].get<long long>(), c["geometry"]["near_change_m"].get<double>());
   }
 }
 
