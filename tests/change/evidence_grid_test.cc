@@ -204,6 +204,15 @@ EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<i
   return grid;
 }
 
+// The regions DiffGrids finds between the grids of the cells `before` and `after` (GridOf).
+std::vector<GeometryRegion> RegionsBetween(const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& before,
+                                           const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& after,
+                                           const GeometryDiffOptions& options) {
+  GeometryChange change;
+  EXPECT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
+  return change.regions;
+}
+
 // The scenes below are mostly the changes themselves, which the pose check would take for a pose error.
 GeometryDiffOptions SceneOfChanges() {
   GeometryDiffOptions options;
@@ -384,11 +393,7 @@ TEST(GeometryChange, AThingWhoseTopStillStandsWasSeenThroughNotRemoved) {
       }
     }
   }
-  const auto regions = [&](const GeometryDiffOptions& options) {
-    GeometryChange change;
-    EXPECT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
-    return change.regions;
-  };
+  const auto regions = [&](const GeometryDiffOptions& options) { return RegionsBetween(before, after, options); };
   const std::vector<GeometryRegion> found = regions(SceneOfChanges());
   ASSERT_EQ(found.size(), 2u);
   EXPECT_EQ(found[0].vanished + found[1].vanished, 36);  // the second thing
@@ -438,11 +443,7 @@ TEST(GeometryChange, AStripOfAWallSeenThroughIsNoRegionABoardThatLeftIs) {
       }
     }
   }
-  const auto regions = [&](const GeometryDiffOptions& options) {
-    GeometryChange change;
-    EXPECT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
-    return change.regions;
-  };
+  const auto regions = [&](const GeometryDiffOptions& options) { return RegionsBetween(before, after, options); };
   const std::vector<GeometryRegion> found = regions(SceneOfChanges());
   ASSERT_EQ(found.size(), 3u);
   EXPECT_EQ(found[0].vanished, 24);  // the crate
