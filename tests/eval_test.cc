@@ -396,6 +396,8 @@ TEST(ChangeScore, RouteChangesNotFoundAreCountedAtTheirFurthestStep) {
   const RouteScore score = ScoreRoute(truth, {reported}, candidates, ChangeScoreOptions{});
   EXPECT_EQ(score.visible, 4);
   EXPECT_EQ(score.found, 1);
+  EXPECT_EQ(score.visible_in_prior, 2);  // 1 and 2, each once though 2 shows in both pairs
+  EXPECT_EQ(score.found_in_prior, 1);
   EXPECT_EQ(score.changes_on_truth, 1);
   const std::map<std::string, int> expected = {{"late", 1}, {"no_region", 2}};  // 2 late; 3 and 4 none
   EXPECT_EQ(score.lost_at, expected);

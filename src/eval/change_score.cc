@@ -481,6 +481,10 @@ RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vecto
   score.visible = static_cast<int>(visible.size());
   score.found =
       static_cast<int>(std::count_if(visible.begin(), visible.end(), [](const auto& entry) { return entry.second; }));
+  for (const auto& [change, found] : visible) {
+    score.visible_in_prior += change.first;
+    score.found_in_prior += change.first && found;
+  }
   std::map<std::pair<bool, int>, const RouteCandidate*> furthest;  // per object change not found
   for (const RouteCandidate& candidate : candidates) {
     if (candidate.pair < 0 || candidate.pair >= static_cast<int>(truth.size())) continue;

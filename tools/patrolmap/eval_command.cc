@@ -332,6 +332,8 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
                         {"changes_on_change", score.changes_on_truth},
                         {"visible", score.visible},
                         {"found", score.found},
+                        {"visible_in_prior", score.visible_in_prior},
+                        {"found_in_prior", score.found_in_prior},
                         {"precision", score.Precision()},
                         {"recall", score.Recall()},
                         {"lost_at", score.lost_at}};
@@ -441,6 +443,10 @@ void PrintChangeTable(const nlohmann::json& c) {
         r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
         r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
         r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
+    if (r.contains("visible_in_prior")) {
+      std::printf("route: of those in a prior frame (objects that left, places a moved one left): %d of %d found\n",
+                  r["found_in_prior"].get<int>(), r["visible_in_prior"].get<int>());
+    }
     if (r.contains("lost_at") && !r["lost_at"].empty()) {
       std::string lost;
       for (const auto& [step, count] : r["lost_at"].items())
