@@ -97,7 +97,8 @@ total = {}
 geo = [0, 0, 0]
 geo_near, near_m = 0, 0.5  # false voxels within eval's near_change_m of an object that changed: reported too wide
 app = [0, 0, 0, 0]  # regions, on a change, visible changes, found
-route = [0, 0, 0, 0, 0, 0]  # changes, on a change, visible, found, frames, compared pairs
+route = [0, 0, 0, 0, 0, 0, 0, 0]  # changes, on a change, visible, found, frames, compared pairs, and of the visible
+                                 # those in a prior frame (objects that left, places left by a move), found
 lighting_route = 0  # changes reported on lighting-only patrols
 lost_at = {}  # route: per step, the object changes not found whose furthest region it dropped
 for r in lines:
@@ -121,8 +122,9 @@ for r in lines:
         row.append(f"regions {a['regions_on_change']}/{a['regions']} on changes, {a['changes_found']}/{a['changes']} changes found")
     ro = c.get("route")
     if ro:
-        for i, k in enumerate(("changes", "changes_on_change", "visible", "found", "frames", "pairs")):
-            route[i] += ro[k]
+        for i, k in enumerate(("changes", "changes_on_change", "visible", "found", "frames", "pairs",
+                               "visible_in_prior", "found_in_prior")):
+            route[i] += ro.get(k, 0)
         if r["series"] == "lighting-only":
             lighting_route += ro["changes"]
         for step, n in ro.get("lost_at", {}).items():
@@ -155,8 +157,10 @@ r = route[3] / route[2] if route[2] else 0.0
 share = route[5] / route[4] if route[4] else 0.0
 summary["route"] = {"changes": route[0], "changes_on_change": route[1], "visible": route[2], "found": route[3],
                     "frames": route[4], "pairs": route[5], "precision": p, "recall": r, "compared_share": share,
+                    "visible_in_prior": route[6], "found_in_prior": route[7],
                     "lighting_only_changes": lighting_route, "lost_at": lost_at}
 print(f"  route      {route[1]}/{route[0]} changes on object changes (P {p:.2f}), {route[3]}/{route[2]} visible changes found (R {r:.2f}), {share:.0%} of the route compared, {lighting_route} changes on lighting-only patrols")
+print(f"             of the visible changes in a prior frame (objects that left, places left by a move) {route[7]}/{route[6]} found")
 if lost_at:
     print("             not found, lost at: " + ", ".join(f"{k} {v}" for k, v in sorted(lost_at.items())))
 json.dump(summary, open(out + "/summary.json", "w"), indent=1)
