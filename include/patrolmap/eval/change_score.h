@@ -196,8 +196,8 @@ struct RouteCandidate {
 struct RouteScore {
   int changes = 0, changes_on_truth = 0;
   int visible = 0, found = 0;
-  // Of those, the ones visible in a prior frame (an object that left, or the place a moved one left): the side
-  // that is harder to see, since the current frame shows only the ground or wall that was behind it.
+  // Of those, the ones visible in a prior frame (an object that left, or the place a moved one left), counted
+  // apart: the current frame shows only the ground or wall that was behind the object.
   int visible_in_prior = 0, found_in_prior = 0;
   // Per object change visible and not found: the name of the furthest step a candidate lying on it reached, in
   // any pair ("no_region" when none lay on it). Where recall is lost.
