@@ -479,9 +479,8 @@ RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vecto
     score.changes_on_truth += on_truth;
   }
   score.visible = static_cast<int>(visible.size());
-  score.found =
-      static_cast<int>(std::count_if(visible.begin(), visible.end(), [](const auto& entry) { return entry.second; }));
   for (const auto& [change, found] : visible) {
+    score.found += found;
     score.visible_in_prior += change.first;
     score.found_in_prior += change.first && found;
   }

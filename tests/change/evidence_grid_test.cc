@@ -191,7 +191,10 @@ TEST(EvidenceGrid, StereoDepthCarvesLessAndHitsOnlyWhereItIsSure) {
   EXPECT_GT(count(c, 30, 39, false), 0);
 }
 
-EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& cells) {
+// Voxel cells of a grid: index -> (hits, passes).
+using Cells = std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>;
+
+EvidenceGridData GridOf(const Cells& cells) {
   EvidenceGridData grid;
   grid.voxel_size = 0.2;
   for (const auto& [v, counts] : cells) {
@@ -205,8 +208,7 @@ EvidenceGridData GridOf(const std::vector<std::pair<Eigen::Vector3i, std::pair<i
 }
 
 // The regions DiffGrids finds between the grids of the cells `before` and `after` (GridOf).
-std::vector<GeometryRegion> RegionsBetween(const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& before,
-                                           const std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>>& after,
+std::vector<GeometryRegion> RegionsBetween(const Cells& before, const Cells& after,
                                            const GeometryDiffOptions& options) {
   GeometryChange change;
   EXPECT_TRUE(DiffGrids(GridOf(before), GridOf(after), options, &change));
@@ -221,7 +223,7 @@ GeometryDiffOptions SceneOfChanges() {
 }
 
 TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   for (int x = 0; x < 4; ++x) {
     for (int y = 0; y < 4; ++y) {
       for (int z = 1; z < 4; ++z) {
@@ -255,7 +257,7 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
 // plane (along an axis, or diagonal). That is no change; a box whose voxels both vanish and appear is one, and so is a
 // new board one voxel thick.
 TEST(GeometryChange, AnEdgeSeenAVoxelOffIsNoRegionWhateverItsDirection) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   const auto shifted = [&](const Eigen::Vector3i& at, bool vanished) {
     before.push_back({at, vanished ? std::make_pair(9, 0) : std::make_pair(0, 9)});
     after.push_back({at, vanished ? std::make_pair(0, 9) : std::make_pair(9, 0)});
@@ -288,7 +290,7 @@ TEST(GeometryChange, AnEdgeSeenAVoxelOffIsNoRegionWhateverItsDirection) {
 // Two boxes seen solid in the second patrol. The first patrol saw one as free by many rays (it is new) and the other by
 // a handful only, where the other patrol has over a hundred returns: rays past an occluder, not free space.
 TEST(GeometryChange, AFewRaysThroughASurfaceSeenSolidAreNoFreeSpace) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   for (int x = 0; x < 4; ++x) {
     for (int y = 0; y < 4; ++y) {
       for (int z = 1; z < 4; ++z) {
@@ -317,7 +319,7 @@ TEST(GeometryChange, AFewRaysThroughASurfaceSeenSolidAreNoFreeSpace) {
 // whole voxel leaves) and a new flat lid 1 m up: both change one layer of voxels, but only the patch lies on the
 // ground around it. It is no region; the lid is (with drop_ground_sheets off, both are).
 TEST(GeometryChange, TheGroundSeenAVoxelHigherIsNoRegionALidAboveItIs) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   for (int x = -10; x < 25; ++x) {
     for (int y = -10; y < 15; ++y) {
       const bool patch = x >= 0 && x < 5 && y >= 0 && y < 5, lid = x >= 12 && x < 17 && y >= 0 && y < 5;
@@ -345,7 +347,7 @@ TEST(GeometryChange, TheGroundSeenAVoxelHigherIsNoRegionALidAboveItIs) {
 // patrol, with the ground around it a voxel above the floor in both. Its ground is searched up to one voxel above
 // it, so it is no region either (with drop_ground_sheets off it is one).
 TEST(GeometryChange, APitFloorSeenAVoxelLowerIsNoRegion) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   for (int x = -10; x < 15; ++x) {
     for (int y = -10; y < 15; ++y) {
       const bool pit = x >= 0 && x < 5 && y >= 0 && y < 5;
@@ -381,7 +383,7 @@ TEST(GeometryChange, APitFloorSeenAVoxelLowerIsNoRegion) {
 // barrel is no region unless the cap test is off, asks for more columns, or its cap stands beyond the search; and
 // the test is off for a --poses file, whose frame may not have z up.
 TEST(GeometryChange, AThingWhoseTopStillStandsWasSeenThroughNotRemoved) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   const std::pair<int, int> solid(8, 0), free(0, 10);
   for (const int x0 : {0, 20, 40}) {
     for (int x = x0; x < x0 + 3; ++x) {
@@ -393,20 +395,19 @@ TEST(GeometryChange, AThingWhoseTopStillStandsWasSeenThroughNotRemoved) {
       }
     }
   }
-  const auto regions = [&](const GeometryDiffOptions& options) { return RegionsBetween(before, after, options); };
-  const std::vector<GeometryRegion> found = regions(SceneOfChanges());
+  const std::vector<GeometryRegion> found = RegionsBetween(before, after, SceneOfChanges());
   ASSERT_EQ(found.size(), 2u);
   EXPECT_EQ(found[0].vanished + found[1].vanished, 36);  // the second thing
   EXPECT_EQ(found[0].appeared + found[1].appeared, 36);  // the new one
   GeometryDiffOptions off = SceneOfChanges(), more = SceneOfChanges();
   off.min_capped_columns = 0;
   more.min_capped_columns = 10;  // the barrel has 9 columns
-  EXPECT_EQ(regions(off).size(), 3u);
-  EXPECT_EQ(regions(more).size(), 3u);
+  EXPECT_EQ(RegionsBetween(before, after, off).size(), 3u);
+  EXPECT_EQ(RegionsBetween(before, after, more).size(), 3u);
   for (auto* grid : {&before, &after}) {  // the barrel's lower layers 3 voxels lower: its cap 4 above them
     for (auto& voxel : *grid) voxel.first.z() -= voxel.first.x() < 3 && voxel.first.z() < 4 ? 3 : 0;
   }
-  EXPECT_EQ(regions(SceneOfChanges()).size(), 3u);
+  EXPECT_EQ(RegionsBetween(before, after, SceneOfChanges()).size(), 3u);
   EXPECT_EQ(ForPoseSources(SceneOfChanges(), kPosesFromFile, kPosesFromStateEstimate).min_capped_columns, 0);
   EXPECT_EQ(ForPoseSources(SceneOfChanges(), kPosesFromGps, kPosesFromStateEstimate).min_capped_columns, 2);
 }
@@ -418,7 +419,7 @@ TEST(GeometryChange, AThingWhoseTopStillStandsWasSeenThroughNotRemoved) {
 // walls in line with it (not thin). With the test off, or for a --poses file (z may not point up), the strip is a
 // region too.
 TEST(GeometryChange, AStripOfAWallSeenThroughIsNoRegionABoardThatLeftIs) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   const std::pair<int, int> solid(8, 0), free(0, 10);
   for (int z = 1; z <= 8; ++z) {
     for (int x = 0; x < 15; ++x) {
@@ -443,8 +444,7 @@ TEST(GeometryChange, AStripOfAWallSeenThroughIsNoRegionABoardThatLeftIs) {
       }
     }
   }
-  const auto regions = [&](const GeometryDiffOptions& options) { return RegionsBetween(before, after, options); };
-  const std::vector<GeometryRegion> found = regions(SceneOfChanges());
+  const std::vector<GeometryRegion> found = RegionsBetween(before, after, SceneOfChanges());
   ASSERT_EQ(found.size(), 3u);
   EXPECT_EQ(found[0].vanished, 24);  // the crate
   EXPECT_EQ(found[1].vanished, 12);
@@ -453,14 +453,16 @@ TEST(GeometryChange, AStripOfAWallSeenThroughIsNoRegionABoardThatLeftIs) {
   GeometryDiffOptions off = SceneOfChanges(), more = SceneOfChanges();
   off.min_flank_voxels = 0;
   more.min_flank_voxels = 17;  // the strip's ends have 16 each: 2 wall columns 8 high within 3 voxels
-  EXPECT_EQ(regions(off).size(), 4u);
-  EXPECT_EQ(regions(more).size(), 4u);
-  EXPECT_EQ(regions(ForPoseSources(SceneOfChanges(), kPosesFromFile, kPosesFromStateEstimate)).size(), 4u);
+  EXPECT_EQ(RegionsBetween(before, after, off).size(), 4u);
+  EXPECT_EQ(RegionsBetween(before, after, more).size(), 4u);
+  EXPECT_EQ(
+      RegionsBetween(before, after, ForPoseSources(SceneOfChanges(), kPosesFromFile, kPosesFromStateEstimate)).size(),
+      4u);
   EXPECT_EQ(ForPoseSources(SceneOfChanges(), kPosesFromGps, kPosesFromStateEstimate).min_flank_voxels, 2);
 }
 
 TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   const auto removed_box = [&](int x0, int length) {
     for (int x = x0; x < x0 + length; ++x) {
       for (int z = 1; z < 3; ++z) {
@@ -483,7 +485,7 @@ TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
 // differs, which no change does, so nothing is reported. With a box put down on a ground both patrols agree on,
 // only the box differs and it is reported.
 TEST(GeometryChange, SurfacesThatDifferEverywhereAreAPoseErrorNotAChange) {
-  std::vector<std::pair<Eigen::Vector3i, std::pair<int, int>>> before, after;
+  Cells before, after;
   for (int x = 0; x < 40; ++x) {
     for (int y = 0; y < 40; ++y) {
       before.push_back({{x, y, 0}, {8, 0}});  // the ground, occupied, with free air above it

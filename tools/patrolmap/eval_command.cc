@@ -443,10 +443,8 @@ void PrintChangeTable(const nlohmann::json& c) {
         r["pairs"].get<int>(), r["frames"].get<int>(), 100.0 * r["compared_share"].get<double>(), changes,
         r["changes_on_change"].get<int>(), Score(r["precision"].get<double>(), changes > 0, 0).c_str(),
         r["found"].get<int>(), visible, Score(r["recall"].get<double>(), visible > 0, 0).c_str());
-    if (r.contains("visible_in_prior")) {
-      std::printf("route: of those in a prior frame (objects that left, places a moved one left): %d of %d found\n",
-                  r["found_in_prior"].get<int>(), r["visible_in_prior"].get<int>());
-    }
+    std::printf("route: of those in a prior frame (objects that left, places a moved one left): %d of %d found\n",
+                r["found_in_prior"].get<int>(), r["visible_in_prior"].get<int>());
     if (r.contains("lost_at") && !r["lost_at"].empty()) {
       std::string lost;
       for (const auto& [step, count] : r["lost_at"].items())
