@@ -99,6 +99,7 @@ void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
       .InRange("change.geometry_objects.separating_rays", g.separating_rays, 1, 1000000)
       .InRange("change.geometry_objects.alike_top_difference_m", g.alike_top_difference_m, 0.0, 1000.0)
       .InRange("change.geometry_objects.alike_shape_overlap", g.alike_shape_overlap, 0.0, 1.0)
+      .InRange("change.geometry_objects.max_partial_free_share", g.max_partial_free_share, 0.0, 1.0)
       .InRange("change.geometry_objects.min_surface_occupancy", g.min_surface_occupancy, 0.0, 1.0)
       .InRange("change.geometry_objects.ground_clearance_voxels", g.ground_clearance_voxels, 0, 100)
       .AboveAtMost("change.geometry_objects.max_size_m", g.max_size_m, 0.0, 10000.0)

@@ -323,17 +323,24 @@ EvidenceGridData Observed(const std::vector<Eigen::AlignedBox3i>& solid,
   return grid;  // x, then y, then z ascending: the grid's order
 }
 
+// The class-agnostic objects between two grids of a scene of changes only (most of its surfaces differ, so the check
+// of the poses is off).
+std::vector<ObjectChange> ObjectsBetween(const EvidenceGridData& before, const EvidenceGridData& after,
+                                         const GeometryObjectOptions& options = GeometryObjectOptions()) {
+  GeometryDiffOptions diff;
+  diff.max_differing_share = 1.0;
+  GeometryChange change;
+  EXPECT_TRUE(DiffGrids(before, after, diff, &change));
+  return GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
+}
+
 // A vehicle (21 x 9 x 7 voxels) moved 2 m along its length: only its two ends change, yet the completed objects are
 // the whole vehicle where it was and where it is.
 TEST(GeometryObjects, AnObjectMovedLessThanItsLengthIsCompletedFromEachGrid) {
   const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(20, 8, 7))});
   const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(10, 0, 1), Eigen::Vector3i(30, 8, 7))});
-  GeometryDiffOptions diff;
-  diff.max_differing_share = 1.0;  // a scene of the vehicle only, whose ends differ
-  GeometryChange change;
-  ASSERT_TRUE(DiffGrids(before, after, diff, &change));
   GeometryObjectOptions options;
-  std::vector<ObjectChange> objects = GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
+  std::vector<ObjectChange> objects = ObjectsBetween(before, after, options);
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_EQ(objects[0].state, ObjectState::kMoved);
   EXPECT_NEAR(objects[0].before->x(), 2.0, 1e-6);  // the vehicle's centre, x 0..4 m
@@ -342,13 +349,13 @@ TEST(GeometryObjects, AnObjectMovedLessThanItsLengthIsCompletedFromEachGrid) {
   EXPECT_NEAR(objects[0].box_after.min().z(), kVoxel, 1e-6);  // the ground left out
   // The changed ends alone put the vehicle's centre 1.2 m off at each end.
   options.complete_objects = false;
-  objects = GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
+  objects = ObjectsBetween(before, after, options);
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_GT(std::abs(objects[0].before->x() - 2.0), 1.0);
   // Grown past max_size_m the object stays its changed part.
   options.complete_objects = true;
   options.max_size_m = 3.0;
-  objects = GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
+  objects = ObjectsBetween(before, after, options);
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_GT(std::abs(objects[0].before->x() - 2.0), 1.0);
 }
@@ -361,33 +368,86 @@ TEST(GeometryObjects, AVehicleSeenOnlyByItsEndsIsOneObject) {
   const Eigen::AlignedBox3i front(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(0, 8, 7));
   const Eigen::AlignedBox3i back(Eigen::Vector3i(20, 0, 1), Eigen::Vector3i(20, 8, 7));
   const Eigen::AlignedBox3i inside(Eigen::Vector3i(1, 0, 1), Eigen::Vector3i(19, 8, 7));
-  const auto objects_of = [&](const EvidenceGridData& after, const GeometryObjectOptions& options) {
-    GeometryDiffOptions diff;
-    diff.max_differing_share = 1.0;
-    GeometryChange change;
-    EXPECT_TRUE(DiffGrids(before, after, diff, &change));
-    return GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, options);
-  };
   const EvidenceGridData ends = Observed({front, back}, {inside});
-  std::vector<ObjectChange> objects = objects_of(ends, GeometryObjectOptions{});
+  std::vector<ObjectChange> objects = ObjectsBetween(before, ends);
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_EQ(objects[0].state, ObjectState::kNew);
   EXPECT_NEAR(objects[0].after->x(), 2.0, 1e-6);  // x 0..4 m
   // Free space seen between them: two objects.
-  objects = objects_of(Observed({front, back}), GeometryObjectOptions{});
+  objects = ObjectsBetween(before, Observed({front, back}));
   EXPECT_EQ(Count(objects, ObjectState::kNew), 2);
   // Farther apart than unseen_join_m, or with the join off: two.
   GeometryObjectOptions options;
   options.unseen_join_m = 3.7;  // the ends' footprints are 3.8 m apart
-  EXPECT_EQ(Count(objects_of(ends, options), ObjectState::kNew), 2);
+  EXPECT_EQ(Count(ObjectsBetween(before, ends, options), ObjectState::kNew), 2);
   options.unseen_join_m = 0.0;
-  EXPECT_EQ(Count(objects_of(ends, options), ObjectState::kNew), 2);
+  EXPECT_EQ(Count(ObjectsBetween(before, ends, options), ObjectState::kNew), 2);
   // A few rays through the inside (fewer than separating_rays) do not part them.
   EvidenceGridData sparse = Observed({front, back});
   for (VoxelEvidence& v : sparse.voxels) {
     if (inside.contains(Eigen::Vector3i(v.x, v.y, v.z))) v.passes = 2;
   }
-  EXPECT_EQ(Count(objects_of(sparse, GeometryObjectOptions{}), ObjectState::kNew), 1);
+  EXPECT_EQ(Count(ObjectsBetween(before, sparse), ObjectState::kNew), 1);
+}
+
+// A vehicle (31 x 9 x 7 voxels) moved 2 m along its length. Stereo sees its surfaces, not its inside. The later
+// patrol sees them whole; the earlier one only in slices every third voxel, none touching the next. Only the slices it
+// left changed: a part whose shape is no vehicle. The whole vehicle, shifted back onto that part, lands on the
+// slices, so the two are one vehicle moved, reported where it stood (x 0..6 m) and where it stands (2..8 m).
+TEST(GeometryObjects, AVehicleMovedLessThanItsLengthAndSeenWholeOnceIsOneMove) {
+  const Eigen::AlignedBox3i was(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(30, 8, 7));
+  const Eigen::AlignedBox3i is(Eigen::Vector3i(10, 0, 1), Eigen::Vector3i(40, 8, 7));
+  const auto inside = [](const Eigen::AlignedBox3i& box) {
+    return Eigen::AlignedBox3i(box.min() + Eigen::Vector3i::Ones(), box.max() - Eigen::Vector3i::Ones());
+  };
+  std::vector<Eigen::AlignedBox3i> unseen = {inside(was)};
+  for (int x = 1; x <= 30; x += 3) unseen.emplace_back(Eigen::Vector3i(x, 0, 1), Eigen::Vector3i(x + 1, 8, 7));
+  const EvidenceGridData before = Observed({was}, unseen);
+  const EvidenceGridData after = Observed({is}, {inside(is)});
+  GeometryObjectOptions options;
+  std::vector<ObjectChange> objects = ObjectsBetween(before, after, options);
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].state, ObjectState::kMoved);
+  EXPECT_NEAR(objects[0].before->x(), 3.0, 1e-6);
+  EXPECT_NEAR(objects[0].after->x(), 5.0, 1e-6);
+  EXPECT_NEAR(objects[0].before->y(), 0.8, 1e-6);
+  EXPECT_NEAR(objects[0].box_before.sizes().x(), 6.0, 1e-6);  // the whole vehicle at both places
+  // Without the partial test the slices are a removal and the vehicle is new.
+  options.partial_moves = false;
+  objects = ObjectsBetween(before, after, options);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+}
+
+// A crate (6 x 6 x 5 voxels) taken away and a lower, longer one (7 x 6 x 3) set down half over its place. Shifted 0.8 m
+// back, the new one would cover the old one and land on its surfaces; but the old one reaches along that shift as far
+// as the shift itself, and no shorter shift than the new one's length reaches past it: an object in its own right,
+// not the ground a moved one left. A removal and a new object.
+TEST(GeometryObjects, AnObjectReplacedInPlaceIsNoPartialMove) {
+  const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(5, 5, 5))});
+  const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(3, 0, 1), Eigen::Vector3i(9, 5, 3))});
+  const std::vector<ObjectChange> objects = ObjectsBetween(before, after);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+}
+
+// A post (2 x 2 x 4 voxels) taken away and a taller box (2 x 5 x 6) set down against its place. The box, shifted back
+// 0.6 m, covers the post and half of it lands on the post's surfaces; the rest lies where the earlier patrol saw free
+// space, so it never stood there. A removal and a new object.
+TEST(GeometryObjects, AnObjectSetDownBesideARemovedOneIsNoPartialMove) {
+  const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(1, 1, 4))});
+  const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 2, 1), Eigen::Vector3i(1, 6, 6))});
+  GeometryObjectOptions options;
+  std::vector<ObjectChange> objects = ObjectsBetween(before, after, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  // Free space under the shifted box allowed: taken for the post moved.
+  options.max_partial_free_share = 1.0;
+  objects = ObjectsBetween(before, after, options);
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 1);
 }
 
 // A 2 x 2 m patch of ground seen one voxel higher in the second patrol (what a pose correction to within half a voxel
@@ -410,13 +470,7 @@ TEST(GeometryObjects, ASheetOfGroundSeenAVoxelHigherIsNoObject) {
     }
     return g;
   };
-  const EvidenceGridData before = grid(false), after = grid(true);
-  GeometryDiffOptions diff;
-  diff.max_differing_share = 1.0;
-  GeometryChange change;
-  ASSERT_TRUE(DiffGrids(before, after, diff, &change));
-  const std::vector<ObjectChange> objects =
-      GeometryObjects(change, LookupIn(before), LookupIn(after), {}, {}, GeometryObjectOptions{});
+  const std::vector<ObjectChange> objects = ObjectsBetween(grid(false), grid(true));
   ASSERT_EQ(objects.size(), 1u);
   EXPECT_EQ(objects[0].state, ObjectState::kNew);
   EXPECT_NEAR(objects[0].after->x(), 5.2, 1e-6);  // the crate, x 5.0-5.4 m

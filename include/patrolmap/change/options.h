@@ -167,6 +167,13 @@ struct GeometryObjectOptions {
   // (a lid on a voxel boundary is seen in the voxel above or below it) [m].
   double alike_top_difference_m = 0.25;
   double alike_shape_overlap = 0.9;
+  // An object moved less than its own length changes only at the parts that left and took new ground; one side of the
+  // move is then the whole object, the other only a part of it. A vanished and an appeared object no move took are
+  // one moved object when the whole one, shifted horizontally by more than shape_search_m and at most max_move_m,
+  // has min_shape_overlap of the part within shape_tolerance_m and lands, with min_shape_overlap of its voxels, on
+  // surfaces the other patrol's grid holds and its own does not (outside the object) ...
+  bool partial_moves = true;
+  double max_partial_free_share = 0.2;  // ... and where at most this share of it lies on space the other grid saw free
 };
 
 // Evidence grid of one patrol (paper 004).

@@ -168,6 +168,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.max_top_difference_m", &change.geometry_objects.max_top_difference_m);
   visitor->Field("change.geometry_objects.alike_top_difference_m", &change.geometry_objects.alike_top_difference_m);
   visitor->Field("change.geometry_objects.alike_shape_overlap", &change.geometry_objects.alike_shape_overlap);
+  visitor->Field("change.geometry_objects.partial_moves", &change.geometry_objects.partial_moves);
+  visitor->Field("change.geometry_objects.max_partial_free_share", &change.geometry_objects.max_partial_free_share);
   visitor->Field("change.geometry_objects.min_shape_overlap", &change.geometry_objects.min_shape_overlap);
   visitor->Field("change.geometry_objects.shape_tolerance_m", &change.geometry_objects.shape_tolerance_m);
   visitor->Field("change.geometry_objects.shape_search_m", &change.geometry_objects.shape_search_m);
