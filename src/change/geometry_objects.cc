@@ -308,6 +308,22 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double 
   return true;
 }
 
+// Paper 003's greedy assignment: the candidate pairs (each with `vanished`, `appeared` and `cost`) cheapest first,
+// each cluster taken at most once; the taken ones are marked in `vanished_used` and `appeared_used`.
+template <typename Candidate>
+std::vector<Candidate> TakeCheapest(std::vector<Candidate> candidates, std::vector<bool>* vanished_used,
+                                    std::vector<bool>* appeared_used) {
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+  std::vector<Candidate> chosen;
+  for (const Candidate& candidate : candidates) {
+    if ((*vanished_used)[candidate.vanished] || (*appeared_used)[candidate.appeared]) continue;
+    (*vanished_used)[candidate.vanished] = (*appeared_used)[candidate.appeared] = true;
+    chosen.push_back(candidate);
+  }
+  return chosen;
+}
+
 std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
                                      const std::vector<VoxelCluster>& appeared, double voxel,
                                      const GeometryObjectOptions& options) {
@@ -318,16 +334,8 @@ std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
       if (MayHaveMoved(vanished[v], appeared[a], voxel, options, &candidate)) candidates.push_back(candidate);
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const MoveCandidate& x, const MoveCandidate& y) { return x.cost < y.cost; });
   std::vector<bool> vanished_used(vanished.size()), appeared_used(appeared.size());
-  std::vector<MoveCandidate> chosen;
-  for (const MoveCandidate& candidate : candidates) {
-    if (vanished_used[candidate.vanished] || appeared_used[candidate.appeared]) continue;
-    vanished_used[candidate.vanished] = appeared_used[candidate.appeared] = true;
-    chosen.push_back(candidate);
-  }
-  return chosen;
+  return TakeCheapest(std::move(candidates), &vanished_used, &appeared_used);
 }
 
 // The voxel keys of `cluster` and of every voxel within `reach` voxels of one of them.
@@ -495,15 +503,7 @@ std::vector<PartialMove> PairPartialMoves(const std::vector<VoxelCluster>& vanis
       }
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const PartialMove& x, const PartialMove& y) { return x.cost < y.cost; });
-  std::vector<PartialMove> chosen;
-  for (const PartialMove& move : candidates) {
-    if ((*vanished_used)[move.vanished] || (*appeared_used)[move.appeared]) continue;
-    (*vanished_used)[move.vanished] = (*appeared_used)[move.appeared] = true;
-    chosen.push_back(move);
-  }
-  return chosen;
+  return TakeCheapest(std::move(candidates), vanished_used, appeared_used);
 }
 
 // `cluster` shifted by `shift` voxels.
