@@ -384,12 +384,13 @@ struct Landing {
                                  // hold outside the whole: the place it left or took, not structure both patrols saw
   double on_free_space = 0.0;    // where the other grid saw free space and no surface within reach: it did not stand
                                  // there
+  double on_left_voxel = 0.0;    // as on_left_surface, on such a surface voxel itself (how exactly it lands)
 };
 
 Landing LandShifted(const VoxelCluster& whole, const Eigen::Vector3i& shift,
                     const std::unordered_set<std::uint64_t>& own_reach, const GridPair& grids, int reach,
                     const GeometryObjectOptions& options) {
-  int landed = 0, free = 0;
+  int landed = 0, free = 0, exact = 0;
   VoxelEvidence evidence;
   for (const Eigen::Vector3i& v : whole.voxels) {
     const Eigen::Vector3i there = v + shift;
@@ -399,12 +400,16 @@ Landing LandShifted(const VoxelCluster& whole, const Eigen::Vector3i& shift,
     }
     const bool still_there = own_reach.count(VoxelKey(there)) == 0 && grids.own(there, &evidence) &&
                              IsSurface(evidence, options.min_surface_occupancy);
-    landed += !still_there;
+    if (still_there) continue;
+    ++landed;
+    exact += SurfaceNear(there, 0, grids.other, options.min_surface_occupancy);
   }
   Landing landing;
   if (whole.voxels.empty()) return landing;
-  landing.on_left_surface = static_cast<double>(landed) / static_cast<double>(whole.voxels.size());
-  landing.on_free_space = static_cast<double>(free) / static_cast<double>(whole.voxels.size());
+  const double voxels = static_cast<double>(whole.voxels.size());
+  landing.on_left_surface = landed / voxels;
+  landing.on_free_space = free / voxels;
+  landing.on_left_voxel = exact / voxels;
   return landing;
 }
 
@@ -433,8 +438,7 @@ bool PartialShiftAllowed(int i, int j, const VoxelCluster& whole, const VoxelClu
 // The best horizontal shift (in voxels; PartialShiftAllowed) that moves `whole` onto `part`, the part mostly outside
 // the whole's footprint: at least min_shape_overlap of the part within shape_tolerance_m of the shifted whole, and
 // as much of the shifted whole landing on surfaces it left, at most max_partial_free_share on free space
-// (LandShifted). False when none qualifies;
-// `overlap` is the smaller of the two shares at the best shift.
+// (LandShifted). False when none qualifies; `overlap` is the smaller of the two shares at the best shift.
 bool ShiftOntoPart(const VoxelCluster& whole, const VoxelCluster& part, const GridPair& grids, double voxel,
                    const GeometryObjectOptions& options, Eigen::Vector3i* best_shift, double* overlap) {
   *overlap = 0.0;
@@ -465,11 +469,10 @@ bool ShiftOntoPart(const VoxelCluster& whole, const VoxelCluster& part, const Gr
         continue;
       }
       // Shifts a voxel apart often tie within the tolerance: the one landing more exactly on the surfaces wins.
-      const double exact = LandShifted(whole, shift, own_reach, grids, 0, options).on_left_surface;
-      if (std::min(covered, landed) == *overlap && exact <= best_exact) continue;
+      if (std::min(covered, landed) == *overlap && landing.on_left_voxel <= best_exact) continue;
       *overlap = std::min(covered, landed);
       *best_shift = shift;
-      best_exact = exact;
+      best_exact = landing.on_left_voxel;
     }
   }
   return *overlap > 0.0;
@@ -535,6 +538,14 @@ ObjectChange ClassAgnostic(ObjectState state, const VoxelCluster* before, const 
   return change;
 }
 
+// A class-agnostic move, its confidence weighed by the shapes' overlap, with paper 003's weighted distance.
+ObjectChange Moved(const VoxelCluster& before, const VoxelCluster& after, double overlap, double cost) {
+  ObjectChange moved = ClassAgnostic(ObjectState::kMoved, &before, &after);
+  moved.confidence *= overlap;
+  moved.weighted_distance = cost;
+  return moved;
+}
+
 }  // namespace
 
 Eigen::Vector3d VoxelCluster::Centroid() const {
@@ -579,10 +590,8 @@ std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const Vo
   const std::vector<VoxelCluster> appeared = ObjectClusters(change, true, current_grid, current_detected, options);
   std::vector<bool> vanished_moved(vanished.size()), appeared_moved(appeared.size());
   for (const MoveCandidate& move : PairMoves(vanished, appeared, change.voxel_size, options)) {
-    ObjectChange moved = ClassAgnostic(ObjectState::kMoved, &vanished[move.vanished], &appeared[move.appeared]);
-    moved.confidence *= move.overlap;
+    ObjectChange moved = Moved(vanished[move.vanished], appeared[move.appeared], move.overlap, move.cost);
     moved.rotation = move.rotation;
-    moved.weighted_distance = move.cost;
     objects.push_back(std::move(moved));
     vanished_moved[move.vanished] = appeared_moved[move.appeared] = true;
   }
@@ -591,11 +600,8 @@ std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const Vo
                                                     current_grid, change.voxel_size, options)) {
       const VoxelCluster& whole = move.appeared_whole ? appeared[move.appeared] : vanished[move.vanished];
       const VoxelCluster other_place = Shifted(whole, move.shift, change.voxel_size);
-      ObjectChange moved = move.appeared_whole ? ClassAgnostic(ObjectState::kMoved, &other_place, &whole)
-                                               : ClassAgnostic(ObjectState::kMoved, &whole, &other_place);
-      moved.confidence *= move.overlap;
-      moved.weighted_distance = move.cost;
-      objects.push_back(std::move(moved));
+      objects.push_back(move.appeared_whole ? Moved(other_place, whole, move.overlap, move.cost)
+                                            : Moved(whole, other_place, move.overlap, move.cost));
     }
   }
   for (std::size_t v = 0; v < vanished.size(); ++v) {

@@ -59,6 +59,13 @@ int Count(const std::vector<ObjectChange>& objects, ObjectState state) {
       std::count_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; }));
 }
 
+// A removal and a new object, and no move.
+void ExpectRemovalAndNew(const std::vector<ObjectChange>& objects) {
+  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
+  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+}
+
 const ObjectChange* First(const std::vector<ObjectChange>& objects, ObjectState state) {
   const auto it =
       std::find_if(objects.begin(), objects.end(), [state](const ObjectChange& o) { return o.state == state; });
@@ -414,10 +421,7 @@ TEST(GeometryObjects, AVehicleMovedLessThanItsLengthAndSeenWholeOnceIsOneMove) {
   EXPECT_NEAR(objects[0].box_before.sizes().x(), 6.0, 1e-6);  // the whole vehicle at both places
   // Without the partial test the slices are a removal and the vehicle is new.
   options.partial_moves = false;
-  objects = ObjectsBetween(before, after, options);
-  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
-  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
-  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
+  ExpectRemovalAndNew(ObjectsBetween(before, after, options));
 }
 
 // A crate (6 x 6 x 5 voxels) taken away and a lower, longer one (7 x 6 x 3) set down half over its place. Shifted 0.8 m
@@ -427,10 +431,7 @@ TEST(GeometryObjects, AVehicleMovedLessThanItsLengthAndSeenWholeOnceIsOneMove) {
 TEST(GeometryObjects, AnObjectReplacedInPlaceIsNoPartialMove) {
   const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(5, 5, 5))});
   const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(3, 0, 1), Eigen::Vector3i(9, 5, 3))});
-  const std::vector<ObjectChange> objects = ObjectsBetween(before, after);
-  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
-  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
-  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  ExpectRemovalAndNew(ObjectsBetween(before, after));
 }
 
 // A post (2 x 2 x 4 voxels) taken away and a taller box (2 x 5 x 6) set down against its place. The box, shifted back
@@ -439,15 +440,11 @@ TEST(GeometryObjects, AnObjectReplacedInPlaceIsNoPartialMove) {
 TEST(GeometryObjects, AnObjectSetDownBesideARemovedOneIsNoPartialMove) {
   const EvidenceGridData before = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(1, 1, 4))});
   const EvidenceGridData after = Observed({Eigen::AlignedBox3i(Eigen::Vector3i(0, 2, 1), Eigen::Vector3i(1, 6, 6))});
-  GeometryObjectOptions options;
-  std::vector<ObjectChange> objects = ObjectsBetween(before, after, options);
-  EXPECT_EQ(Count(objects, ObjectState::kMoved), 0);
-  EXPECT_EQ(Count(objects, ObjectState::kRemoved), 1);
-  EXPECT_EQ(Count(objects, ObjectState::kNew), 1);
+  ExpectRemovalAndNew(ObjectsBetween(before, after));
   // Free space under the shifted box allowed: taken for the post moved.
+  GeometryObjectOptions options;
   options.max_partial_free_share = 1.0;
-  objects = ObjectsBetween(before, after, options);
-  EXPECT_EQ(Count(objects, ObjectState::kMoved), 1);
+  EXPECT_EQ(Count(ObjectsBetween(before, after, options), ObjectState::kMoved), 1);
 }
 
 // A 2 x 2 m patch of ground seen one voxel higher in the second patrol (what a pose correction to within half a voxel
