@@ -393,7 +393,11 @@ TEST(ChangeScore, RouteChangesNotFoundAreCountedAtTheirFurthestStep) {
       {1, {off, c}, 3, "late"},   // on nothing: 3 is visible in pair 0, not 1
       {7, {off, d}, 3, "late"},   // a pair that was not scored
   };
-  const RouteScore score = ScoreRoute(truth, {reported}, candidates, ChangeScoreOptions{});
+  ReportedRouteChange astray;  // on nothing
+  astray.pairs = {1};
+  astray.boxes = {{off, off}};
+  astray.confidence = 0.5;
+  const RouteScore score = ScoreRoute(truth, {reported, astray}, candidates, ChangeScoreOptions{});
   EXPECT_EQ(score.visible, 4);
   EXPECT_EQ(score.found, 1);
   EXPECT_EQ(score.visible_in_prior, 2);  // 1 and 2, each once though 2 shows in both pairs
@@ -401,6 +405,17 @@ TEST(ChangeScore, RouteChangesNotFoundAreCountedAtTheirFurthestStep) {
   EXPECT_EQ(score.changes_on_truth, 1);
   const std::map<std::string, int> expected = {{"late", 1}, {"no_region", 2}};  // 2 late; 3 and 4 none
   EXPECT_EQ(score.lost_at, expected);
+  const std::vector<std::pair<double, bool>> ranked = {{0.0, true}, {0.5, false}};
+  EXPECT_EQ(score.ranked, ranked);
+}
+
+// The precision at each true change's rank, averaged; a tie ranks the false change first.
+TEST(ChangeScore, AveragePrecisionRewardsConfidencesThatPutTrueChangesFirst) {
+  EXPECT_DOUBLE_EQ(AveragePrecision({{0.9, true}, {0.8, true}, {0.1, false}}), 1.0);
+  EXPECT_DOUBLE_EQ(AveragePrecision({{0.7, true}, {0.8, false}, {0.9, true}}), (1.0 + 2.0 / 3.0) / 2.0);
+  EXPECT_DOUBLE_EQ(AveragePrecision({{0.5, true}, {0.5, false}}), 0.5);
+  EXPECT_DOUBLE_EQ(AveragePrecision({{0.5, false}}), 0.0);
+  EXPECT_DOUBLE_EQ(AveragePrecision({}), 0.0);
 }
 
 }  // namespace

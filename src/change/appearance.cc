@@ -375,7 +375,11 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
       drop(DropReason::kAtPriorEdge);  // the prior frame ends there: what it shows is cut or smeared
       continue;
     }
-    region.score = cv::mean(local, labels == label)[0];
+    const cv::Mat in_region = labels == label;
+    region.score = cv::mean(local, in_region)[0];
+    if (!also_changed.empty()) {
+      region.marked_share = static_cast<double>(cv::countNonZero(also_changed & in_region)) / region.area_px;
+    }
     const cv::Rect2f box(region.current_box);
     for (std::size_t k = 0; k < prior_in_current.size(); ++k) {
       if (!box.contains(prior_in_current[k])) continue;

@@ -60,11 +60,13 @@ json RouteJson(const ChangeReport& report, const graph::TopoMap& map, const std:
                        {"current_frame", current[pair.current].frame_index},
                        {"prior_box", Box(r.prior_box)},
                        {"current_box", Box(r.current_box)},
-                       {"score", r.score}});
+                       {"score", r.score},
+                       {"marked_share", r.marked_share}});
     }
     changes.push_back({{"id", i < ids.size() ? ids[i] : std::string()},
                        {"confidence", change.confidence},
                        {"score", change.score},
+                       {"marked_share", change.marked_share},
                        {"views", views}});
   }
   return {{"frames", report.route.current_frames},

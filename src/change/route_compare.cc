@@ -241,17 +241,19 @@ std::vector<RouteChange> Vote(const RouteComparison& comparison, const std::vect
     const int votes = static_cast<int>(std::set<int>(pairs.begin(), pairs.end()).size());
     if (votes < options.min_votes) continue;
     int largest = 0;
-    double score = 0.0;
+    double score = 0.0, marked = 0.0;
     for (std::size_t k = 0; k < change.views.size(); ++k) {
       const auto region = [&](std::size_t j) -> const AppearanceRegion& {
         return comparison.pairs[change.views[j].pair].appearance.regions[change.views[j].region];
       };
       score += region(k).score;
+      marked += region(k).marked_share;
       if (region(k).area_px > region(largest).area_px) largest = static_cast<int>(k);
     }
     change.best = largest;
     change.score = score / change.views.size();
-    change.confidence = std::clamp(change.score, 0.0, 1.0) * votes / (votes + 1.0);
+    change.marked_share = marked / change.views.size();
+    change.confidence = RouteConfidence(change.score, change.marked_share, votes);
     changes.push_back(std::move(change));
   }
   std::sort(changes.begin(), changes.end(),
@@ -360,6 +362,11 @@ void CompareBlocks(const std::vector<Alignment>& alignments, const std::vector<K
 }
 
 }  // namespace
+
+double RouteConfidence(double score, double marked_share, int votes) {
+  const double doubt = (1.0 - std::clamp(score, 0.0, 1.0)) * (1.0 - std::clamp(marked_share, 0.0, 1.0));
+  return (1.0 - doubt) * votes / (votes + 1.0);
+}
 
 void KeepSeenFromBoth(const AppearanceChange& second, const cv::Size& second_size, double min_overlap,
                       AppearanceChange* change) {

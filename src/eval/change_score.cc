@@ -449,6 +449,19 @@ AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
 }
 
 double RouteScore::Precision() const { return Ratio(changes_on_truth, changes); }
+
+double AveragePrecision(std::vector<std::pair<double, bool>> ranked) {
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& a, const auto& b) { return a.first != b.first ? a.first > b.first : a.second < b.second; });
+  int true_so_far = 0;
+  double sum = 0.0;
+  for (std::size_t i = 0; i < ranked.size(); ++i) {
+    if (!ranked[i].second) continue;
+    ++true_so_far;
+    sum += static_cast<double>(true_so_far) / (i + 1);
+  }
+  return true_so_far > 0 ? sum / true_so_far : 0.0;
+}
 double RouteScore::Recall() const { return Ratio(found, visible); }
 
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
@@ -477,6 +490,7 @@ RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vecto
       }
     }
     score.changes_on_truth += on_truth;
+    score.ranked.emplace_back(change.confidence, on_truth);
   }
   score.visible = static_cast<int>(visible.size());
   for (const auto& [change, found] : visible) {

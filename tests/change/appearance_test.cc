@@ -79,6 +79,35 @@ TEST(Appearance, AnAddedObjectIsARegionInBothImages) {
   EXPECT_NEAR(region.prior_box.x, region.current_box.x + 2, 2);  // the prior view is 2 px to the right
   EXPECT_GT(region.score, 0.0);
   EXPECT_GT(region.unmatched_prior_features, 0);  // the prior texture under the object no longer matches
+  EXPECT_EQ(region.marked_share, 0.0);            // nothing marked it
+}
+
+// Pixels another witness (depth's visibility test) marked are counted in the region they join.
+TEST(Appearance, ARegionCountsTheShareOfItsPixelsDepthMarked) {
+  const cv::Mat scene = Scene(2);
+  cv::Mat current = scene.clone();
+  const cv::Rect object(60, 40, 26, 22);
+  current(object).setTo(30);
+  cv::rectangle(current, object, cv::Scalar(220), 2);
+  const KeyFrameView prior_view = Describe(scene), current_view = Describe(current);
+  const Registration registration = Register(prior_view, current_view, AppearanceOptions{});
+  const auto marked_share = [&](const cv::Rect& marked) {
+    cv::Mat marks = cv::Mat::zeros(scene.size(), CV_8U);
+    marks(marked).setTo(255);
+    marks(cv::Rect(4, 4, 6, 6)).setTo(255);  // a speck far off, too small to be a region of its own
+    const AppearanceChange change =
+        CompareRegistered(prior_view, current_view, registration, AppearanceOptions{}, marks);
+    EXPECT_EQ(change.regions.size(), 1u);
+    if (change.regions.empty()) return -1.0;
+    const AppearanceRegion& region = change.regions[0];
+    EXPECT_LE(region.marked_share * region.area_px, cv::countNonZero(marks(region.current_box)) + 0.5);  // its own
+    return region.marked_share;
+  };
+  const double whole = marked_share(object), left = marked_share(cv::Rect(60, 40, 13, 22));
+  EXPECT_GT(whole, 0.7);
+  EXPECT_LE(whole, 1.0);
+  EXPECT_GT(left, 0.3);  // the flat inside was not found by appearance alone: marked, it joins the region
+  EXPECT_LT(left, whole);
 }
 
 // A scene whose middle is bare ground, a gentle gradient, and the same scene with a thin dark object (a person)

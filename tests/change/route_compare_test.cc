@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -154,11 +155,24 @@ TEST(RouteCompare, AnObjectSeenFromSeveralFramesIsFoundWithTheirVotes) {
   std::size_t most_views = 0;
   for (const RouteChange& change : comparison.changes) {  // the object's outline and its inside may part
     EXPECT_TRUE(OnObject(comparison, change, 8, object.x, object.br().x, object));
-    EXPECT_GT(change.confidence, 0.0);
-    EXPECT_LE(change.confidence, 1.0);
+    EXPECT_GT(change.score, 0.0);
+    EXPECT_EQ(change.marked_share, 0.0);  // no poses, no depth
+    std::set<int> pairs;
+    for (const RouteChange::View& v : change.views) pairs.insert(v.pair);
+    EXPECT_DOUBLE_EQ(change.confidence, RouteConfidence(change.score, 0.0, static_cast<int>(pairs.size())));
     most_views = std::max(most_views, change.views.size());
   }
   EXPECT_GE(most_views, 4u);
+}
+
+// Appearance and depth each vouch for a change; more views weigh more.
+TEST(RouteCompare, AChangeIsDoubtedOnlyAsFarAsAppearanceAndDepthBothDoubtIt) {
+  EXPECT_DOUBLE_EQ(RouteConfidence(0.5, 0.0, 1), 0.25);         // appearance alone, one view
+  EXPECT_DOUBLE_EQ(RouteConfidence(0.5, 0.0, 3), 0.375);        // ... three views
+  EXPECT_DOUBLE_EQ(RouteConfidence(-0.4, 0.8, 3), 0.6);         // depth alone: a score under 0 takes nothing
+  EXPECT_DOUBLE_EQ(RouteConfidence(0.5, 0.5, 3), 0.75 * 0.75);  // both
+  EXPECT_DOUBLE_EQ(RouteConfidence(1.7, 0.0, 1), 0.5);          // a score over 1 counts as 1
+  EXPECT_DOUBLE_EQ(RouteConfidence(0.0, 0.0, 4), 0.0);
 }
 
 TEST(RouteCompare, ARegionInOneFrameOnlyIsNotReported) {

@@ -322,6 +322,7 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
       r.pairs.push_back(v.pair);
       r.boxes.push_back({region.prior_box, region.current_box});
     }
+    r.confidence = change.confidence;
     reported.push_back(r);
   }
   const eval::RouteScore score = eval::ScoreRoute(truth, reported, RouteCandidates(report.route, scored), options);
@@ -336,7 +337,9 @@ void ScoreRouteOf(const graph::TopoMap& map, const change::ChangeReport& report,
                         {"found_in_prior", score.found_in_prior},
                         {"precision", score.Precision()},
                         {"recall", score.Recall()},
-                        {"lost_at", score.lost_at}};
+                        {"lost_at", score.lost_at},
+                        {"average_precision", eval::AveragePrecision(score.ranked)},
+                        {"ranked", score.ranked}};
 }
 
 // Changes of RUN (changes.json, and the grids in map.pmap) against the two flights' ground truth.

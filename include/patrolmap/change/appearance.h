@@ -46,6 +46,7 @@ struct AppearanceRegion {
   cv::Rect prior_box;    // the same region in the prior key frame
   int area_px = 0;
   double score = 0.0;                  // mean structure change in the region (1 - contrast-structure term)
+  double marked_share = 0.0;           // share of its pixels that depth marked as changed (`also_changed`)
   int prior_features = 0;              // prior features inside the region's box (mapped into the current frame)
   int unmatched_prior_features = 0;    // ... of which no current feature matches (they support the change)
   int current_features = 0;            // current features inside the box

@@ -42,10 +42,11 @@ struct RouteChange {
   struct View {
     int pair = -1, region = -1;  // RouteComparison::pairs[pair].appearance.regions[region]
   };
-  std::vector<View> views;  // in time order, one per agreeing pair
-  int best = 0;             // index into views: the largest region
-  double score = 0.0;       // mean structure change over the views
-  double confidence = 0.0;  // in [0, 1]: the score, weighed by how many views agreed
+  std::vector<View> views;    // in time order, one per agreeing pair
+  int best = 0;               // index into views: the largest region
+  double score = 0.0;         // mean structure change over the views
+  double marked_share = 0.0;  // mean share of the views' pixels that depth marked (AppearanceRegion::marked_share)
+  double confidence = 0.0;    // RouteConfidence(score, marked_share, the pairs the views come from)
 };
 
 struct RouteComparison {
@@ -58,6 +59,12 @@ struct RouteComparison {
   // The share of the current route that was aligned and compared.
   double ComparedShare() const;
 };
+
+// A route change's confidence, in [0, 1]: appearance (the mean structure `score`, clamped to [0, 1]) and depth (the
+// `marked_share`) are two witnesses, and the change is doubted only as far as both doubt it; weighed by v / (v + 1) for
+// the `votes` (pairs) that agreed. A change that depth marked and that appearance barely shows (score <= 0) keeps
+// the confidence depth gives it.
+double RouteConfidence(double score, double marked_share, int votes);
 
 // Keeps the regions of `change` that a comparison of the same current frame with a second prior frame (of
 // `second_size`) also found (a region overlapping by `min_overlap` of the smaller box): what differs only from one

@@ -184,6 +184,7 @@ struct RoutePairTruth {
 struct ReportedRouteChange {
   std::vector<int> pairs;          // per view: the compared pair (index into the truth)
   std::vector<RegionBoxes> boxes;  // ... and its boxes in the pair's two frames
+  double confidence = 0.0;
 };
 // A region the comparison found in a pair and did not report, with the step that dropped it: a higher `step`
 // came later in the comparison; `step_name` names it.
@@ -202,9 +203,16 @@ struct RouteScore {
   // Per object change visible and not found: the name of the furthest step a candidate lying on it reached, in
   // any pair ("no_region" when none lay on it). Where recall is lost.
   std::map<std::string, int> lost_at;
+  // Per reported change, in the order given: its confidence and whether it lies on an object change.
+  std::vector<std::pair<double, bool>> ranked;
   double Precision() const;
   double Recall() const;
 };
+
+// How well `ranked`'s confidences put the changes that lie on an object change first: the precision at each such
+// change's rank, averaged, the changes sorted by confidence with ties ranked false first (a tie tells nothing).
+// 1 when every true change outranks every false one; 0 with no true change.
+double AveragePrecision(std::vector<std::pair<double, bool>> ranked);
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
                       const std::vector<RouteCandidate>& candidates, const ChangeScoreOptions& options);
 
