@@ -97,7 +97,9 @@ cv::Mat BestStructure(const cv::Mat& a, const cv::Mat& b, int radius, double sig
       best = best.empty() ? value : cv::Mat(cv::max(best, value));
     }
   }
-  return best;
+  // Within a frame the term is at most 1. At its border, b's moments shifted (replicated) and the product's window
+  // (reflected) disagree and the term can exceed it, which would read as less than no change.
+  return cv::min(best, 1.0);
 }
 
 // Per pixel, the smallest absolute difference between `a` and `b` shifted by up to `radius` pixels (parallax).

@@ -289,6 +289,10 @@ ChangeItem RouteItem(const ChangeReport& report, const graph::TopoMap& map, cons
   item.kind = "appearance";
   item.state = "changed";
   item.label = "seen in " + std::to_string(change.views.size()) + " views";
+  if (change.marked_share > 0.0) {  // the inspector learns that the shape changed too, not only the look
+    item.label += ", depth changed over " + std::to_string(static_cast<int>(std::lround(100.0 * change.marked_share))) +
+                  " % of it";
+  }
   item.confidence = change.confidence;
   item.position = current.pose ? std::optional<Eigen::Vector3d>(current.pose->position)
                                : CameraAt(map, report.current_flight, current.timestamp_ns);

@@ -110,6 +110,24 @@ TEST(Appearance, ARegionCountsTheShareOfItsPixelsDepthMarked) {
   EXPECT_LT(left, whole);
 }
 
+// A region that only depth marked, along the frame's bottom row where nothing changed: its structure change is
+// small and never below 0 (the window there reaches past the frame).
+TEST(Appearance, TheStructureChangeAtTheFramesBorderStaysWithinZeroAndOne) {
+  const cv::Mat scene = Scene(3);
+  const KeyFrameView prior_view = Describe(scene), current_view = Describe(Relit(scene, 0.8, 1.3, 0.0));
+  AppearanceOptions options;
+  options.min_unmatched_share = 0.0;     // the features there still match: nothing changed ...
+  options.max_shifted_similarity = 1.0;  // ... and the prior shows the same content there
+  const Registration registration = Register(prior_view, current_view, options);
+  cv::Mat marks = cv::Mat::zeros(scene.size(), CV_8U);
+  marks(cv::Rect(30, scene.rows - 12, 100, 12)).setTo(255);
+  const AppearanceChange change = CompareRegistered(prior_view, current_view, registration, options, marks);
+  ASSERT_EQ(change.regions.size(), 1u);
+  EXPECT_GE(change.regions[0].score, 0.0);
+  EXPECT_LT(change.regions[0].score, 0.2);
+  EXPECT_GT(change.regions[0].marked_share, 0.9);
+}
+
 // A scene whose middle is bare ground, a gentle gradient, and the same scene with a thin dark object (a person)
 // standing on it. An object that came is found whichever way the pixels are searched. One that left is found with
 // both_ways, both the pixels and the shift test: searched one way only, the bare ground now in its place is found

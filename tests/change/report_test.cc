@@ -122,6 +122,36 @@ TEST(ReportItems, NothingShowsAChangeOutOfEveryFramesView) {
   EXPECT_TRUE(items[0].after.image.empty());
 }
 
+// A change along the route, seen in two pairs of route frames: the label says how far depth changed too.
+TEST(ReportItems, ARouteChangeSaysInHowManyViewsAndHowMuchOfItDepthMarked) {
+  Scene scene = NewCrate();
+  scene.report.objects.clear();
+  scene.report.route.compared = true;
+  for (int i = 0; i < 2; ++i) {
+    RoutePair pair;
+    pair.prior = pair.current = i;
+    AppearanceRegion region;
+    region.current_box = region.prior_box = cv::Rect(10, 10, 20, 16);
+    pair.appearance.registered = true;
+    pair.appearance.regions.push_back(region);
+    scene.report.route.pairs.push_back(pair);
+  }
+  RouteChange change;
+  change.views = {{0, 0}, {1, 0}};
+  change.marked_share = 0.454;
+  change.confidence = RouteConfidence(0.2, change.marked_share, 2);
+  scene.report.route.changes.push_back(change);
+  std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
+  ASSERT_EQ(items.size(), 1u);
+  EXPECT_EQ(items[0].kind, "appearance");
+  EXPECT_EQ(items[0].label, "seen in 2 views, depth changed over 45 % of it");
+  EXPECT_DOUBLE_EQ(items[0].confidence, change.confidence);
+  scene.report.route.changes[0].marked_share = 0.0;  // a log without poses: appearance alone
+  items = ReportItems(scene.report, scene.map);
+  ASSERT_EQ(items.size(), 1u);
+  EXPECT_EQ(items[0].label, "seen in 2 views");
+}
+
 TEST(ChangeReportPage, HasAMarkerARowAndBothPicturesPerChange) {
   const Scene scene = NewCrate();
   const std::vector<ChangeItem> items = ReportItems(scene.report, scene.map);
