@@ -449,6 +449,7 @@ AppearanceScore ScoreAppearance(const std::vector<PlaceTruth>& truth,
 }
 
 double RouteScore::Precision() const { return Ratio(changes_on_truth, changes); }
+double RouteScore::Recall() const { return Ratio(found, visible); }
 
 double AveragePrecision(std::vector<std::pair<double, bool>> ranked) {
   std::sort(ranked.begin(), ranked.end(),
@@ -462,7 +463,6 @@ double AveragePrecision(std::vector<std::pair<double, bool>> ranked) {
   }
   return true_so_far > 0 ? sum / true_so_far : 0.0;
 }
-double RouteScore::Recall() const { return Ratio(found, visible); }
 
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
                       const std::vector<RouteCandidate>& candidates, const ChangeScoreOptions& options) {

@@ -62,8 +62,8 @@ struct RouteComparison {
 
 // A route change's confidence, in [0, 1]: appearance (the mean structure `score`, clamped to [0, 1]) and depth (the
 // `marked_share`) are two witnesses, and the change is doubted only as far as both doubt it; weighed by v / (v + 1) for
-// the `votes` (pairs) that agreed. A change that depth marked and that appearance barely shows (score <= 0) keeps
-// the confidence depth gives it.
+// the `votes` (pairs) that agreed. A change that depth marked and that appearance barely shows (a score near 0)
+// keeps the confidence depth gives it.
 double RouteConfidence(double score, double marked_share, int votes);
 
 // Keeps the regions of `change` that a comparison of the same current frame with a second prior frame (of
