@@ -280,6 +280,12 @@ struct MoveCandidate {
   Eigen::Matrix3d rotation;
 };
 
+// Paper 003's weighted distance of a move `distance_m` long between shapes overlapping by `overlap`.
+double MoveCost(double distance_m, double overlap, const GeometryObjectOptions& options) {
+  const double normalised = options.max_move_m > 0.0 ? distance_m / options.max_move_m : 0.0;
+  return options.physical_weight * normalised + options.shape_weight * (1.0 - overlap);
+}
+
 // Whether appeared cluster `after` may be vanished cluster `before` moved; fills the candidate's cost. The shape
 // test searches shifts in steps of `voxel`, or of half the shape tolerance where that is larger (a finer shift
 // changes little within the tolerance, and a coarser step bounds the search).
@@ -303,8 +309,7 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double 
   if (candidate->overlap < options.min_shape_overlap) return false;
   // A top a voxel apart only for shapes that agree closely (the top of a crate whose lid lies on a voxel boundary).
   if (top_difference > options.max_top_difference_m && candidate->overlap < options.alike_shape_overlap) return false;
-  const double normalised = options.max_move_m > 0.0 ? distance / options.max_move_m : 0.0;
-  candidate->cost = options.physical_weight * normalised + options.shape_weight * (1.0 - candidate->overlap);
+  candidate->cost = MoveCost(distance, candidate->overlap, options);
   return true;
 }
 
@@ -324,9 +329,11 @@ std::vector<Candidate> TakeCheapest(std::vector<Candidate> candidates, std::vect
   return chosen;
 }
 
+// The moves between vanished and appeared clusters (MayHaveMoved), greedily by cost; marks the clusters taken.
 std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
                                      const std::vector<VoxelCluster>& appeared, double voxel,
-                                     const GeometryObjectOptions& options) {
+                                     const GeometryObjectOptions& options, std::vector<bool>* vanished_used,
+                                     std::vector<bool>* appeared_used) {
   std::vector<MoveCandidate> candidates;
   for (std::size_t v = 0; v < vanished.size(); ++v) {
     for (std::size_t a = 0; a < appeared.size(); ++a) {
@@ -334,8 +341,7 @@ std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
       if (MayHaveMoved(vanished[v], appeared[a], voxel, options, &candidate)) candidates.push_back(candidate);
     }
   }
-  std::vector<bool> vanished_used(vanished.size()), appeared_used(appeared.size());
-  return TakeCheapest(std::move(candidates), &vanished_used, &appeared_used);
+  return TakeCheapest(std::move(candidates), vanished_used, appeared_used);
 }
 
 // The voxel keys of `cluster` and of every voxel within `reach` voxels of one of them.
@@ -499,9 +505,7 @@ std::vector<PartialMove> PairPartialMoves(const std::vector<VoxelCluster>& vanis
         PartialMove move;
         move.vanished = v, move.appeared = a, move.appeared_whole = appeared_whole;
         if (!ShiftOntoPart(whole, part, grids, voxel, options, &move.shift, &move.overlap)) continue;
-        const double distance = voxel * move.shift.cast<double>().norm();
-        move.cost =
-            options.physical_weight * distance / options.max_move_m + options.shape_weight * (1.0 - move.overlap);
+        move.cost = MoveCost(voxel * move.shift.cast<double>().norm(), move.overlap, options);
         candidates.push_back(move);
       }
     }
@@ -589,11 +593,11 @@ std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const Vo
   const std::vector<VoxelCluster> vanished = ObjectClusters(change, false, prior_grid, prior_detected, options);
   const std::vector<VoxelCluster> appeared = ObjectClusters(change, true, current_grid, current_detected, options);
   std::vector<bool> vanished_moved(vanished.size()), appeared_moved(appeared.size());
-  for (const MoveCandidate& move : PairMoves(vanished, appeared, change.voxel_size, options)) {
+  for (const MoveCandidate& move :
+       PairMoves(vanished, appeared, change.voxel_size, options, &vanished_moved, &appeared_moved)) {
     ObjectChange moved = Moved(vanished[move.vanished], appeared[move.appeared], move.overlap, move.cost);
     moved.rotation = move.rotation;
     objects.push_back(std::move(moved));
-    vanished_moved[move.vanished] = appeared_moved[move.appeared] = true;
   }
   if (options.partial_moves && prior_grid && current_grid) {
     for (const PartialMove& move : PairPartialMoves(vanished, appeared, &vanished_moved, &appeared_moved, prior_grid,
