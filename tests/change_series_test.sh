@@ -67,6 +67,13 @@ check "object outcomes agree with the counts" "all(
   for s in ('new', 'removed', 'moved', 'persistent')
   for k, f in (('found', 'true_positives'), ('missed', 'false_negatives'), ('false', 'false_positives')))
   and all((o['report_id'] is None) == (o['outcome'] == 'missed') for o in r['objects']['outcomes'])" "$json"
+# Each true change says how the flights saw its places: the prior where it was, the current where it is.
+check "true changes carry their sightings" "all(
+  all((o[p] is not None) == (f'seen_{p}' in o) for p in ('before', 'after'))
+  and all(0 <= o[k]['whole'] <= o[k]['views'] and o[k]['nearest_m'] <= o[k]['farthest_m']
+          for k in ('seen_before', 'seen_after') if k in o)
+  for o in r['objects']['outcomes'] if o['outcome'] != 'false')
+  and any(o.get('seen_before', {}).get('whole', 0) > 0 for o in r['objects']['outcomes'])" "$json"
 
 if $py -c "
 import json, sys, jsonschema

@@ -228,6 +228,9 @@ TEST(ChangeScore, ObjectStatesPerStateWithOptionalSightings) {
   EXPECT_EQ(missed_barrel.outcome, "missed");
   EXPECT_EQ(missed_barrel.label, "barrel");
   EXPECT_EQ(missed_barrel.reported, -1);
+  EXPECT_EQ(missed_barrel.id, 3);  // the true object's id; a false report has none
+  EXPECT_EQ(wrong.outcomes[2].outcome, "false");
+  EXPECT_EQ(wrong.outcomes[2].id, -1);
   ASSERT_TRUE(missed_barrel.before.has_value());
   EXPECT_DOUBLE_EQ(missed_barrel.before->x(), 9.0);
 }
@@ -374,6 +377,31 @@ TEST(ChangeScore, AppearanceRegionsOnVisibleObjectChanges) {
   KeepInOverlap(shift, 160, 100, &kept);
   ASSERT_EQ(kept.size(), 1u);
   EXPECT_GT(kept[0].x, prior[0].x);
+}
+
+// A flight's views of a 1 m crate 10 m ahead: from 10 m and 5 m it shows whole, from 1 m it fills more than the
+// frame, and from beyond it the camera looks away. Only the whole views give depths.
+TEST(ChangeScore, SightingsCountTheViewsThatShowAnObjectWholeAndTheirDepths) {
+  CameraPoseSample pose;  // looking along +x, as above
+  Eigen::Matrix3d r;
+  r.col(0) = Eigen::Vector3d(0, -1, 0), r.col(1) = Eigen::Vector3d(0, 0, -1), r.col(2) = Eigen::Vector3d(1, 0, 0);
+  pose.rotation = Eigen::Quaterniond(r);
+  const CameraIntrinsics camera{100, 100, 80, 50, 160, 100};
+  std::vector<CameraPoseSample> views;
+  for (const double x : {0.0, 5.0, 9.0, 12.0}) {
+    pose.position = Eigen::Vector3d(x, 0, 0.5);
+    views.push_back(pose);
+  }
+  const Sightings seen = SightingsOf(Truth(1, "crate", 10, 0, 4), views, camera);
+  EXPECT_EQ(seen.views, 3);  // the camera at x = 12 has it behind
+  EXPECT_EQ(seen.whole, 2);  // from x = 9 its near face spans 200 px of the 160
+  EXPECT_NEAR(seen.nearest_m, 5.0, 1e-9);
+  EXPECT_NEAR(seen.farthest_m, 10.0, 1e-9);
+  // Beside the path, 8.5 m to the left, it is cut by the frame's left edge from every view.
+  const Sightings beside = SightingsOf(Truth(2, "crate", 10, 8.5, 4), {views[0]}, camera);
+  EXPECT_EQ(beside.views, 1);
+  EXPECT_EQ(beside.whole, 0);
+  EXPECT_EQ(beside.nearest_m, 0.0);
 }
 
 // Object changes visible in two compared pairs of route frames; one reported change, and candidates that were

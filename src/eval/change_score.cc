@@ -163,7 +163,9 @@ void AddOutcomes(const std::string& state, const std::vector<TruthChange>& truth
   for (std::size_t t = 0; t < truth.size(); ++t) {
     if (truth[t].state != state || !truth[t].required) continue;
     const char* outcome = found_by[t] >= 0 ? "found" : "missed";
-    outcomes->push_back({state, outcome, truth[t].label, truth[t].before, truth[t].after, found_by[t]});
+    const TruthObject* object = truth[t].was != nullptr ? truth[t].was : truth[t].is;
+    outcomes->push_back({state, outcome, truth[t].label, truth[t].before, truth[t].after, found_by[t],
+                         object != nullptr ? object->id : -1});
   }
   const auto flat = [](const std::optional<Eigen::Vector3d>& p) {
     return p ? std::optional<Eigen::Vector2d>(p->head<2>()) : std::nullopt;
@@ -380,6 +382,26 @@ bool Overlaps(const cv::Rect2d& a, const cv::Rect2d& b, double min_overlap) {
 }
 
 }  // namespace
+
+Sightings SightingsOf(const TruthObject& object, const std::vector<CameraPoseSample>& views,
+                      const CameraIntrinsics& camera, const Distortion& distortion) {
+  Sightings sightings;
+  const cv::Rect2d image(0, 0, camera.width, camera.height);
+  const Eigen::Vector3d centre(object.centre.x(), object.centre.y(), object.height / 2);
+  const std::array<Eigen::Vector3d, 8> corners =
+      StandingBoxCorners(object.centre, object.yaw, object.length, object.width, object.height);
+  for (const CameraPoseSample& view : views) {
+    const double depth = view.ToCamera(centre).z();
+    if (depth <= 0.0) continue;
+    ++sightings.views;
+    const cv::Rect2d box = ProjectCorners(camera, view, corners, distortion);
+    if (box.area() <= 0.0 || (box & image) != box) continue;
+    sightings.nearest_m = sightings.whole == 0 ? depth : std::min(sightings.nearest_m, depth);
+    sightings.farthest_m = std::max(sightings.farthest_m, depth);
+    ++sightings.whole;
+  }
+  return sightings;
+}
 
 std::vector<VisibleChange> VisibleChanges(const std::vector<TruthObject>& here, const std::vector<TruthObject>& other,
                                           TimestampNs time_ns, const CameraPoseSample& pose,

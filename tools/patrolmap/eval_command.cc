@@ -168,6 +168,34 @@ nlohmann::json OutcomesJson(const std::vector<eval::ObjectOutcome>& outcomes,
   return list;
 }
 
+// Adds to each true change in `list` (OutcomesJson of `outcomes`) how the two flights of `map` saw it
+// (eval::SightingsOf, from the poses the map keeps at the truth detector's sightings): `seen_before` the prior flight
+// where the object was, `seen_after` the current one where it is.
+void AddSightings(const graph::TopoMap& map, const std::string& prior, const std::string& current,
+                  const std::vector<eval::ObjectOutcome>& outcomes, const std::vector<eval::TruthObject>& before,
+                  const std::vector<eval::TruthObject>& after, nlohmann::json* list) {
+  for (std::size_t i = 0; i < outcomes.size(); ++i) {
+    const eval::ObjectOutcome& o = outcomes[i];
+    if (o.id < 0) continue;
+    for (const bool was : {true, false}) {
+      const PatrolRecord* record = map.Patrol(was ? prior : current);
+      const std::vector<eval::TruthObject>& objects = was ? before : after;
+      const auto object =
+          std::find_if(objects.begin(), objects.end(), [&o](const eval::TruthObject& t) { return t.id == o.id; });
+      if (!(was ? o.before : o.after) || record == nullptr || !record->camera.valid() || object == objects.end()) {
+        continue;
+      }
+      std::vector<CameraPoseSample> views;
+      for (const TimestampNs time_ns : object->seen_ns) {
+        if (const std::optional<CameraPoseSample> pose = io::PoseAt(record->views, time_ns)) views.push_back(*pose);
+      }
+      const eval::Sightings seen = eval::SightingsOf(*object, views, record->camera, record->distortion);
+      (*list)[i][was ? "seen_before" : "seen_after"] = {
+          {"views", seen.views}, {"whole", seen.whole}, {"nearest_m", seen.nearest_m}, {"farthest_m", seen.farthest_m}};
+    }
+  }
+}
+
 // Geometry of the recomputed report, per voxel.
 void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& report,
                      const std::vector<eval::TruthObject>& before, const std::vector<eval::TruthObject>& after,
@@ -371,6 +399,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
                            {"distance_m", arguments.changes.distance_m},
                            {"places_compared", changes["summary"].value("places_compared", 0)},
                            {"places_changed", changes["summary"].value("places_changed", 0)}};
+  std::vector<eval::ObjectOutcome> outcomes;
   if (changes.contains("objects") && changes["objects"].is_array()) {
     std::vector<eval::ReportedObject> reported;
     PATROLMAP_RETURN_IF_ERROR(ReadReportedObjects(path, changes["objects"], &reported));
@@ -378,6 +407,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     for (const auto& [state, counts] : score.by_state) result["objects"][state] = CountsJson(counts);
     result["objects"]["unobserved_reported"] = score.unobserved;
     result["objects"]["outcomes"] = OutcomesJson(score.outcomes, reported);
+    outcomes = score.outcomes;
   }
   if (std::filesystem::exists(arguments.run + "/map.pmap")) {
     pipeline::Config config;
@@ -385,6 +415,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     change::ChangeReport recomputed;
     PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(arguments.config, &config));
     PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.run + "/map.pmap", &map));
+    if (!outcomes.empty()) AddSightings(map, prior, current, outcomes, before, after, &result["objects"]["outcomes"]);
     PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, prior, current, config.change, &recomputed));
     eval::ChangeScoreOptions options = arguments.changes;
     options.min_observations = config.change.geometry.min_observations;

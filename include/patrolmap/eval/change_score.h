@@ -93,7 +93,20 @@ struct ObjectOutcome {
   std::string label;                             // the true object's; a false report's own
   std::optional<Eigen::Vector2d> before, after;  // where the true object was and is; a false report's positions
   int reported = -1;  // the report that found it, or the false report: its index in `reported`
+  int id = -1;        // the true object's id (groundtruth/objects.csv); -1 for a false report
 };
+
+// How a flight saw an object from `views`, the camera poses of the truth detector's sightings of it
+// (TruthObject::seen_ns): in how many its box lay whole in the image, and the camera depth of its centre (half its
+// height up) in those. Tells a missed change that a depth sensor could not have ranged (seen only nearer or farther
+// than its reach, or only cut by the frame's edge) from one the method lost.
+struct Sightings {
+  int views = 0;                             // views with the object in front of the camera
+  int whole = 0;                             // ... of which its box lay whole in the image
+  double nearest_m = 0.0, farthest_m = 0.0;  // camera depth over the whole ones; 0 without
+};
+Sightings SightingsOf(const TruthObject& object, const std::vector<CameraPoseSample>& views,
+                      const CameraIntrinsics& camera, const Distortion& distortion = {});
 
 struct ObjectChangeScore {
   std::map<std::string, Counts> by_state;  // persistent, new, removed, moved
