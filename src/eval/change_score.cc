@@ -8,16 +8,16 @@
 #include "patrolmap/core/csv.h"
 
 namespace patrolmap::eval {
-namespace {
-
-constexpr double kSamePlace = 0.05;  // [m]: an object this close to where it was has not moved
-
 const TruthObject* FindId(const std::vector<TruthObject>& objects, int id) {
   for (const TruthObject& o : objects) {
     if (o.id == id) return &o;
   }
   return nullptr;
 }
+
+namespace {
+
+constexpr double kSamePlace = 0.05;  // [m]: an object this close to where it was has not moved
 
 struct TruthChange {
   std::string state, label;

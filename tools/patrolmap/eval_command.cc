@@ -179,12 +179,8 @@ void AddSightings(const graph::TopoMap& map, const std::string& prior, const std
     if (o.id < 0) continue;
     for (const bool was : {true, false}) {
       const PatrolRecord* record = map.Patrol(was ? prior : current);
-      const std::vector<eval::TruthObject>& objects = was ? before : after;
-      const auto object =
-          std::find_if(objects.begin(), objects.end(), [&o](const eval::TruthObject& t) { return t.id == o.id; });
-      if (!(was ? o.before : o.after) || record == nullptr || !record->camera.valid() || object == objects.end()) {
-        continue;
-      }
+      const eval::TruthObject* object = eval::FindId(was ? before : after, o.id);
+      if (!(was ? o.before : o.after) || record == nullptr || !record->camera.valid() || object == nullptr) continue;
       std::vector<CameraPoseSample> views;
       for (const TimestampNs time_ns : object->seen_ns) {
         if (const std::optional<CameraPoseSample> pose = io::PoseAt(record->views, time_ns)) views.push_back(*pose);

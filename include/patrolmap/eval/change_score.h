@@ -71,6 +71,9 @@ struct TruthObject {
 // Reads groundtruth/objects.csv and counts groundtruth/detections.csv of a simulated log.
 Status ReadTruthObjects(const std::string& log, std::vector<TruthObject>* objects);
 
+// The object with `id` among `objects`; null when none has it.
+const TruthObject* FindId(const std::vector<TruthObject>& objects, int id);
+
 struct ReportedObject {
   std::string state;  // persistent, new, removed, moved, unobserved
   std::string label;
