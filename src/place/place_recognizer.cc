@@ -183,8 +183,8 @@ void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::ve
 
 cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& options) {
   if (!options.compact_descriptors) return descriptors;
-  cv::Mat bytes;  // RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is
-  descriptors.convertTo(bytes, CV_8U, options.root_sift ? 255.0 : 1.0);
+  cv::Mat bytes(0, vocab::kDescriptorDimension, CV_8U);  // RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is
+  if (descriptors.rows > 0) descriptors.convertTo(bytes, CV_8U, options.root_sift ? 255.0 : 1.0);
   return options.descriptor_bits == 4 ? vocab::PackDescriptors(bytes) : bytes;
 }
 

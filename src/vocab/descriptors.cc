@@ -35,6 +35,7 @@ const LevelTable& Levels() {
 bool IsPacked(const cv::Mat& descriptors) { return descriptors.type() == CV_8U && descriptors.cols == kPackedColumns; }
 
 cv::Mat PackDescriptors(const cv::Mat& bytes) {
+  if (bytes.rows == 0) return cv::Mat(0, kPackedColumns, CV_8U);  // a frame without features
   PATROLMAP_CHECK(bytes.type() == CV_8U && bytes.cols == kDescriptorDimension);
   const std::uint8_t* level = Levels().of;
   cv::Mat packed(bytes.rows, kPackedColumns, CV_8U);
@@ -49,6 +50,7 @@ cv::Mat PackDescriptors(const cv::Mat& bytes) {
 }
 
 cv::Mat Expanded(const cv::Mat& descriptors) {
+  if (descriptors.rows == 0) return cv::Mat(0, kDescriptorDimension, descriptors.empty() ? CV_8U : descriptors.type());
   if (!IsPacked(descriptors)) return descriptors;
   cv::Mat bytes(descriptors.rows, kDescriptorDimension, CV_8U);
   for (int row = 0; row < descriptors.rows; ++row) {
