@@ -1,10 +1,14 @@
 // Place verification on real images with the default options, at the scale `patrolmap map` describes key
 // frames (flow.frames.scale). Each test skips when its data is absent: ../shared/data (DBoW2 demo, EuRoC
 // revisit pairs, KITTI excerpt) and Debian's opencv-doc (graf, leuven, aero pairs).
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -117,6 +121,117 @@ TEST(RealPairs, DefaultVerificationFindsRevisitsAndRejectsEveryOtherPair) {
     EXPECT_EQ(other.found, counts.found) << compact;
     EXPECT_EQ(other.false_accepts, counts.false_accepts) << compact;
   }
+}
+
+// How two images of the wide-baseline sets relate: the same place (a listed revisit), different places (images
+// of different sets, scenes or landmarks), or not known (two photographs of one landmark that pairs.txt does not
+// list, frames of the hand-held orbit that are not neighbours).
+enum class Relation { kRevisit, kOther, kUnknown };
+
+struct WideImage {
+  std::string name, set, scene;  // scene: a ScanNet scene, a landmark, the orbit
+  int index = 0;                 // its place in the orbit
+};
+
+Relation Relate(const WideImage& a, const WideImage& b, const std::set<std::pair<std::string, std::string>>& listed) {
+  if (a.set != b.set || a.scene != b.scene) return Relation::kOther;
+  if (listed.count({a.name, b.name}) != 0 || listed.count({b.name, a.name}) != 0) return Relation::kRevisit;
+  if (a.set == "tum" && std::abs(a.index - b.index) == 1) return Relation::kRevisit;  // 1 s apart, much overlap
+  return a.set == "scannet" ? Relation::kOther : Relation::kUnknown;  // a ScanNet scene shows one room twice
+}
+
+struct WideCounts {
+  int revisits = 0, found = 0, others = 0, false_accepts = 0;
+};
+
+// The ScanNet pairs, phototourism pairs and TUM orbit of ../shared/data with every other image as a non-revisit,
+// verified under `options`.
+WideCounts VerifyWidePairs(const std::vector<WideImage>& images, const std::vector<Described>& described,
+                           const std::set<std::pair<std::string, std::string>>& listed, const PlaceOptions& options,
+                           bool print) {
+  WideCounts counts;
+  std::vector<cv::Mat> stored;
+  for (const Described& d : described) stored.push_back(StoredDescriptors(d.descriptors, options));
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    for (std::size_t j = i + 1; j < images.size(); ++j) {
+      const Relation relation = Relate(images[i], images[j], listed);
+      if (relation == Relation::kUnknown) continue;
+      const Verification v = VerifyPair(options, described[i].points, stored[i], described[j].points, stored[j]);
+      if (print && (relation == Relation::kRevisit || v.inliers >= 8)) {
+        std::printf("%-44s %-44s %s matches %4d inliers %4d log NFA %8.1f\n", images[i].name.c_str(),
+                    images[j].name.c_str(), relation == Relation::kRevisit ? "revisit" : "other  ", v.matches,
+                    v.inliers, v.log_nfa);
+      }
+      if (relation == Relation::kRevisit) {
+        ++counts.revisits;
+        counts.found += v.accepted;
+      } else {
+        ++counts.others;
+        counts.false_accepts += v.accepted;
+      }
+    }
+  }
+  return counts;
+}
+
+// The a-contrario rule of the defaults (log NFA <= 0: at most one false alarm expected, Moisan and Stival's
+// epsilon = 1) on real revisits of wide baseline and on every pair of images of different scenes, beside the rule
+// fitted to the simulator before (log NFA <= -30). BENCHMARKS.md, "Verification on real revisits", prints this
+// table.
+TEST(RealPairs, TheoreticalRuleKeepsWideRevisitsAndAcceptsNoPairOfDifferentScenes) {
+  const std::string folder = kShared;
+  if (!std::filesystem::exists(folder + "/scannet_pairs/pairs_with_gt.txt")) GTEST_SKIP() << "shared data not present";
+  std::vector<WideImage> images;
+  std::set<std::pair<std::string, std::string>> listed;
+  std::ifstream scannet(folder + "/scannet_pairs/pairs_with_gt.txt");
+  for (std::string line; std::getline(scannet, line);) {
+    std::istringstream fields(line);
+    std::string a, b;
+    if (!(fields >> a >> b)) continue;
+    listed.insert({a, b});
+    for (const std::string& name : {a, b}) images.push_back({name, "scannet", name.substr(0, 12), 0});
+  }
+  std::ifstream landmarks(folder + "/phototourism_pairs/pairs.txt");
+  for (std::string a, b; landmarks >> a >> b;) listed.insert({a, b});
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder + "/phototourism_pairs")) {
+    if (entry.path().extension() == ".jpg") names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  for (const std::string& name : names) {
+    images.push_back({name, "phototourism", name.substr(0, name.find_first_of("0123456789")), 0});
+  }
+  names.clear();
+  for (const auto& entry : std::filesystem::directory_iterator(folder + "/tum_freiburg_orbit")) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  for (std::size_t k = 0; k < names.size(); ++k) images.push_back({names[k], "tum", "orbit", static_cast<int>(k)});
+  std::vector<Described> described;
+  for (const WideImage& image : images) {
+    const std::string subfolder = image.set == "scannet" ? "/scannet_pairs/"
+                                  : image.set == "tum"   ? "/tum_freiburg_orbit/"
+                                                         : "/phototourism_pairs/";
+    ASSERT_TRUE(Describe(folder + subfolder + image.name, image.set, -1, &described)) << image.name;
+  }
+  const WideCounts now = VerifyWidePairs(images, described, listed, PlaceOptions(), true);
+  std::printf("| rule | revisits kept | pairs of different scenes accepted |\n|---|---|---|\n");
+  for (const int min_inliers : {15, 8}) {
+    for (const double max_log_nfa : {0.0, -5.0, -10.0, -20.0, -30.0}) {
+      PlaceOptions options;
+      options.max_log_nfa = max_log_nfa;
+      options.min_inliers = min_inliers;
+      const WideCounts counts = VerifyWidePairs(images, described, listed, options, false);
+      const bool default_rule = max_log_nfa == PlaceOptions().max_log_nfa && min_inliers == PlaceOptions().min_inliers;
+      std::printf("| log NFA <= %.0f, %d inliers%s | %d of %d | %d of %d |\n", max_log_nfa, min_inliers,
+                  default_rule ? " (default)" : "", counts.found, counts.revisits, counts.false_accepts, counts.others);
+    }
+  }
+  PlaceOptions fitted;  // the rule fitted to the simulator before
+  fitted.max_log_nfa = -30.0;
+  const WideCounts before = VerifyWidePairs(images, described, listed, fitted, false);
+  EXPECT_EQ(now.false_accepts, 0);
+  EXPECT_GE(now.found, before.found);
 }
 
 // KITTI poses.txt: the camera centre of each frame (the translation column of its 3x4 matrix).

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -31,6 +32,16 @@ inline CLI::Validator FiniteRange(double low, double high = std::numeric_limits<
         return "";
       },
       "number in " + rule);
+}
+
+// --set KEY=VALUE (repeatable): a configuration key set on the command line, over the --config file.
+inline void AddSetOption(CLI::App* app, std::vector<std::string>* settings) {
+  app->add_option("--set", *settings,
+                  "set a configuration key over the --config file, as KEY=VALUE (e.g. --set place.max_log_nfa=0); "
+                  "repeatable; the keys are config/default.yaml's")
+      ->type_name("KEY=VALUE")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
 }  // namespace patrolmap::tools

@@ -32,6 +32,11 @@ void RemoveStaleTemporaries(const std::string& path) {
 
 }  // namespace
 
+bool PathExists(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error);
+}
+
 bool SameFile(const std::string& a, const std::string& b) {
   std::error_code error;
   if (std::filesystem::equivalent(a, b, error) && !error) return true;
@@ -41,9 +46,32 @@ bool SameFile(const std::string& a, const std::string& b) {
   return !error && canonical_a == canonical_b;
 }
 
+// Whether `path` names an existing file inside the folder `folder` (at any depth, through links and "..").
+bool FileInside(const std::string& path, const std::string& folder) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_regular_file(path, error) || !fs::is_directory(folder, error)) return false;
+  const fs::path file = fs::weakly_canonical(path, error), root = fs::weakly_canonical(folder, error);
+  if (error) return false;
+  const fs::path relative = file.lexically_relative(root);
+  return !relative.empty() && *relative.begin() != "..";
+}
+
 Status RefuseOverwritingInput(const std::string& output, const std::string& input, const std::string& what) {
-  if (!SameFile(output, input)) return Status::Ok();
+  if (!SameFile(output, input) && !FileInside(output, input)) return Status::Ok();
   return Status::InvalidArgument(output + " would replace " + input + " (the " + what + "); choose another output");
+}
+
+const char* const kMapOutputFiles[11] = {"map.pmap",        "nodes.csv",    "loop_closures.csv", "key_locations.csv",
+                                         "response.csv",    "response.svg", "changes.json",      "changes.html",
+                                         "changes.geojson", "changes.kml",  "events.jsonl"};
+
+Status RefuseOverwritingInFolder(const std::string& folder, const std::string& input, const std::string& what) {
+  if (input.empty()) return Status::Ok();
+  for (const char* name : kMapOutputFiles) {
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(folder + "/" + name, input, what));
+  }
+  return Status::Ok();
 }
 
 Status AtomicFile::Open(const std::string& path, AtomicFile* file) {

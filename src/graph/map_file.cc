@@ -1,16 +1,22 @@
 #include "patrolmap/graph/map_file.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <tuple>
 
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/flight_id.h"
 #include "patrolmap/vocab/descriptors.h"
+
+#include <opencv2/core.hpp>
 
 namespace patrolmap::graph {
 namespace {
@@ -19,8 +25,8 @@ constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
 // 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
 // 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit;
-// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion
-constexpr std::uint32_t kVersion = 10;
+// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion; 11: the patrol's log and its digest
+constexpr std::uint32_t kVersion = 11;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
@@ -282,6 +288,8 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     w.Value<std::uint8_t>(p.timed ? 1 : 0);
     w.String(p.pose_source);
     for (double k : p.distortion) w.Value(k);
+    w.String(p.source);
+    w.String(p.source_digest);
   }
 }
 
@@ -315,9 +323,16 @@ Status Corrupt(const std::string& path, const std::string& what) {
   return Status::DataLoss(path + ": corrupt map (" + what + ")");
 }
 
-// Flight ids as readers keep them (io::CleanFlightId): no control characters, commas or double quotes.
-bool ValidFlightId(const std::string& id) {
-  return !id.empty() && id.size() <= 1000 && std::none_of(id.begin(), id.end(), BreaksCsvField);
+// Flight ids as readers keep them (core/flight_id.h); maps written before ids were cut at 200 bytes hold longer ones.
+bool ValidFlightId(const std::string& id) { return IsValidFlightId(id, 1000); }
+
+// A patrol's log as the pipeline records it: printable text, and a digest of 16 hex digits (or none).
+bool ValidSource(const PatrolRecord& p) {
+  const std::string& d = p.source_digest;
+  return p.source.size() <= 4096 && PrintableText(p.source) == p.source &&
+         (d.empty() || (d.size() == 16 && std::all_of(d.begin(), d.end(), [](char c) {
+                          return std::isxdigit(static_cast<unsigned char>(c)) != 0;
+                        })));
 }
 
 bool Finite(std::initializer_list<double> values) {
@@ -360,6 +375,7 @@ Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
 
 Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
+  std::set<std::tuple<std::uint32_t, std::uint32_t, std::uint8_t>> seen;
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
     const auto a = r->Value<std::uint32_t>(), b = r->Value<std::uint32_t>();
     EdgeData e;
@@ -370,8 +386,14 @@ Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, Top
     if (version >= 3) e.log_nfa = r->Value<double>();
     if (r->failed()) break;
     if (kind > 1 || a >= static_cast<std::uint32_t>(map->node_count()) ||
-        b >= static_cast<std::uint32_t>(map->node_count()) || a == b) {
+        b >= static_cast<std::uint32_t>(map->node_count()) || a == b ||
+        !Finite({e.bow_score, e.matched_fraction, e.log_nfa}) || e.bow_score < 0.0 || e.matched_fraction < 0.0 ||
+        e.inliers < 0) {
       return Corrupt(path, "edge " + std::to_string(i));
+    }
+    // A map holds one edge of a kind between two nodes (a crafted one could repeat it thousands of times).
+    if (!seen.insert({std::min(a, b), std::max(a, b), kind}).second) {
+      return Corrupt(path, "edge " + std::to_string(i) + " repeats another");
     }
     e.kind = static_cast<EdgeKind>(kind);
     map->AddEdge(static_cast<int>(a), static_cast<int>(b), e);
@@ -395,7 +417,8 @@ Status ParseFeatures(const std::string& path, std::uint32_t version, Reader* r, 
         (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.points.size()) ||
         !vocab::IsStoredDescriptorKind(n.descriptors) ||
         !std::all_of(n.points.begin(), n.points.end(), [](const cv::Point2f& p) { return std::isfinite(p.x + p.y); }) ||
-        !std::all_of(n.bow.weights.begin(), n.bow.weights.end(), [](float w) { return std::isfinite(w); })) {
+        (n.descriptors.depth() == CV_32F && !cv::checkRange(n.descriptors)) ||
+        !std::all_of(n.bow.weights.begin(), n.bow.weights.end(), [](float w) { return std::isfinite(w) && w >= 0; })) {
       return Corrupt(path, "features of node " + std::to_string(i));
     }
   }
@@ -428,8 +451,14 @@ MapObject ReadObject(Reader* r) {
   return o;
 }
 
+// Sorted voxels, each well inside the integer range, so the grid's neighbour and shift arithmetic cannot overflow
+// (2^30 voxels of 1 cm are 10,000 km).
 bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
-  return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore);
+  constexpr int kMaxIndex = 1 << 30;
+  const auto inside = [](const VoxelEvidence& v) {
+    return std::max({v.x, v.y, v.z}) <= kMaxIndex && std::min({v.x, v.y, v.z}) >= -kMaxIndex;
+  };
+  return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore) && std::all_of(voxels.begin(), voxels.end(), inside);
 }
 
 // A pose with a valid time, a finite position and a rotation of about unit norm.
@@ -563,6 +592,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     if (version >= 9) p.pose_source = r->String();
     if (version >= 10)
       for (double& k : p.distortion) k = r->Value<double>();
+    if (version >= 11) p.source = r->String(), p.source_digest = r->String();
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
@@ -575,6 +605,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     }
     if (!ValidRoute(p.route)) return Corrupt(path, "route frames of " + p.flight);
     if (!KnownPoseSource(p.pose_source)) return Corrupt(path, "pose source of " + p.flight);
+    if (!ValidSource(p)) return Corrupt(path, "log of " + p.flight);
     // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.
     if (map->Patrol(p.flight) != nullptr) return Corrupt(path, "second patrol record of " + p.flight);
     map->SetPatrol(std::move(p));

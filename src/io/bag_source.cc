@@ -14,6 +14,7 @@
 #include "bag_file.h"
 #include "gps_poses.h"
 #include "image_times.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/pose_file.h"
 #include "patrolmap/io/readers.h"
@@ -182,8 +183,13 @@ std::optional<Value> ValueAt(std::deque<TimedValue<Value>>* samples, TimestampNs
 // Converts a decoded image message to the frame's 8-bit grey image; fails naming the problem.
 Status ToGrey(const rosmsg::ImageMessage& image, cv::Mat* grey) {
   if (image.compressed) {
+    if (image.size == 0 || image.data == nullptr) return Status::DataLoss("compressed image of 0 bytes");
     const cv::Mat bytes(1, static_cast<int>(image.size), CV_8UC1, const_cast<std::uint8_t*>(image.data));
-    *grey = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    try {
+      *grey = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    } catch (const cv::Exception&) {
+      grey->release();
+    }
     if (grey->empty()) return Status::DataLoss("compressed image (" + image.encoding + ") does not decode");
     return Status::Ok();
   }
@@ -271,6 +277,7 @@ class BagSource : public FrameSource {
         body_from_camera_(body_from_camera.value_or(Eigen::Quaterniond::Identity())) {}
 
   const LogInfo& info() const override { return info_; }
+  void SetFlightId(std::string id) override { info_.flight_id = std::move(id); }
 
   Status UsePoseFile(const std::string& path) override {
     std::vector<TimestampNs> times;
@@ -556,7 +563,7 @@ class BagSource : public FrameSource {
 };
 
 Status OpenBagFile(const std::string& path, std::unique_ptr<BagFile>* bag) {
-  if (!fs::exists(path)) return Status::NotFound(path + ": no such file or folder");
+  if (!PathExists(path)) return Status::NotFound(path + ": no such file or folder");
   const fs::path location(path);
   if (fs::is_directory(location)) return OpenRos2Bag(path, bag);
   if (location.extension() == ".db3") return OpenRos2Bag(location.parent_path().string(), bag);

@@ -12,6 +12,7 @@
 #include "image_list_source.h"
 #include "image_times.h"
 #include "patrolmap/core/csv.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/io/camera_file.h"
 #include "patrolmap/io/patrol_sensors.h"
 #include "patrolmap/io/readers.h"
@@ -81,6 +82,9 @@ Status ReadNumbers(const std::string& path, const YAML::Node& node, const char* 
 
 // Reads the optional frame rate `key` of a YAML file into `rate_hz` (unchanged when absent): a finite
 // number above 0, or the file is refused naming the key.
+// The highest frame rate a log may declare (input.frame_rate_hz's bound too) [Hz].
+constexpr double kMaxFrameRateHz = 10000.0;
+
 Status ReadRate(const std::string& path, const YAML::Node& root, const char* key, double* rate_hz) {
   if (!root[key]) return Status::Ok();
   double value = 0.0;
@@ -89,8 +93,9 @@ Status ReadRate(const std::string& path, const YAML::Node& root, const char* key
   } catch (const YAML::Exception&) {
     value = 0.0;
   }
-  if (!std::isfinite(value) || value <= 0.0) {
-    return Status::DataLoss(path + ": '" + key + "' must be a frame rate above 0 [Hz]");
+  if (!std::isfinite(value) || value <= 0.0 || value > kMaxFrameRateHz) {
+    return Status::DataLoss(path + ": '" + key + "' must be a frame rate above 0 and at most " +
+                            std::to_string(static_cast<int>(kMaxFrameRateHz)) + " [Hz]");
   }
   *rate_hz = value;
   return Status::Ok();
@@ -189,8 +194,8 @@ Status ReadStereoCamera(const std::string& path, StereoCamera* camera, std::stri
 // frame that cam1 saw at the same time (left and right image). Nothing when the log has no cam1/.
 Status ReadStereoPairs(const std::string& log, const std::vector<ImageEntry>& left_entries,
                        std::optional<StereoCalibration>* calibration, std::vector<DepthEntry>* pairs) {
-  if (!fs::exists(log + "/cam1/data.csv") || !fs::exists(log + "/cam1/sensor.yaml")) return Status::Ok();
-  if (!fs::exists(log + "/cam0/sensor.yaml")) {
+  if (!PathExists(log + "/cam1/data.csv") || !PathExists(log + "/cam1/sensor.yaml")) return Status::Ok();
+  if (!PathExists(log + "/cam0/sensor.yaml")) {
     spdlog::warn("{}: cam1/ present but cam0/sensor.yaml missing: the stereo pair's calibration is unknown", log);
     return Status::Ok();
   }
@@ -251,16 +256,16 @@ Status ReadMeta(const std::string& path, LogInfo* info) {
 Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<ImuSample>* imu,
                            std::vector<AttitudeSample>* attitude, std::vector<SpeedSample>* speeds) {
   Eigen::Matrix3d body_from_camera = Eigen::Matrix3d::Identity();
-  const bool has_camera_yaml = fs::exists(log + "/cam0/sensor.yaml");
+  const bool has_camera_yaml = PathExists(log + "/cam0/sensor.yaml");
   if (has_camera_yaml) {
     PATROLMAP_RETURN_IF_ERROR(ReadCameraSensor(log + "/cam0/sensor.yaml", info, &body_from_camera));
     info->body_from_camera = body_from_camera;
   }
-  if (fs::exists(log + "/meta.yaml")) PATROLMAP_RETURN_IF_ERROR(ReadMeta(log + "/meta.yaml", info));
-  if (fs::exists(log + "/imu0/data.csv")) {
+  if (PathExists(log + "/meta.yaml")) PATROLMAP_RETURN_IF_ERROR(ReadMeta(log + "/meta.yaml", info));
+  if (PathExists(log + "/imu0/data.csv")) {
     PATROLMAP_RETURN_IF_ERROR(ReadImuTable(log + "/imu0/data.csv", imu, attitude));
     Eigen::Matrix3d body_from_imu = Eigen::Matrix3d::Identity();
-    if (fs::exists(log + "/imu0/sensor.yaml")) {
+    if (PathExists(log + "/imu0/sensor.yaml")) {
       YAML::Node root;
       PATROLMAP_RETURN_IF_ERROR(LoadYamlMap(log + "/imu0/sensor.yaml", &root));
       PATROLMAP_RETURN_IF_ERROR(ReadBodyFromSensor(log + "/imu0/sensor.yaml", root, &body_from_imu));
@@ -268,7 +273,7 @@ Status ReadOptionalSensors(const std::string& log, LogInfo* info, std::vector<Im
     if (has_camera_yaml) info->camera_from_imu = body_from_camera.transpose() * body_from_imu;
   }
   const std::string state = log + "/state_groundtruth_estimate0/data.csv";
-  if (fs::exists(state)) PATROLMAP_RETURN_IF_ERROR(ReadSpeedTable(state, speeds));
+  if (PathExists(state)) PATROLMAP_RETURN_IF_ERROR(ReadSpeedTable(state, speeds));
   return Status::Ok();
 }
 
@@ -329,13 +334,17 @@ Status ReadCameraFile(const std::string& path, CameraIntrinsics* camera, Distort
 
 Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source) {
   std::string log = folder;
-  if (!fs::exists(log + "/cam0/data.csv") && fs::exists(log + "/mav0/cam0/data.csv")) log += "/mav0";
+  if (!PathExists(log + "/cam0/data.csv") && PathExists(log + "/mav0/cam0/data.csv")) log += "/mav0";
   LogInfo info;
   info.path = folder;
   info.kind = "euroc";
-  info.flight_id = fs::path(folder).lexically_normal().filename().string();
-  if (info.flight_id.empty()) info.flight_id = fs::path(folder).parent_path().filename().string();
-  info.flight_id = CleanFlightId(info.flight_id);
+  // A EuRoC log keeps its data in mav0/: given as LOG/mav0, the flight is LOG's.
+  std::error_code ignored;  // without a current folder the name as given serves
+  fs::path named = fs::absolute(folder, ignored).lexically_normal();
+  if (named.empty()) named = fs::path(folder).lexically_normal();
+  if (!named.has_filename()) named = named.parent_path();
+  if (named.filename() == "mav0" && named.has_parent_path()) named = named.parent_path();
+  info.flight_id = CleanFlightId(named.filename().string());
   std::vector<ImageEntry> entries;
   std::vector<ImuSample> imu;
   std::vector<AttitudeSample> attitude;
@@ -343,7 +352,7 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   std::vector<GpsSample> gps;
   PATROLMAP_RETURN_IF_ERROR(ReadCameraTable(log, "cam0", &entries));
   PATROLMAP_RETURN_IF_ERROR(ReadOptionalSensors(log, &info, &imu, &attitude, &speeds));
-  if (fs::exists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
+  if (PathExists(log + "/gps0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadGpsTable(log + "/gps0/data.csv", &gps));
   if (!(info.frame_rate_hz > 0.0 && std::isfinite(info.frame_rate_hz))) {
     info.frame_rate_hz = MedianRate(FrameTimes(entries));
   }

@@ -2,16 +2,14 @@
 
 #include <spdlog/spdlog.h>
 
-#include "patrolmap/core/csv.h"
+#include "patrolmap/core/flight_id.h"
 
 namespace patrolmap::io {
 
 std::string CleanFlightId(const std::string& raw) {
-  std::string id;
-  for (char c : raw) id += BreaksCsvField(c) ? '_' : c;
-  if (id.size() > kMaxFlightIdLength) id.resize(kMaxFlightIdLength);
-  if (id.empty()) id = "flight";
-  if (id != raw) spdlog::warn("flight id '{}' contains characters tables cannot hold; it is '{}' here", raw, id);
+  const std::string id = CleanedFlightId(raw);
+  if (id != raw && !raw.empty())
+    spdlog::warn("flight id '{}' contains characters tables cannot hold; it is '{}' here", raw, id);
   return id;
 }
 

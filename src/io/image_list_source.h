@@ -29,6 +29,7 @@ class ImageListSource : public FrameSource {
 
   Status Next(bool decode_image, Frame* frame) override;
   const LogInfo& info() const override { return info_; }
+  void SetFlightId(std::string id) override { info_.flight_id = std::move(id); }
   Status UsePoseFile(const std::string& path) override;
   Status UseCameraFile(const std::string& path) override;
 

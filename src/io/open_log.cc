@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <set>
 
@@ -15,6 +16,7 @@
 
 #include "image_list_source.h"
 #include "image_times.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/io/bag.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/readers.h"
@@ -153,6 +155,7 @@ class VideoSource : public FrameSource {
     return Status::Ok();
   }
   const LogInfo& info() const override { return info_; }
+  void SetFlightId(std::string id) override { info_.flight_id = std::move(id); }
 
  private:
   // A video that ends well before the frame count of its header was cut short (a copy or a recording
@@ -194,7 +197,8 @@ Status OpenImageFolder(const std::string& folder, const ImageFolderOptions& opti
   std::vector<std::string> names;
   std::error_code error;
   for (const auto& item : fs::directory_iterator(folder, error)) {
-    if (item.is_regular_file() && IsImageFile(item.path())) names.push_back(item.path().filename());
+    std::error_code unreadable;  // a link into a loop, or to nowhere, is no image
+    if (item.is_regular_file(unreadable) && IsImageFile(item.path())) names.push_back(item.path().filename());
   }
   if (error) return Status::IoError(folder + ": cannot list: " + error.message());
   if (names.empty()) return Status::DataLoss(folder + ": folder holds no images (.png, .jpg, ...)");
@@ -214,9 +218,9 @@ Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& op
   PATROLMAP_RETURN_IF_ERROR(CheckFrameRate(options));
   ImagePattern parsed;
   PATROLMAP_RETURN_IF_ERROR(ParsePattern(pattern, &parsed));
-  const int first = fs::exists(parsed.Format(0)) ? 0 : 1;
+  const int first = PathExists(parsed.Format(0)) ? 0 : 1;
   std::vector<std::string> paths;
-  for (int index = first; index < std::numeric_limits<int>::max() && fs::exists(parsed.Format(index)); ++index) {
+  for (int index = first; index < std::numeric_limits<int>::max() && PathExists(parsed.Format(index)); ++index) {
     paths.push_back(parsed.Format(index));
   }
   if (paths.empty()) {
@@ -229,9 +233,43 @@ Status OpenImagePattern(const std::string& pattern, const ImageFolderOptions& op
   return Status::Ok();
 }
 
+// Refuses, by its first bytes, a file that is plainly no video before a decoder (and its library's traces) sees it:
+// patrolmap's own maps and vocabularies, single images, and text (configurations, tables).
+Status RefuseNonVideo(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  char head[512] = {};
+  stream.read(head, sizeof(head));
+  const std::string start(head, static_cast<std::size_t>(stream.gcount()));
+  const auto starts = [&](const std::string& magic) { return start.compare(0, magic.size(), magic) == 0; };
+  if (start.empty()) return Status::DataLoss(path + ": an empty file, not a flight log");
+  if (starts(std::string("PMMAP\0", 6))) {
+    return Status::InvalidArgument(path + ": a patrolmap map, not a flight log (give a map with --map)");
+  }
+  if (starts("PMVOCAB")) {
+    return Status::InvalidArgument(path + ": a patrolmap vocabulary, not a flight log (give it with --vocabulary)");
+  }
+  std::string extension = fs::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::set<std::string> image_extensions = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".pgm", ".ppm"};
+  if (image_extensions.count(extension) != 0 && !starts("\0")) {
+    return Status::InvalidArgument(path + ": a single image, not a flight log; give the folder that holds the images");
+  }
+  const bool text = std::all_of(start.begin(), start.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return u >= 0x20 || c == '\n' || c == '\r' || c == '\t';
+  });
+  if (text) {
+    return Status::InvalidArgument(path +
+                                   ": a text file (a configuration or a table?), not a flight log; a EuRoC log is the "
+                                   "folder that holds cam0/, an image collection the folder of its images");
+  }
+  return Status::Ok();
+}
+
 Status OpenVideo(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
   PATROLMAP_RETURN_IF_ERROR(CheckFrameRate(options));
   if (!fs::is_regular_file(path)) return Status::NotFound(path + ": no such file");
+  PATROLMAP_RETURN_IF_ERROR(RefuseNonVideo(path));
   cv::VideoCapture capture(path);
   if (!capture.isOpened()) return Status::DataLoss(path + ": not a video OpenCV can decode");
   const double reported_rate = capture.get(cv::CAP_PROP_FPS);
@@ -294,10 +332,10 @@ Status ParseTopicChoice(const std::vector<std::string>& assignments, TopicChoice
 
 Status OpenLog(const std::string& path, const ImageFolderOptions& options, std::unique_ptr<FrameSource>* source) {
   if (path.find('%') != std::string::npos) return OpenImagePattern(path, options, source);
-  if (!fs::exists(path)) return Status::NotFound(path + ": no such file or folder");
+  if (!PathExists(path)) return Status::NotFound(path + ": no such file or folder");
   if (IsBag(path)) return OpenBag(path, options, source);
   if (fs::is_directory(path)) {
-    if (fs::exists(path + "/cam0/data.csv") || fs::exists(path + "/mav0/cam0/data.csv")) {
+    if (PathExists(path + "/cam0/data.csv") || PathExists(path + "/mav0/cam0/data.csv")) {
       return OpenEuroc(path, source);
     }
     return OpenImageFolder(path, options, source);

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "euroc_tables.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/io/readers.h"
 
 namespace fs = std::filesystem;
@@ -86,20 +87,20 @@ Status ReadPatrolSensors(const std::string& log, PatrolSensors* sensors) {
   sensors->camera = info.camera;
   if (info.kind != "euroc") return Status::Ok();
   std::string root = log;
-  if (!fs::exists(root + "/cam0/data.csv") && fs::exists(root + "/mav0/cam0/data.csv")) root += "/mav0";
+  if (!PathExists(root + "/cam0/data.csv") && PathExists(root + "/mav0/cam0/data.csv")) root += "/mav0";
   return ReadSensorTables(root, info.body_from_camera.value_or(Eigen::Matrix3d::Identity()), sensors);
 }
 
 Status ReadSensorTables(const std::string& root, const Eigen::Matrix3d& body_from_camera, PatrolSensors* sensors) {
   const std::string state = root + "/state_groundtruth_estimate0/data.csv";
-  if (fs::exists(state)) {
+  if (PathExists(state)) {
     PATROLMAP_RETURN_IF_ERROR(ReadPoseTable(state, body_from_camera, &sensors->poses));
     if (!sensors->poses.empty()) sensors->pose_source = kPosesFromStateEstimate;
   }
-  if (fs::exists(root + "/objects0/data.csv")) {
+  if (PathExists(root + "/objects0/data.csv")) {
     PATROLMAP_RETURN_IF_ERROR(ReadDetectionTable(root + "/objects0/data.csv", &sensors->detections));
   }
-  if (fs::exists(root + "/depth0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadDepthTable(root, &sensors->depth));
+  if (PathExists(root + "/depth0/data.csv")) PATROLMAP_RETURN_IF_ERROR(ReadDepthTable(root, &sensors->depth));
   return Status::Ok();
 }
 
@@ -122,7 +123,7 @@ std::optional<CameraPoseSample> PoseAt(const std::vector<CameraPoseSample>& pose
 }
 
 Status ReadDepthImage(const std::string& path, cv::Mat* depth_m) {
-  if (!fs::exists(path)) return Status::NotFound(path + ": depth image missing");
+  if (!PathExists(path)) return Status::NotFound(path + ": depth image missing");
   const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) return Status::DataLoss(path + ": cannot decode depth image");
   if (raw.type() != CV_16UC1) return Status::DataLoss(path + ": depth image must be 16-bit single-channel");

@@ -60,6 +60,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
     report->places.push_back(std::move(place));
   }
   if (along_route) {
+    spdlog::info("{}: comparing its {} route frames with the {} of {} (appearance along the route)", current,
+                 current_record->route.size(), prior_record->route.size(), prior);
     report->route = change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route,
                                           options.appearance, change::RouteCamerasOf(*prior_record, *current_record));
   }
@@ -69,6 +71,10 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   report->pose_current = current_record->pose_source;
 
   start = std::chrono::steady_clock::now();
+  if (!prior_record->grid.voxels.empty() && !current_record->grid.voxels.empty()) {
+    spdlog::info("{}: comparing its evidence grid ({} voxels) with {}'s ({}; geometry and objects)", current,
+                 current_record->grid.voxels.size(), prior, prior_record->grid.voxels.size());
+  }
   report->geometry_compared = change::DiffGrids(
       prior_record->grid, current_record->grid,
       change::ForPoseSources(options.geometry, prior_record->pose_source, current_record->pose_source),

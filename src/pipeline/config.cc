@@ -1,10 +1,12 @@
 #include "patrolmap/pipeline/config.h"
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
+#include "patrolmap/core/nearest_name.h"
 #include "patrolmap/core/option_check.h"
 #include "patrolmap/io/yaml_file.h"
 
@@ -42,7 +44,7 @@ class YamlReader {
         CheckUnknown(item.second, path);
         continue;
       }
-      Fail(path, item.first, "unknown key");
+      Fail(path, item.first, "unknown key" + DidYouMean(path, KnownAtDepthOf(path)));
       return;
     }
   }
@@ -50,6 +52,20 @@ class YamlReader {
   const Status& status() const { return status_; }
 
  private:
+  // The known keys and sections as deep as `path` ("flow.smoothing" for "flow.smothing"), to suggest one.
+  std::vector<std::string> KnownAtDepthOf(const std::string& path) const {
+    const std::size_t depth = SplitPath(path).size();
+    std::set<std::string> names;
+    for (const std::string& key : known_) {
+      const std::vector<std::string> parts = SplitPath(key);
+      if (parts.size() < depth) continue;
+      std::string name = parts[0];
+      for (std::size_t i = 1; i < depth; ++i) name += "." + parts[i];
+      names.insert(name);
+    }
+    return {names.begin(), names.end()};
+  }
+
   bool IsSection(const std::string& path) const {
     for (const std::string& key : known_) {
       if (key.rfind(path + ".", 0) == 0) return true;
@@ -68,9 +84,10 @@ class YamlReader {
     return node;
   }
 
+  // "FILE:LINE: KEY: problem"; a tree built from the command line has no lines ("--set: KEY: problem").
   void Fail(const std::string& path, const YAML::Node& node, const std::string& problem) {
-    status_ =
-        Status::InvalidArgument(file_ + ":" + std::to_string(node.Mark().line + 1) + ": " + path + ": " + problem);
+    const std::string where = node.Mark().is_null() ? file_ : file_ + ":" + std::to_string(node.Mark().line + 1);
+    status_ = Status::InvalidArgument(where + ": " + path + ": " + problem);
   }
 
   template <typename T>
@@ -174,8 +191,33 @@ std::string ConfigToYaml(const Config& config) {
   return std::string(emitter.c_str()) + "\n";
 }
 
-Status LoadCheckedConfig(const std::string& path, Config* config) {
+Status ApplySettings(const std::vector<std::string>& settings, Config* config) {
+  YAML::Node root(YAML::NodeType::Map);
+  for (const std::string& setting : settings) {
+    const std::size_t equals = setting.find('=');
+    const std::vector<std::string> parts = SplitPath(setting.substr(0, equals));
+    if (equals == std::string::npos || parts.empty() ||
+        std::any_of(parts.begin(), parts.end(), [](const std::string& part) { return part.empty(); }) ||
+        setting.back() == '.') {
+      return Status::InvalidArgument("--set " + setting + ": expected KEY=VALUE, e.g. place.max_log_nfa=0");
+    }
+    YAML::Node node;
+    node.reset(root);
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      if (!node[parts[i]] || !node[parts[i]].IsMap()) node[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      node.reset(node[parts[i]]);
+    }
+    node[parts.back()] = setting.substr(equals + 1);
+  }
+  YamlReader reader("--set", root);
+  VisitConfig(config, &reader);
+  reader.CheckUnknown(root, "");
+  return reader.status();
+}
+
+Status LoadCheckedConfig(const std::string& path, const std::vector<std::string>& settings, Config* config) {
   if (!path.empty()) PATROLMAP_RETURN_IF_ERROR(LoadConfig(path, config));
+  PATROLMAP_RETURN_IF_ERROR(ApplySettings(settings, config));
   std::string error;
   if (!config->IsValid(&error)) return Status::InvalidArgument(error);
   return Status::Ok();

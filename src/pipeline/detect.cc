@@ -95,7 +95,9 @@ std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const Detect
   std::vector<std::string> warnings;
   if (!info.timed) {
     warnings.push_back(info.path + ": the log has no timestamps, so its frames are taken as " +
-                       Number(info.frame_rate_hz) + " Hz; give --fps (input.frame_rate_hz) for the real rate");
+                       Number(info.frame_rate_hz) +
+                       " Hz; give --fps (input.frame_rate_hz) for the real rate, or, for a collection of "
+                       "photographs rather than a video's frames, map --every-frame (each image a node)");
   }
   const double duration_s = result.samples.size() < 2
                                 ? 0.0
@@ -106,7 +108,9 @@ std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const Detect
                        "window (flow.smoothing.window_s = " +
                        Number(options.smoothing.window_s) + " s, " + std::to_string(result.timing.window) +
                        " processed frames), which flattens the response; "
-                       "for short logs lower flow.smoothing.window_s to about a quarter of the log");
+                       "for short logs lower flow.smoothing.window_s to about a quarter of the log (--set "
+                       "flow.smoothing.window_s=" +
+                       Number(std::max(0.1, duration_s / 4.0)) + ")");
   }
   if (result.unusable_frames > 0) {
     warnings.push_back(info.path + ": " + std::to_string(result.unusable_frames) + " frames were too small (under " +

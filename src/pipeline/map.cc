@@ -139,7 +139,7 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
     nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.points.size() << "\n";
   }
   closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers,log_nfa\n";
-  char line[256];
+  char line[1200];  // room for three doubles of any size (%.4f of 1e308 is 314 characters) and the integers
   for (const graph::TopoMap::Edge& e : map.Edges()) {
     if (e.data.kind != graph::EdgeKind::kLoopClosure) continue;
     std::snprintf(line, sizeof(line), "%d,%d,%lld,%lld,%.4f,%.4f,%d,%.1f\n", e.a, e.b,

@@ -2,6 +2,7 @@
 #include "patrolmap/pipeline/mapping.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -9,7 +10,9 @@
 
 #include "patrolmap/change/grid_alignment.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/flight_id.h"
 #include "patrolmap/graph/map_file.h"
+#include "patrolmap/io/log_digest.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/pipeline/change.h"
 #include "patrolmap/pipeline/detect.h"
@@ -40,8 +43,21 @@ Status CheckRequest(const MappingRequest& request, Config* config) {
     PATROLMAP_RETURN_IF_ERROR(io::CheckLogExists(source));
     PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out, source, "flight log"));
   }
-  if (!request.prior_map.empty()) {
-    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out + "/map.pmap", request.prior_map, "prior map"));
+  const std::pair<std::string, const char*> inputs[] = {{request.prior_map, "prior map"},
+                                                        {request.poses, "pose file"},
+                                                        {request.camera, "camera file"},
+                                                        {request.config_path, "configuration"},
+                                                        {request.vocabulary_path, "vocabulary"}};
+  for (const auto& [input, what] : inputs) {
+    PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInFolder(request.out, input, what));
+  }
+  if (!request.flight_id.empty() && request.sources.size() > 1) {
+    return Status::InvalidArgument("--flight-id " + request.flight_id + ": names one log; map the logs one at a time");
+  }
+  if (!request.flight_id.empty() && !IsValidFlightId(request.flight_id)) {
+    return Status::InvalidArgument("--flight-id " + request.flight_id + ": a flight id is UTF-8 text of at most " +
+                                   std::to_string(kMaxFlightIdLength) +
+                                   " bytes without control characters, commas, quotes or slashes, not . or ..");
   }
   if (!request.poses.empty() && request.sources.size() > 1) {
     return Status::InvalidArgument("--poses " + request.poses +
@@ -51,7 +67,7 @@ Status CheckRequest(const MappingRequest& request, Config* config) {
   std::string error;
   if (!request.pass.IsValid(&error)) return Status::InvalidArgument(error);
   if (request.events && !request.events->IsValid(&error)) return Status::InvalidArgument(error);
-  PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, config));
+  PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, request.config_settings, config));
   if (request.fps > 0.0) config->input.frame_rate_hz = request.fps;
   PATROLMAP_RETURN_IF_ERROR(io::ParseTopicChoice(request.topics, &config->input.topics));
   return Status::Ok();
@@ -103,11 +119,70 @@ Status WriteFlightOutputs(const MappingRequest& request, const io::LogInfo& info
   return Status::Ok();
 }
 
+// The flights a new log must not repeat: the prior map's and those mapped earlier in this run.
+struct KnownFlight {
+  std::string id, source, digest;
+};
+
+std::vector<KnownFlight> KnownFlights(const graph::TopoMap& prior, const MappingOutcome& outcome) {
+  std::vector<KnownFlight> known;
+  for (const std::string& flight : prior.Flights()) {
+    const PatrolRecord* record = prior.Patrol(flight);
+    known.push_back({flight, record ? record->source : "", record ? record->source_digest : ""});
+  }
+  for (const FlightRun& run : outcome.flights) {
+    const PatrolRecord& record = run.result.record;
+    known.push_back({record.flight, record.source, record.source_digest});
+  }
+  return known;
+}
+
+// The flight id of a new log, its path and digest: a log whose content is already in the map is refused; an id
+// the map has is refused when the user chose it, else the log's own id gets the first free suffix (ID-2, ID-3, ...,
+// as merge --rename-clashes), with a warning, so two flights never become one.
+Status IdentifyFlight(const std::string& spec, const std::string& chosen_id, const std::vector<KnownFlight>& known,
+                      io::FrameSource* source, PatrolRecord* identity) {
+  if (!IsCamera(spec)) {
+    std::error_code ignored;
+    const std::filesystem::path absolute = std::filesystem::absolute(spec, ignored).lexically_normal();
+    identity->source = PrintableText(absolute.empty() ? spec : absolute.string());
+    identity->source_digest = io::LogDigest(spec);
+  }
+  for (const KnownFlight& flight : known) {
+    if (identity->source_digest.empty() || flight.digest != identity->source_digest) continue;
+    return Status::InvalidArgument(spec + ": this log is already in the map as flight '" + flight.id + "'" +
+                                   (flight.source.empty() ? "" : " (read from " + flight.source + ")") +
+                                   "; a log is mapped once");
+  }
+  const auto taken = [&](const std::string& id) {
+    return std::any_of(known.begin(), known.end(), [&](const KnownFlight& flight) { return flight.id == id; });
+  };
+  const std::string wanted = chosen_id.empty() ? source->info().flight_id : chosen_id;
+  std::string id = wanted;
+  if (taken(id) && !chosen_id.empty()) {
+    return Status::InvalidArgument("--flight-id " + chosen_id + ": the map already has a flight of that id");
+  }
+  for (int suffix = 2; taken(id); ++suffix) id = CleanedFlightId(wanted + "-" + std::to_string(suffix));
+  if (id != wanted) {
+    spdlog::warn(
+        "{}: the map already has a flight '{}' from another log; this one is flight '{}' (name it with "
+        "--flight-id or flight_id in meta.yaml)",
+        spec, wanted, id);
+  }
+  identity->flight = id;
+  source->SetFlightId(id);
+  return Status::Ok();
+}
+
 // One source through the per-frame pass; its nodes and loop closures go to `outcome->places`.
 Status MapSource(const MappingRequest& request, const std::string& spec, const Config& config,
-                 place::PlaceRecognizer* recognizer, ChangeMonitor* monitor, MappingOutcome* outcome) {
+                 const graph::TopoMap& prior, place::PlaceRecognizer* recognizer, ChangeMonitor* monitor,
+                 MappingOutcome* outcome) {
   std::unique_ptr<io::FrameSource> source;
   PATROLMAP_RETURN_IF_ERROR(OpenSource(spec, config.input, &source));
+  PatrolRecord identity;
+  PATROLMAP_RETURN_IF_ERROR(
+      IdentifyFlight(spec, request.flight_id, KnownFlights(prior, *outcome), source.get(), &identity));
   if (!request.poses.empty()) PATROLMAP_RETURN_IF_ERROR(source->UsePoseFile(request.poses));
   if (!request.camera.empty()) PATROLMAP_RETURN_IF_ERROR(source->UseCameraFile(request.camera));
   const io::LogInfo& info = source->info();
@@ -122,6 +197,8 @@ Status MapSource(const MappingRequest& request, const std::string& spec, const C
   FlightRun& run = outcome->flights.emplace_back();
   PATROLMAP_RETURN_IF_ERROR(
       RunFlight(source.get(), config, request.pass, drive, recognizer, &outcome->places, monitor, &run));
+  run.result.record.source = identity.source;
+  run.result.record.source_digest = identity.source_digest;
   if (run.drive.interrupted) spdlog::info("{}: stop requested: writing the map", spec);
   for (const std::string& warning : run.warnings) spdlog::warn("{}", warning);
   LogRecord(run.result);
@@ -187,7 +264,7 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   }
   outcome->flights.reserve(request.sources.size());
   for (const std::string& source : request.sources) {
-    PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, &recognizer, monitor.get(), outcome));
+    PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, prior, &recognizer, monitor.get(), outcome));
   }
   graph::TopoMap map =
       AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change.alignment, outcome);

@@ -143,7 +143,7 @@ Status RunMerge(const MergeRequest& request, MergeOutcome* outcome) {
     PATROLMAP_RETURN_IF_ERROR(RefuseOverwritingInput(request.out + "/map.pmap", path, "map"));
   }
   Config config;
-  PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, &config));
+  PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(request.config_path, request.config_settings, &config));
   vocab::Vocabulary vocabulary;
   std::string vocabulary_path;
   PATROLMAP_RETURN_IF_ERROR(LoadSiftVocabulary(request.vocabulary_path, &vocabulary, &vocabulary_path));

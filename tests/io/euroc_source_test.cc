@@ -214,6 +214,26 @@ TEST(FlightId, CharactersThatBreakTablesAreReplaced) {
   EXPECT_EQ(CleanFlightId(std::string(500, 'a')).size(), kMaxFlightIdLength);
 }
 
+TEST(FlightId, IdsNeverNameAFolderOutsideTheOutputOrBreakUtf8) {
+  EXPECT_EQ(CleanFlightId("../../../x"), ".._.._.._x");
+  EXPECT_EQ(CleanFlightId(".."), "__");
+  EXPECT_EQ(CleanFlightId("."), "_");
+  EXPECT_EQ(CleanFlightId("a\\b"), "a_b");
+  EXPECT_EQ(CleanFlightId("caf\xc3\xa9"), "caf\xc3\xa9");  // UTF-8 stays
+  EXPECT_EQ(CleanFlightId("x\xffy"), "x_y");
+  EXPECT_EQ(CleanFlightId("x\xc3"), "x_");  // a character cut short
+  EXPECT_FALSE(IsValidFlightId("x\xffy"));
+  EXPECT_FALSE(IsValidFlightId(".."));
+  // Two long ids that share their first 200 bytes stay two ids, and a cut never splits a character.
+  const std::string start(190, 'a'), accented = std::string(199, 'a') + "\xc3\xa9" + "tail";
+  EXPECT_NE(CleanFlightId(start + std::string(50, 'x')), CleanFlightId(start + std::string(50, 'y')));
+  for (const std::string& raw : {start + std::string(50, 'x'), accented}) {
+    const std::string id = CleanFlightId(raw);
+    EXPECT_LE(id.size(), kMaxFlightIdLength);
+    EXPECT_TRUE(IsValidFlightId(id)) << id;
+  }
+}
+
 TEST(Euroc, BadSensorYamlNamesTheFile) {
   TempDir dir;
   const std::string log = dir / "flight";

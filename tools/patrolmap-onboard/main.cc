@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
                  "changes.json, changes.html")
       ->capture_default_str();
   app.add_option("-c,--config", arguments.request.config_path, "YAML configuration (see config/default.yaml)");
+  patrolmap::tools::AddSetOption(&app, &arguments.request.config_settings);
+  app.add_option("--flight-id", arguments.request.flight_id,
+                 "the flight's id (default: the log's own, or cameraN, made unique in the map)");
   app.add_option("--vocabulary", arguments.request.vocabulary_path, "vocabulary file (default: the shipped one)");
   app.add_option("--fps", arguments.request.fps, "frame rate of a log without timestamps [Hz] (default: its own times)")
       ->check(patrolmap::tools::FiniteRange(0.001, 10000.0));

@@ -19,6 +19,7 @@ namespace {
 struct DetectArguments {
   std::string log;
   std::string config;
+  std::vector<std::string> settings;  // --set KEY=VALUE
   std::string out = "patrolmap_out";
   std::string quantity;
   std::string smoothing;
@@ -52,7 +53,7 @@ int RunDetect(const DetectArguments& arguments) {
   pipeline::Config config;
   Status status = io::CheckLogExists(arguments.log);
   if (status.ok()) status = RefuseOverwritingInput(arguments.out, arguments.log, "flight log");
-  if (status.ok()) status = LoadCheckedConfig(arguments.config, &config);
+  if (status.ok()) status = LoadCheckedConfig(arguments.config, arguments.settings, &config);
   if (status.ok()) status = ApplyOverrides(arguments, &config);  // command-line flags win over the file
   if (status.ok() && arguments.fps > 0.0) config.input.frame_rate_hz = arguments.fps;
   if (status.ok()) status = io::ParseTopicChoice(arguments.topics, &config.input.topics);
@@ -89,6 +90,7 @@ Command AddDetectCommand(CLI::App* app) {
                   "flight log: EuRoC folder, image folder, printf pattern (frame_%04d.png) or video file")
       ->required();
   app->add_option("-c,--config", arguments->config, "YAML configuration (see config/default.yaml)");
+  AddSetOption(app, &arguments->settings);
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("--response", arguments->quantity, "override flow.response.quantity: length or line_parameter");
   app->add_option("--smoothing", arguments->smoothing, "override flow.smoothing.mode: centered or causal");

@@ -19,12 +19,13 @@ struct DiffArguments {
   std::string from, to;  // default: the map's last two flights
   std::string out = "patrolmap_diff";
   std::string config;
+  std::vector<std::string> settings;  // --set KEY=VALUE
 };
 
 int RunDiff(const DiffArguments& arguments) {
   pipeline::Config config;
   graph::TopoMap map;
-  Status status = LoadCheckedConfig(arguments.config, &config);
+  Status status = LoadCheckedConfig(arguments.config, arguments.settings, &config);
   if (status.ok()) status = graph::LoadMap(arguments.map, &map);
   if (!status.ok()) return Fail(status);
   const std::vector<std::string> flights = map.Flights();
@@ -103,6 +104,7 @@ Command AddDiffCommand(CLI::App* app) {
   app->add_option("--to", arguments->to, "the later flight (default: the map's last flight)");
   app->add_option("-o,--out", arguments->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->config, "YAML configuration (change.* keys; see config/default.yaml)");
+  AddSetOption(app, &arguments->settings);
   app->footer(
       "Compares the two flights: appearance at every place both saw (their loop closures), objects when both "
       "logs had detections, geometry when both had depth. Writes OUT/changes.json (format "

@@ -36,6 +36,7 @@ struct EvalArguments {
   eval::LoopClosureScoreOptions loop_closures;
   eval::ChangeScoreOptions changes;
   std::string config;
+  std::vector<std::string> settings;  // --set KEY=VALUE
 };
 
 // A simulated log: its flight id, frame count and ground-truth places.
@@ -409,7 +410,7 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     pipeline::Config config;
     graph::TopoMap map;
     change::ChangeReport recomputed;
-    PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(arguments.config, &config));
+    PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(arguments.config, arguments.settings, &config));
     PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.run + "/map.pmap", &map));
     if (!outcomes.empty()) AddSightings(map, prior, current, outcomes, before, after, &result["objects"]["outcomes"]);
     PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, prior, current, config.change, &recomputed));
@@ -591,6 +592,7 @@ Command AddEvalCommand(CLI::App* app) {
                   "changes: true objects the detector reported fewer times in a flight do not count")
       ->capture_default_str();
   app->add_option("-c,--config", arguments->config, "the run's configuration (change.* keys), for the geometry score");
+  AddSetOption(app, &arguments->settings);
   return [arguments] { return RunEval(*arguments); };
 }
 

@@ -69,6 +69,9 @@ std::string Picture(const graph::TopoMap& map, const ExportArguments& arguments,
 int RunExport(const ExportArguments& arguments) {
   graph::TopoMap map;
   Status status = arguments.out.empty() ? Status::Ok() : RefuseOverwritingInput(arguments.out, arguments.map, "map");
+  for (std::size_t i = 0; status.ok() && !arguments.out.empty() && i < arguments.logs.size(); ++i) {
+    status = RefuseOverwritingInput(arguments.out, arguments.logs[i], "flight log");
+  }
   if (status.ok()) status = graph::LoadMap(arguments.map, &map);
   if (!status.ok()) return Fail(status);
   const bool geographic = arguments.format == "geojson" || arguments.format == "kml";

@@ -85,6 +85,10 @@ int RunInfo(const std::string& path, bool verbose) {
     }
     if (record != nullptr) PrintCamera(*record);
     std::printf("\n");
+    if (record != nullptr && !record->source.empty()) {
+      std::printf("    read from %s%s\n", record->source.c_str(),
+                  record->source_digest.empty() ? "" : (" (content " + record->source_digest + ")").c_str());
+    }
     if (record == nullptr || !verbose) continue;
     for (const MapObject& o : record->objects) {
       std::printf("    object %3d %-10s confidence %.2f, %3d detections at (%.2f, %.2f, %.2f), %zu points%s\n", o.id,

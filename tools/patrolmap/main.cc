@@ -1,7 +1,10 @@
 // patrolmap: topological appearance mapping for UAV patrols (offline front end).
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <map>
+#include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -9,23 +12,10 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "patrolmap/core/nearest_name.h"
+#include "progress.h"
 
 namespace {
-
-// Edits (insertions, deletions, substitutions, swaps of neighbours) that turn `a` into `b`.
-std::size_t Distance(const std::string& a, const std::string& b) {
-  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
-        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  }
-  return d[a.size()][b.size()];
-}
 
 // A first argument that is neither an option nor a command is named, with the nearest command.
 bool UnknownCommand(const CLI::App& app, int argc, char** argv) {
@@ -36,12 +26,49 @@ bool UnknownCommand(const CLI::App& app, int argc, char** argv) {
   for (const CLI::App* sub : app.get_subcommands({})) {
     if (sub->get_name() == word) return false;
     names += (names.empty() ? "" : ", ") + sub->get_name();
-    const std::size_t distance = Distance(word, sub->get_name());
+    const std::size_t distance = patrolmap::EditDistance(word, sub->get_name());
     if (distance < best) best = distance, nearest = sub->get_name();
   }
   std::fprintf(stderr, "patrolmap: '%s' is not a command%s\ncommands: %s (patrolmap COMMAND --help for each)\n",
                word.c_str(), nearest.empty() ? "" : ("; did you mean '" + nearest + "'?").c_str(), names.c_str());
   return true;
+}
+
+// The long names ("--out") of the options `app` takes.
+std::vector<std::string> LongNames(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::Option* option : app.get_options()) {
+    for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+  }
+  return names;
+}
+
+// A long option that the chosen command does not take is named, with the nearest one it does take, before CLI11
+// reads the line (its own message for "--mpa foo" counts positional arguments instead).
+bool UnknownOption(CLI::App& app, int argc, char** argv) {
+  CLI::App* command = &app;
+  int i = 1;
+  for (; i < argc; ++i) {
+    const std::vector<CLI::App*> subs =
+        command->get_subcommands([&](const CLI::App* sub) { return sub->get_name() == argv[i]; });
+    if (subs.empty()) break;
+    command = subs.front();
+  }
+  if (command == &app) return false;
+  std::vector<std::string> names = LongNames(*command), global = LongNames(app);
+  names.insert(names.end(), global.begin(), global.end());
+  for (; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word == "--") break;
+    if (word.size() < 3 || word.compare(0, 2, "--") != 0) continue;
+    const std::string name = word.substr(0, word.find('='));
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    std::fprintf(stderr, "patrolmap %s: unknown option '%s'%s\n(patrolmap %s --help lists its options)\n",
+                 command->get_name().c_str(), name.c_str(), patrolmap::DidYouMean(name, names).c_str(),
+                 command->get_name().c_str());
+    return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -77,18 +104,31 @@ int main(int argc, char** argv) {
       patrolmap::tools::AddExportCommand);
   add("vocab", "vocabulary tools: vocab build", patrolmap::tools::AddVocabCommand);
   add("eval", "score a run against a simulated log's ground truth", patrolmap::tools::AddEvalCommand);
-  if (UnknownCommand(app, argc, argv)) return 2;
+  if (UnknownCommand(app, argc, argv) || UnknownOption(app, argc, argv)) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     const int code = app.exit(error);
     return code == 0 ? 0 : 2;
   }
-  spdlog::set_default_logger(spdlog::stderr_logger_mt("patrolmap"));  // results on stdout, messages on stderr
+  // Results on stdout, messages on stderr.
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("patrolmap", std::make_shared<patrolmap::tools::ProgressAwareSink>()));
   spdlog::set_pattern("%l: %v");
   spdlog::set_level(quiet ? spdlog::level::err : spdlog::level::info);
   for (const auto& [sub, command] : commands) {
-    if (sub->parsed()) return command();
+    if (!sub->parsed()) continue;
+    // Input errors are Status values; what a library still throws (a file system that refuses a name, memory
+    // that runs out for a huge request) ends the command with its message, never an abort.
+    try {
+      return command();
+    } catch (const std::bad_alloc&) {
+      spdlog::error("patrolmap {}: out of memory (a resolution, count or file larger than this machine holds?)",
+                    sub->get_name());
+    } catch (const std::exception& error) {
+      spdlog::error("patrolmap {}: {}", sub->get_name(), error.what());
+    }
+    return 1;
   }
   return 2;
 }

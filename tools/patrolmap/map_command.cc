@@ -16,6 +16,7 @@ namespace {
 struct MapArguments {
   pipeline::MappingRequest request;
   bool every_frame = false;
+  const char* command = "map";  // names its progress line
 };
 
 void PrintSummary(const pipeline::MappingOutcome& outcome, const std::string& out) {
@@ -36,7 +37,7 @@ int RunMap(MapArguments arguments) {
   request.pass.node_every = arguments.every_frame ? 1 : 0;
   request.pass.keep_samples = !arguments.every_frame;
   request.outputs = arguments.every_frame ? pipeline::FlightOutputs::kNone : pipeline::FlightOutputs::kDetection;
-  Progress progress("map");
+  Progress progress(arguments.command);
   request.drive.progress = [&progress](std::int64_t done, std::int64_t total) { progress.Update(done, total); };
   pipeline::MappingOutcome outcome;
   const Status status = pipeline::RunMapping(request, &outcome);
@@ -51,10 +52,15 @@ int RunMap(MapArguments arguments) {
 Command AddPatrolCommand(CLI::App* app) {
   auto arguments = std::make_shared<MapArguments>();
   arguments->request.out = "patrolmap_patrol";
+  arguments->command = "patrol";
   app->add_option("log", arguments->request.sources, "the new flight's log")->required()->expected(1);
   app->add_option("--map", arguments->request.prior_map, "the map of earlier flights (map.pmap)")->required();
   app->add_option("-o,--out", arguments->request.out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->request.config_path, "YAML configuration (see config/default.yaml)");
+  AddSetOption(app, &arguments->request.config_settings);
+  app->add_option("--flight-id", arguments->request.flight_id,
+                  "the new flight's id (default: meta.yaml's flight_id, else the log's folder or file name, made "
+                  "unique in the map)");
   app->add_option("--vocabulary", arguments->request.vocabulary_path, "vocabulary file (default: the shipped one)");
   AddFpsOption(app, &arguments->request.fps);
   AddTopicOption(app, &arguments->request.topics);
@@ -76,6 +82,10 @@ Command AddMapCommand(CLI::App* app) {
       ->required();
   app->add_option("-o,--out", arguments->request.out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->request.config_path, "YAML configuration (see config/default.yaml)");
+  AddSetOption(app, &arguments->request.config_settings);
+  app->add_option("--flight-id", arguments->request.flight_id,
+                  "the new flight's id (default: meta.yaml's flight_id, else the log's folder or file name, made "
+                  "unique in the map)");
   app->add_option("--vocabulary", arguments->request.vocabulary_path,
                   "vocabulary file (patrolmap vocab build; default: the shipped one, found beside the program, in "
                   "the install prefix or at $PATROLMAP_VOCABULARY)");

@@ -38,6 +38,7 @@ Command AddMergeCommand(CLI::App* app) {
   app->add_option("-o,--out", request->out, "output folder")->capture_default_str();
   app->add_option("-c,--config", request->config_path,
                   "YAML configuration: the place.* keys the maps were built with (see config/default.yaml)");
+  AddSetOption(app, &request->config_settings);
   app->add_option("--vocabulary", request->vocabulary_path,
                   "vocabulary file the maps were built with (default: the shipped one)");
   app->add_flag("--rename-clashes", request->rename_clashes,

@@ -36,8 +36,11 @@ struct SimulateArguments {
 };
 
 Status ParseResolution(const std::string& text, int* width, int* height) {
-  if (std::sscanf(text.c_str(), "%dx%d", width, height) != 2 || *width < 32 || *height < 24) {
-    return Status::InvalidArgument("--resolution must look like 752x480, got '" + text + "'");
+  constexpr int kMaxSide = 8192;  // an 8K frame; larger renders run out of memory before they end
+  if (std::sscanf(text.c_str(), "%dx%d", width, height) != 2 || *width < 32 || *height < 24 || *width > kMaxSide ||
+      *height > kMaxSide) {
+    return Status::InvalidArgument("--resolution must look like 752x480, from 32x24 to " + std::to_string(kMaxSide) +
+                                   "x" + std::to_string(kMaxSide) + ", got '" + text + "'");
   }
   return Status::Ok();
 }

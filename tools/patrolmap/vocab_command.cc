@@ -11,6 +11,7 @@
 
 #include "commands.h"
 #include "common.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/place/place_recognizer.h"
 #include "patrolmap/vocab/vocabulary.h"
@@ -23,6 +24,7 @@ struct VocabArguments {
   std::vector<std::string> inputs;
   std::string out;
   std::string config;
+  std::vector<std::string> settings;  // --set KEY=VALUE
   int every = 15;
   vocab::VocabularyOptions options;
 };
@@ -78,7 +80,11 @@ Status CollectFeatures(const std::string& input, const VocabArguments& arguments
 
 int RunBuild(const VocabArguments& arguments) {
   pipeline::Config config;
-  Status status = LoadCheckedConfig(arguments.config, &config);
+  Status status = RefuseOverwritingInput(arguments.out, arguments.config, "configuration");
+  for (std::size_t i = 0; status.ok() && i < arguments.inputs.size(); ++i) {
+    status = RefuseOverwritingInput(arguments.out, arguments.inputs[i], "training input");
+  }
+  if (status.ok()) status = LoadCheckedConfig(arguments.config, arguments.settings, &config);
   std::vector<cv::Mat> images;
   for (std::size_t i = 0; status.ok() && i < arguments.inputs.size(); ++i) {
     const std::string& input = arguments.inputs[i];
@@ -117,6 +123,7 @@ Command AddVocabCommand(CLI::App* app) {
   build->add_option("-o,--out", arguments->out, "vocabulary file to write")->required();
   build->add_option("-c,--config", arguments->config,
                     "YAML configuration (features: place.*, scale: flow.frames.scale)");
+  AddSetOption(build, &arguments->settings);
   build->add_option("-k,--branching", arguments->options.branching, "children per node")->capture_default_str();
   build->add_option("-L,--depth", arguments->options.depth, "levels below the root")->capture_default_str();
   build->add_option("--every", arguments->every, "use every n-th frame")

@@ -34,6 +34,10 @@ class AtomicFile {
 // Writes `content` to `path` atomically (AtomicFile).
 Status WriteFileAtomically(const std::string& path, const std::string& content);
 
+// Whether `path` names something (a file, a folder, a link that leads somewhere). Never throws: a name too long, a
+// loop of links or a folder that cannot be searched count as nothing there.
+bool PathExists(const std::string& path);
+
 // Creates `path` and its parents when missing.
 Status EnsureDirectory(const std::string& path);
 
@@ -41,7 +45,14 @@ Status EnsureDirectory(const std::string& path);
 // input must be refused before anything is written.
 bool SameFile(const std::string& a, const std::string& b);
 
-// Fails "OUTPUT would replace INPUT (the WHAT); choose another output" when they are the same file.
+// Fails "OUTPUT would replace INPUT (the WHAT); choose another output" when they are the same file, or when INPUT
+// is a folder (a flight log) that holds OUTPUT as one of its files.
 Status RefuseOverwritingInput(const std::string& output, const std::string& input, const std::string& what);
+
+// The files an output folder of `map`, `patrol` and `patrolmap-onboard` may receive.
+extern const char* const kMapOutputFiles[11];
+
+// RefuseOverwritingInput for each of kMapOutputFiles in `folder` and an input file (a pose file, a configuration).
+Status RefuseOverwritingInFolder(const std::string& folder, const std::string& input, const std::string& what);
 
 }  // namespace patrolmap

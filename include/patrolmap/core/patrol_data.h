@@ -122,6 +122,9 @@ struct PatrolRecord {
   // Whether the log had timestamps (false: 'recent' nodes are counted in images; map format 7 on, true before),
   // so a merge recognises its nodes' places as the mapping run did.
   bool timed = true;
+  // The log the patrol was read from, as an absolute path, and io::LogDigest of its content (map format 11 on;
+  // empty before, and for a camera), so the same log is never mapped twice.
+  std::string source, source_digest;
 };
 
 }  // namespace patrolmap

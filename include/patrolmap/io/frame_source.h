@@ -9,17 +9,14 @@
 
 #include <Eigen/Core>
 
+#include "patrolmap/core/flight_id.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/core/types.h"
 
 namespace patrolmap::io {
 
-// Longest flight id kept [bytes].
-constexpr std::size_t kMaxFlightIdLength = 200;
-
-// A flight id as the map and its tables keep it: control characters, commas and double quotes (which
-// would break a CSV row) become '_', at most kMaxFlightIdLength bytes, never empty; a warning names any
-// change. HTML, XML and JSON writers escape the rest.
+// A flight id as the map and its tables keep it (core/flight_id.h: CleanedFlightId); a warning names any change.
+// HTML, XML and JSON writers escape the rest.
 std::string CleanFlightId(const std::string& raw);
 
 // What a reader knows about a log before reading frames.
@@ -70,6 +67,9 @@ class FrameSource {
   virtual Status Next(bool decode_image, Frame* frame) = 0;
 
   virtual const LogInfo& info() const = 0;
+
+  // Names the flight `id` (a valid one, core/flight_id.h) instead of the id the log gave, before the first Next().
+  virtual void SetFlightId(std::string id) = 0;
 
   // Takes the camera poses from a pose file (io/pose_file.h) instead of the log's own, before the first
   // Next(). Sources whose frame times are not known in advance (videos, cameras) refuse it.

@@ -228,8 +228,14 @@ void VisitConfig(Config* config, Visitor* visitor) {
 // combination fails with a message naming the file, the key and the line.
 Status LoadConfig(const std::string& path, Config* config);
 
-// The defaults, with `path` loaded over them unless it is empty, checked (Config::IsValid).
-Status LoadCheckedConfig(const std::string& path, Config* config);
+// Sets keys from the command line's "--set KEY=VALUE" (KEY as in the file, "place.max_log_nfa"), in order, over
+// `config`: each is read as the file's key would be, and an unknown key fails naming the nearest known one.
+Status ApplySettings(const std::vector<std::string>& settings, Config* config);
+
+// The defaults, with `path` loaded over them unless it is empty and then `settings` (ApplySettings), checked
+// (Config::IsValid).
+Status LoadCheckedConfig(const std::string& path, const std::vector<std::string>& settings, Config* config);
+inline Status LoadCheckedConfig(const std::string& path, Config* config) { return LoadCheckedConfig(path, {}, config); }
 
 // The configuration as YAML (every key, nested sections).
 std::string ConfigToYaml(const Config& config);

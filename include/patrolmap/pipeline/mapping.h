@@ -25,15 +25,17 @@ enum class FlightOutputs {
 };
 
 struct MappingRequest {
-  std::vector<std::string> sources;  // flight logs in the order they are matched, or camera:N (a device)
-  std::string prior_map;             // the map the flights extend (empty: none)
-  std::string out;                   // output folder
-  std::string config_path;           // YAML configuration (empty: the defaults)
-  std::string vocabulary_path;       // empty: the default one (FindDefaultVocabulary)
-  double fps = 0.0;                  // rate of logs without timestamps [Hz] (0: their own)
-  std::vector<std::string> topics;   // a bag's topics as ROLE=NAME (io::ParseTopicChoice)
-  std::string poses;                 // camera poses of the (one) log from a TUM or KITTI file (io/pose_file.h)
-  std::string camera;                // the logs' camera calibration from a file (io/camera_file.h)
+  std::vector<std::string> sources;          // flight logs in the order they are matched, or camera:N (a device)
+  std::string prior_map;                     // the map the flights extend (empty: none)
+  std::string out;                           // output folder
+  std::string config_path;                   // YAML configuration (empty: the defaults)
+  std::vector<std::string> config_settings;  // --set KEY=VALUE over it (ApplySettings)
+  std::string vocabulary_path;               // empty: the default one (FindDefaultVocabulary)
+  double fps = 0.0;                          // rate of logs without timestamps [Hz] (0: their own)
+  std::vector<std::string> topics;           // a bag's topics as ROLE=NAME (io::ParseTopicChoice)
+  std::string poses;                         // camera poses of the (one) log from a TUM or KITTI file (io/pose_file.h)
+  std::string camera;                        // the logs' camera calibration from a file (io/camera_file.h)
+  std::string flight_id;                     // the (one) log's flight id instead of its own (empty: the log's)
   FlightPassOptions pass;
   DriveOptions drive;  // a live camera is never paced (it paces itself)
   // With a prior map that has a flight: append each change found while flying to OUT/events.jsonl.

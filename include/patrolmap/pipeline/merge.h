@@ -21,8 +21,9 @@ struct MergeRequest {
   std::vector<std::string> maps;  // map files (map.pmap), at least one
   std::string out;                // output folder: OUT/map.pmap, OUT/nodes.csv, OUT/loop_closures.csv
   std::string config_path;        // YAML configuration (place.* as the maps were built with; empty: defaults)
-  std::string vocabulary_path;    // empty: the default one; every map must record this vocabulary
-  bool rename_clashes = false;    // a flight id in several maps: false fails, true renames the later ones ID-2, ...
+  std::vector<std::string> config_settings;  // --set KEY=VALUE over it (ApplySettings)
+  std::string vocabulary_path;               // empty: the default one; every map must record this vocabulary
+  bool rename_clashes = false;  // a flight id in several maps: false fails, true renames the later ones ID-2, ...
   std::function<void(std::int64_t done, std::int64_t total)> progress;  // nodes recognised (may be empty)
 };
 
