@@ -124,6 +124,12 @@ ln -s loop_a.png "$work/loop/loop_b"
 expect "a symlink loop in an image folder" 0 "" -- "$bin" detect "$work/loop" --out "$work/w"
 expect "a huge resolution" 2 "--resolution must look like 752x480, from 32x24 to 8192x8192" -- \
   "$bin" simulate --resolution 100000x100000 --out "$work/w"
+expect "an empty --out" 1 "the output folder is empty" -- "$bin" map "$sample" --out ""
+expect "patrol with an empty --map" 2 "an empty map name" -- "$bin" patrol "$sample" --map "" --out "$work/w"
+cp -r "$sample" "$work/no_table"
+rm "$work/no_table/cam0/data.csv"
+expect "a EuRoC log without its camera table" 1 "no_table: a EuRoC log without its camera table" -- \
+  "$bin" map "$work/no_table" --out "$work/w"
 # Inputs are never destroyed by an output.
 expect "vocab build over its log" 1 "would replace $work/day1/cam \(the training input\)" -- \
   "$bin" vocab build "$work/day1/cam" --out "$work/day1/cam/cam0/data.csv" -k 4 -L 2

@@ -131,10 +131,11 @@ Status WriteFileAtomically(const std::string& path, const std::string& content) 
 }
 
 Status EnsureDirectory(const std::string& path) {
+  if (path.empty()) return Status::InvalidArgument("the output folder is empty (--out \"\"?): name one");
   std::error_code error;
   std::filesystem::create_directories(path, error);
   if (error) return Status::IoError(path + ": cannot create folder: " + error.message());
-  if (!std::filesystem::is_directory(path)) return Status::IoError(path + ": is not a folder");
+  if (!std::filesystem::is_directory(path, error)) return Status::IoError(path + ": is not a folder");
   return Status::Ok();
 }
 

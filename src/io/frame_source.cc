@@ -9,7 +9,7 @@ namespace patrolmap::io {
 std::string CleanFlightId(const std::string& raw) {
   const std::string id = CleanedFlightId(raw);
   if (id != raw && !raw.empty())
-    spdlog::warn("flight id '{}' contains characters tables cannot hold; it is '{}' here", raw, id);
+    spdlog::warn("flight id '{}' contains characters a table, a file name or UTF-8 cannot hold; it is '{}' here", raw, id);
   return id;
 }
 

@@ -201,6 +201,9 @@ Status OpenImageFolder(const std::string& folder, const ImageFolderOptions& opti
     if (item.is_regular_file(unreadable) && IsImageFile(item.path())) names.push_back(item.path().filename());
   }
   if (error) return Status::IoError(folder + ": cannot list: " + error.message());
+  if (names.empty() && (PathExists(folder + "/cam0") || PathExists(folder + "/mav0/cam0"))) {
+    return Status::DataLoss(folder + ": a EuRoC log without its camera table (cam0/data.csv: timestamp [ns],filename)");
+  }
   if (names.empty()) return Status::DataLoss(folder + ": folder holds no images (.png, .jpg, ...)");
   NaturalSort(&names);
   for (std::string& name : names) name = (fs::path(folder) / name).string();

@@ -114,9 +114,9 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   EXPECT_NE(LoadBytes(flipped).find("corrupt map (checksum of section"), std::string::npos);
   EXPECT_NE(LoadBytes("%PDF-1.4 something else").find("not a patrolmap map file"), std::string::npos);
   std::string newer = bytes_;
-  const std::uint32_t version = 11;
+  const std::uint32_t version = 12;
   std::memcpy(newer.data() + 8, &version, 4);
-  EXPECT_NE(LoadBytes(newer).find("version 11 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(newer).find("version 12 is newer"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
   // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
   TopoMap unsorted = TwoFlights();
@@ -262,9 +262,11 @@ void DowngradeFeatures(std::string* bytes) {
 }
 
 // The map file of `map` as an older version wrote it: the last `dropped` bytes of the one patrol record (its
-// newest fields) cut off.
+// newest fields up to format 10) cut off, and before format 11 also its log and digest (two empty strings: 8 bytes).
 std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std::uint32_t version,
                                std::uint64_t dropped) {
+  EXPECT_EQ(map.Patrol("b")->source + map.Patrol("b")->source_digest, "");
+  if (version < 11) dropped += 8;
   EXPECT_TRUE(SaveMap(map, path).ok());
   std::string bytes = testing::ReadText(path);
   const std::size_t tag = bytes.find("PTRL", 16);
@@ -458,6 +460,32 @@ TEST(MapFile, TheLensDistortionRoundTripsAndAnImpossibleOneIsRefused) {
     map.SetPatrol(record);
     ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
     EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("camera or views of patrol b"), std::string::npos);
+  }
+}
+
+// A patrol keeps its log and the log's digest (format 11); a version-10 map has neither, and a digest that is not
+// 16 hex digits or a path with a control character is refused.
+TEST(MapFile, ThePatrolsLogRoundTripsAndADamagedOneIsRefused) {
+  testing::TempDir dir;
+  TopoMap map = TwoFlights();
+  std::ofstream(dir / "v10.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 10, 0);
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "v10.pmap", &loaded).ok()) << LoadMap(dir / "v10.pmap", &loaded).message();
+  EXPECT_EQ(loaded.Patrol("b")->source, "");
+  PatrolRecord record = *map.Patrol("b");
+  record.source = "/data/day2/cam";
+  record.source_digest = "0123456789abcdef";
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  EXPECT_EQ(loaded.Patrol("b")->source, "/data/day2/cam");
+  EXPECT_EQ(loaded.Patrol("b")->source_digest, "0123456789abcdef");
+  for (const auto& [source, digest] : {std::make_pair(std::string("/data/x"), std::string("not hex digits!!")),
+                                       std::make_pair(std::string("/data/\n"), std::string())}) {
+    record.source = source, record.source_digest = digest;
+    map.SetPatrol(record);
+    ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+    EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("log of b"), std::string::npos);
   }
 }
 

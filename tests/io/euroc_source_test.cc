@@ -210,7 +210,7 @@ TEST(Euroc, NonFiniteNumbersInTablesAreRefused) {
 TEST(FlightId, CharactersThatBreakTablesAreReplaced) {
   EXPECT_EQ(CleanFlightId("x,y\nz\"w"), "x_y_z_w");
   EXPECT_EQ(CleanFlightId(""), "flight");
-  EXPECT_EQ(CleanFlightId("x</script>"), "x</script>");  // HTML writers escape it
+  EXPECT_EQ(CleanFlightId("x<script>"), "x<script>");  // HTML writers escape it
   EXPECT_EQ(CleanFlightId(std::string(500, 'a')).size(), kMaxFlightIdLength);
 }
 

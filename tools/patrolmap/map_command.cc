@@ -54,7 +54,9 @@ Command AddPatrolCommand(CLI::App* app) {
   arguments->request.out = "patrolmap_patrol";
   arguments->command = "patrol";
   app->add_option("log", arguments->request.sources, "the new flight's log")->required()->expected(1);
-  app->add_option("--map", arguments->request.prior_map, "the map of earlier flights (map.pmap)")->required();
+  app->add_option("--map", arguments->request.prior_map, "the map of earlier flights (map.pmap)")
+      ->required()
+      ->check([](const std::string& path) { return path.empty() ? std::string("an empty map name") : std::string(); });
   app->add_option("-o,--out", arguments->request.out, "output folder")->capture_default_str();
   app->add_option("-c,--config", arguments->request.config_path, "YAML configuration (see config/default.yaml)");
   AddSetOption(app, &arguments->request.config_settings);
