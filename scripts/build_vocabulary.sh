@@ -19,7 +19,7 @@ mkdir -p "$work"
 mate=/usr/share/backgrounds/mate/nature
 photos=(
   "$mate"/{Aqua,Blinds,Dune,FreshFlower,Garden,GreenMeadow,LadyBird,RainDrops,Storm,TwoWings,Wood,YellowFlower}.jpg
-  /usr/share/backgrounds/{Bridge_by_Sander_Klootwijk,Dragonfly_by_Bolly,Kleiber_by_Lukas_Baubkus}.jpg
+  /usr/share/backgrounds/{Bridge_by_Sander_Klootwijk,Dragonfly_by_Bolly,umang_by_Abhishek_Mudgal}.jpg
   /usr/share/backgrounds/{Picture_0B_by_freespace,Picture_1A_by_freespace,Wine_by_Jakkub_Mede}.jpg
   /usr/share/backgrounds/{aitzgorri,friends,life,picosdeeuropa,sunset}_by_Aitzol_Berasategi.jpg
   /usr/share/backgrounds/{free,greentock}_by_Peter_Nerlich.jpg
@@ -31,4 +31,10 @@ for name in building.jpg home.jpg box.png box_in_scene.png stuff.jpg fruits.jpg 
     rubberwhale1.png smarties.png; do
   photos+=("$opencv/$name")
 done
+missing=()
+for photo in "${photos[@]}"; do [[ -f "$photo" ]] || missing+=("$photo"); done
+if ((${#missing[@]})); then
+  echo "build_vocabulary.sh: training photographs missing (their Debian package changed?): ${missing[*]}" >&2
+  exit 1
+fi
 "$bin" vocab build "$work/inner101" "$work/l102" "${photos[@]}" -k 10 -L 4 --seed 1 --out "$out"
