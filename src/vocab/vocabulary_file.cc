@@ -21,6 +21,8 @@
 namespace patrolmap::vocab {
 namespace {
 
+constexpr float kMaxWordWeight = 100.0f;  // far above any idf a vocabulary can hold
+
 constexpr char kMagic[8] = {'P', 'M', 'V', 'O', 'C', 'A', 'B', '\0'};
 constexpr std::uint32_t kVersion = 1;
 constexpr std::size_t kHeaderBytes = 8 + 4 * 6 + 4;
@@ -112,7 +114,10 @@ struct VocabularyFile {
       if (leaf >= nodes) return Status::DataLoss(path + ": corrupt vocabulary (leaf link)");
     }
     for (float idf : v.idf_) {
-      if (!std::isfinite(idf) || idf < 0.0f) return Status::DataLoss(path + ": corrupt vocabulary (word weight)");
+      // idf = ln(N / n) of at most 2^32 training images is below 23; a weight of 3e38 overflows the BoW scores.
+      if (!std::isfinite(idf) || idf < 0.0f || idf > kMaxWordWeight) {
+        return Status::DataLoss(path + ": corrupt vocabulary (word weight)");
+      }
     }
     if (!std::isfinite(v.scale_) || !(v.scale_ > 0.0f)) return Status::DataLoss(path + ": corrupt vocabulary (scale)");
     return Status::Ok();
