@@ -15,7 +15,7 @@ export PATROLMAP=$bin
 "$bin" -q simulate --route l-shape --seed 3 --flights 6 --speed 4 --resolution 376x240 --objects 0 \
   --out "$work/logs" >/dev/null || { echo "FAIL simulate"; exit 1; }
 logs=("$work"/logs/flight_{1..6})
-expect "one map over all" 0 "6 logs: 24 nodes, 18 loop closures" -- \
+expect "one map over all" 0 "6 logs: 24 nodes, 15 loop closures" -- \
   "$bin" map "${logs[@]}" --vocabulary "$vocabulary" --out "$work/all"
 for i in 1 2 3 4 5 6; do
   "$bin" -q map "${logs[$((i - 1))]}" --vocabulary "$vocabulary" --out "$work/m$i" >/dev/null ||
@@ -49,7 +49,7 @@ merge "$work/m3/map.pmap" "$work/m2/map.pmap" -o "$work/b32" &&
 same_map "merge ((6 (3 2)) 1) 5 4" "$work/B"
 merge "$work"/m{6,5,4,3,2,1}/map.pmap -o "$work/C"
 same_map "merge 6 5 4 3 2 1" "$work/C"
-expect "merge summary" 0 "2 maps merged: 6 flights, 24 nodes, 18 loop closures" -- \
+expect "merge summary" 0 "2 maps merged: 6 flights, 24 nodes, 15 loop closures" -- \
   "$bin" merge "$work/a53/map.pmap" "$work/a1462/map.pmap" --vocabulary "$vocabulary" -o "$work/D"
 expect "diff between flights of two maps" 0 "l-shape-3-f2 -> l-shape-3-f5: " -- \
   "$bin" diff "$work/A/map.pmap" --from l-shape-3-f2 --to l-shape-3-f5 -o "$work/diff"

@@ -42,10 +42,10 @@ struct PlaceOptions {
   // 10^max_log_nfa. The NFA scales with the image and the match count, so one setting holds from
   // 376x240 key frames to megapixel photographs.
   int min_inliers = 15;
-  // 10^-10 false alarms: the a-contrario rule (Moisan and Stival) with a margin over the most meaningful match
-  // between two different real scenes measured, 10^-8.2 (office chairs in a ScanNet room and the TUM office;
-  // BENCHMARKS.md, "Verification on real revisits"). Real revisits of low-texture frames lie at -5 to -30.
-  double max_log_nfa = -10.0;
+  // 10^-20 false alarms: the a-contrario rule (Moisan and Stival) with a margin below the most meaningful false
+  // matches measured, real (10^-8.2: office chairs in a ScanNet room and the TUM office) and simulated (10^-15.4:
+  // repeated facades 26 m apart); BENCHMARKS.md, "Verification on real revisits".
+  double max_log_nfa = -20.0;
   bool accept_best = false;  // verify every candidate and keep the best (paper: the first that passes)
   // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already), matched as such; with
   // descriptor_bits 4, two components a byte at steps of 7 (vocab/descriptors.h): 64 instead of 512 bytes a
