@@ -153,6 +153,14 @@ cp -r "$work/bags/ros2_raw/flight_1" "$work/mcap"
 sed -i 's/storage_identifier: sqlite3/storage_identifier: mcap/' "$work/mcap/metadata.yaml"
 expect "another ROS 2 storage is named" 1 "metadata.yaml: storage_identifier 'mcap' is not sqlite3" -- \
   "$bin" map "$work/mcap" --out "$work/o"
+cp -r "$work/bags/ros2_raw/flight_1" "$work/zstd2"
+$python - "$work/zstd2/metadata.yaml" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+open(sys.argv[1], "w").write(re.sub(r"compression_format: [^\n]*", "compression_format: zstd", text))
+PY
+expect "a compressed ROS 2 bag is named" 1 "metadata.yaml: compression_format 'zstd'" -- \
+  "$bin" map "$work/zstd2" --out "$work/o"
 printf 'not a bag' >"$work/junk.bag"
 expect "a file that is not a bag is named" 1 "junk.bag" -- "$bin" map "$work/junk.bag" --out "$work/o"
 

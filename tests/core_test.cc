@@ -1,3 +1,7 @@
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <filesystem>
 #include <vector>
 
@@ -42,6 +46,29 @@ TEST(WriteFileAtomically, WritesAndReplacesWithoutLeavingTemporaries) {
   ASSERT_TRUE(WriteFileAtomically(dir / "a.txt", "first").ok());
   ASSERT_TRUE(WriteFileAtomically(dir / "a.txt", "second").ok());
   EXPECT_EQ(testing::ReadText(dir / "a.txt"), "second");
+  int files = 0;
+  for (const auto& item : std::filesystem::directory_iterator(dir.path())) files += item.is_regular_file();
+  EXPECT_EQ(files, 1);
+}
+
+// A process ended by SIGTERM while it writes a file leaves the previous file and no temporary.
+TEST(AtomicFile, ASignalWhileWritingRemovesTheTemporary) {
+  testing::TempDir dir;
+  ASSERT_TRUE(WriteFileAtomically(dir / "map.pmap", "previous").ok());
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    RemoveTemporariesOnSignal();
+    AtomicFile file;
+    if (!AtomicFile::Open(dir / "map.pmap", &file).ok() || !file.Write("half of a new map").ok()) ::_exit(3);
+    std::raise(SIGTERM);
+    ::_exit(4);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit " << WEXITSTATUS(status);
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
+  EXPECT_EQ(testing::ReadText(dir / "map.pmap"), "previous");
   int files = 0;
   for (const auto& item : std::filesystem::directory_iterator(dir.path())) files += item.is_regular_file();
   EXPECT_EQ(files, 1);

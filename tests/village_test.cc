@@ -47,6 +47,11 @@ TEST(Routes, WaypointFileErrorsNameFileAndLine) {
   EXPECT_EQ(route.waypoints.size(), 2u);
   testing::WriteText(dir / "w.csv", "0,0\nx,y\n");  // ... only as the first
   EXPECT_NE(ReadWaypoints(dir / "w.csv", &route).message().find("w.csv:2:"), std::string::npos);
+  testing::WriteText(dir / "w.csv", "0,0\n1e9,0\n");  // would render for days
+  EXPECT_NE(ReadWaypoints(dir / "w.csv", &route).message().find("w.csv:2: a waypoint lies beyond 10000 m"),
+            std::string::npos);
+  testing::WriteText(dir / "w.csv", "0,0\n9000,0\n0,0\n9000,0\n0,0\n9000,0\n0,0\n");
+  EXPECT_NE(ReadWaypoints(dir / "w.csv", &route).message().find("km long"), std::string::npos);
 }
 
 // Integrates the trajectory's own rates and compares them with its positions and headings.

@@ -25,11 +25,13 @@ import hashlib
 import math
 import os
 import random
+import re
 import shutil
 import struct
 import subprocess
 import sys
 import tempfile
+import time
 from collections import Counter, OrderedDict
 from pathlib import Path
 
@@ -299,8 +301,11 @@ def attack_yaml(attack, work, log):
     """Each file gets the shapes every YAML file must survive, and bad values of the keys patrolmap reads
     from it (keys it does not read, such as an IMU's noise figures, are not its business)."""
     t_bs = ["T_BS: 5\n", "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0]\n",
-            "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"]
+            "T_BS:\n  rows: 4\n  cols: 4\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n",
+            "T_BS:\n  rows: 4\n  cols: 4\n  data: [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]\n",
+            "T_BS:\n  rows: 4\n  cols: 4\n  data: [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n"]
     read = {"cam0/sensor.yaml": t_bs + ["intrinsics: [-1, -1, 1, 1]\nresolution: [188, 120]\n",
+                                        "intrinsics: [100, 100, 94, 60]\nresolution: [640, 480]\n",
                                         "intrinsics: [1, 1, 1, 1]\nresolution: [0, 0]\n", "rate_hz: .nan\n",
                                         "rate_hz: -5\n", "rate_hz: [1]\n"],
             "imu0/sensor.yaml": t_bs,
@@ -315,6 +320,47 @@ def attack_yaml(attack, work, log):
             attack.judge(f"YAML: {yaml_file}", [attack.patrolmap, "map", str(log), "--out",
                                                 str(work / "yout")], [yaml_file], keep=log / yaml_file)
         (log / yaml_file).write_text(original)
+
+
+def attack_reported(attack, work, log, prior):
+    """Inputs an independent attack found silent or slow: detections whose centroid lost a value, a compressed
+    ROS 2 bag, a route far beyond any village, and a save interrupted by a signal."""
+    table = log / "objects0/data.csv"
+    original = table.read_text()
+    rows = [line for line in original.splitlines() if line and not line.startswith("#")]
+    for cut in (1, 2):
+        fields = rows[0].split(",")
+        damaged = ",".join(fields[: len(fields) - cut] if len(fields) >= 10 else fields[:7] + ["0.5"] * (3 - cut))
+        table.write_text("\n".join([damaged] + rows[1:]) + "\n")
+        attack.judge("reported: objects0 centroid cut short", [attack.patrolmap, "map", str(log), "--out",
+                                                               str(work / "rout")], ["objects0/data.csv"], keep=table)
+    table.write_text(original)
+    bag = work / "compressed_ros2"
+    code, _ = attack.run(["/usr/bin/python3", str(Path(__file__).resolve().parents[2] / "tests/write_test_bags.py"),
+                          str(log), str(bag), "--format", "ros2"])
+    if code == 0:
+        metadata = bag / "metadata.yaml"
+        metadata.write_text(re.sub(r"compression_format: [^\n]*", "compression_format: zstd", metadata.read_text()))
+        attack.judge("reported: compressed ROS 2 bag", [attack.patrolmap, "map", str(bag), "--out",
+                                                        str(work / "rout")], ["compression_format"])
+    route = work / "far.csv"
+    for rows_text in ("0,0\n1e9,0\n", "0,0\n9000,0\n" * 5):
+        route.write_text(rows_text)
+        attack.judge("reported: simulated route beyond the village", [attack.patrolmap, "simulate", "--route",
+                                                                      str(route), "--out", str(work / "rsim")],
+                     [str(route)])
+    # A merge stopped by SIGTERM at some point of its run leaves the previous map and no temporary.
+    out = work / "merged"
+    for delay in (0.05, 0.2, 0.5, 1.0):
+        shutil.rmtree(out, ignore_errors=True)
+        process = subprocess.Popen([attack.patrolmap, "-q", "merge", str(prior), str(prior), "--rename-clashes",
+                                    "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(delay)
+        process.terminate()
+        process.wait()
+        left = sorted(str(p.name) for p in out.glob("*.tmp.*")) if out.exists() else []
+        attack.record("reported: merge stopped by SIGTERM", "data loss" if left else "clear error",
+                      f"after {delay} s: {left}")
 
 
 def attack_images(attack, work, log, rng, rounds):
@@ -509,7 +555,8 @@ def main():
              lambda: attack_bags(attack, work, log, rng, 1 if args.quick else 3),
              lambda: attack_options(attack, work, log, prior),
              lambda: attack_outputs(attack, work, log, prior),
-             lambda: attack_injection(attack, work, log)]
+             lambda: attack_injection(attack, work, log),
+             lambda: attack_reported(attack, work, log, prior)]
     for step in steps:
         step()
         print(f"  {attack.count} inputs so far", file=sys.stderr)

@@ -3,7 +3,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -30,7 +32,41 @@ void RemoveStaleTemporaries(const std::string& path) {
   }
 }
 
+// The temporaries being written, for a signal handler to remove: a fixed table, so that the handler neither
+// allocates nor locks. A slot's path is written before the slot is marked used.
+constexpr int kTemporarySlots = 16;
+constexpr std::size_t kTemporaryPathBytes = 4096;
+std::atomic<bool> slot_used[kTemporarySlots];
+char slot_path[kTemporarySlots][kTemporaryPathBytes];
+
+int RegisterTemporary(const std::string& path) {
+  if (path.size() >= kTemporaryPathBytes) return -1;
+  for (int slot = 0; slot < kTemporarySlots; ++slot) {
+    if (slot_used[slot].load()) continue;
+    std::memcpy(slot_path[slot], path.c_str(), path.size() + 1);
+    slot_used[slot].store(true);
+    return slot;
+  }
+  return -1;  // more files open at once than slots: such a file is left to the next writer's clean-up
+}
+
+void UnregisterTemporary(int slot) {
+  if (slot >= 0) slot_used[slot].store(false);
+}
+
+extern "C" void RemoveTemporariesAndDie(int signal_number) {
+  for (int slot = 0; slot < kTemporarySlots; ++slot) {
+    if (slot_used[slot].load()) ::unlink(slot_path[slot]);
+  }
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
 }  // namespace
+
+void RemoveTemporariesOnSignal() {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal_number, RemoveTemporariesAndDie);
+}
 
 bool PathExists(const std::string& path) {
   std::error_code error;
@@ -79,8 +115,13 @@ Status AtomicFile::Open(const std::string& path, AtomicFile* file) {
   RemoveStaleTemporaries(path);
   file->path_ = path;
   file->temporary_ = path + ".tmp." + std::to_string(::getpid());
+  file->slot_ = RegisterTemporary(file->temporary_);
   file->fd_ = ::open(file->temporary_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (file->fd_ < 0) return Status::IoError(file->temporary_ + ": cannot create: " + std::strerror(errno));
+  if (file->fd_ < 0) {
+    UnregisterTemporary(file->slot_);
+    file->slot_ = -1;
+    return Status::IoError(file->temporary_ + ": cannot create: " + std::strerror(errno));
+  }
   return Status::Ok();
 }
 
@@ -90,7 +131,8 @@ void AtomicFile::Abandon() {
   if (fd_ < 0) return;
   ::close(fd_);
   std::remove(temporary_.c_str());
-  fd_ = -1;
+  UnregisterTemporary(slot_);
+  fd_ = -1, slot_ = -1;
 }
 
 Status AtomicFile::Write(const char* data, std::size_t size) {
@@ -120,6 +162,8 @@ Status AtomicFile::Commit() {
     status = Status::IoError(path_ + ": rename failed: " + std::strerror(errno));
   }
   if (!status.ok()) std::remove(temporary_.c_str());
+  UnregisterTemporary(slot_);
+  slot_ = -1;
   return status;
 }
 

@@ -118,6 +118,12 @@ Status ReadBodyFromSensor(const std::string& path, const YAML::Node& root, Eigen
     for (int col = 0; col < 3; ++col) (*rotation)(row, col) = data[row * 4 + col];
     if (translation != nullptr) (*translation)[row] = data[row * 4 + 3];
   }
+  // A rotation's rows are orthonormal and its determinant 1; EuRoC's calibrations hold 1e-6 of that.
+  constexpr double kRotationTolerance = 1e-3;
+  const double error = ((*rotation) * rotation->transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (!(error <= kRotationTolerance) || rotation->determinant() <= 0.0) {
+    return Status::DataLoss(path + ": 'T_BS.data' is not a rigid transform (its 3x3 part is not a rotation)");
+  }
   return Status::Ok();
 }
 
@@ -366,8 +372,11 @@ Status OpenEuroc(const std::string& folder, std::unique_ptr<FrameSource>* source
   PATROLMAP_RETURN_IF_ERROR(ReadStereoPairs(log, entries, &info.stereo, &sensors.stereo));
   if (sensors.poses.empty() && !gps.empty() && !attitude.empty())
     PosesFromFixes(log, info, gps, attitude, entries, &sensors);
-  *source = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu), std::move(speeds),
-                                              std::move(gps), std::move(sensors));
+  const bool calibrated = info.camera.has_value();
+  auto images = std::make_unique<ImageListSource>(std::move(info), std::move(entries), std::move(imu),
+                                                  std::move(speeds), std::move(gps), std::move(sensors));
+  if (calibrated) PATROLMAP_RETURN_IF_ERROR(images->CheckResolution(*images->info().camera, log + "/cam0/sensor.yaml"));
+  *source = std::move(images);
   return Status::Ok();
 }
 

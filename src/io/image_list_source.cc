@@ -80,21 +80,28 @@ Status ImageListSource::UsePoseFile(const std::string& path) {
   return Status::Ok();
 }
 
+Status ImageListSource::CheckResolution(const CameraIntrinsics& camera, const std::string& path) const {
+  // The first image whose header declares its size, or else the first that decodes.
+  for (const ImageEntry& entry : entries_) {
+    std::int64_t width = 0, height = 0;
+    if (!DeclaredSize(entry.path, &width, &height)) {
+      const cv::Mat image = cv::imread(entry.path, cv::IMREAD_UNCHANGED);
+      if (image.empty()) continue;
+      width = image.cols, height = image.rows;
+    }
+    if (width == camera.width && height == camera.height) return Status::Ok();
+    return Status::InvalidArgument(path + ": resolution " + std::to_string(camera.width) + "x" +
+                                   std::to_string(camera.height) + ", but " + entry.path + " is " +
+                                   std::to_string(width) + "x" + std::to_string(height));
+  }
+  return Status::Ok();
+}
+
 Status ImageListSource::UseCameraFile(const std::string& path) {
   CameraIntrinsics camera;
   Distortion distortion;
   PATROLMAP_RETURN_IF_ERROR(ReadCameraFile(path, &camera, &distortion));
-  // The resolution must be the images': the first readable one is decoded to see.
-  for (const ImageEntry& entry : entries_) {
-    const cv::Mat image = cv::imread(entry.path, cv::IMREAD_UNCHANGED);
-    if (image.empty()) continue;
-    if (image.cols != camera.width || image.rows != camera.height) {
-      return Status::InvalidArgument(path + ": resolution " + std::to_string(camera.width) + "x" +
-                                     std::to_string(camera.height) + ", but " + entry.path + " is " +
-                                     std::to_string(image.cols) + "x" + std::to_string(image.rows));
-    }
-    break;
-  }
+  PATROLMAP_RETURN_IF_ERROR(CheckResolution(camera, path));
   if (info_.camera) spdlog::info("{}: camera calibration from {}, not the log's own", info_.path, path);
   info_.camera = camera;
   info_.camera_distortion = distortion;

@@ -32,6 +32,8 @@ class ImageListSource : public FrameSource {
   void SetFlightId(std::string id) override { info_.flight_id = std::move(id); }
   Status UsePoseFile(const std::string& path) override;
   Status UseCameraFile(const std::string& path) override;
+  // Refuses a calibration from `path` whose resolution is not the first readable image's.
+  Status CheckResolution(const CameraIntrinsics& camera, const std::string& path) const;
 
  private:
   void AppendImuUpTo(TimestampNs timestamp_ns, std::vector<ImuSample>* samples);

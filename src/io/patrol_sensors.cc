@@ -40,6 +40,10 @@ Status ReadDetectionTable(const std::string& path, std::vector<ObjectObservation
     for (int i = 0; i < 4; ++i) PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[3 + i], "box [px]", &box[i]));
     if (!(box[2] > box[0] && box[3] > box[1])) return csv.Error("box must have x_max > x_min and y_max > y_min");
     o->box = cv::Rect2d(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    if (fields.size() > 7 && fields.size() < 10) {
+      return csv.Error("a centroid needs three values (x, y, z [m]) after the box; found " +
+                       std::to_string(fields.size() - 7));
+    }
     if (fields.size() >= 10) {
       Eigen::Vector3d centroid;
       PATROLMAP_RETURN_IF_ERROR(ParseVector(csv, fields, 7, "centroid [m]", &centroid));

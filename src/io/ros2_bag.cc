@@ -174,6 +174,14 @@ class Ros2Bag : public BagFile {
                                      "' is not sqlite3, the only ROS 2 storage read (`ros2 bag convert` "
                                      "writes sqlite3)");
     }
+    // rosbag2 compresses whole files (.db3.zstd) or each message's bytes; neither is read.
+    const YAML::Node compression = info["compression_format"];
+    const std::string format = compression && compression.IsScalar() ? compression.Scalar() : "";
+    if (!format.empty()) {
+      return Status::InvalidArgument(path + ": compression_format '" + format +
+                                     "': compressed ROS 2 bags are not read (`ros2 bag decompress` or `ros2 bag "
+                                     "convert` without compression writes a plain one)");
+    }
     const YAML::Node files = info["relative_file_paths"];
     if (!files || !files.IsSequence() || files.size() == 0) {
       return Status::DataLoss(path + ": 'relative_file_paths' must list the bag's .db3 files");

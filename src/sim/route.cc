@@ -189,6 +189,20 @@ Status FlyRoute(const Route& route, const RouteOptions& options, SimulatedFlight
   return Status::Ok();
 }
 
+namespace {
+
+// Waypoints and routes beyond these are no simulated patrol's: a flight of 1e9 m would render for days.
+constexpr double kMaxWaypointDistanceM = 10000.0;
+constexpr double kMaxRouteLengthM = 50000.0;
+
+double RouteLength(const std::vector<Eigen::Vector2d>& waypoints) {
+  double length = 0.0;
+  for (std::size_t k = 1; k < waypoints.size(); ++k) length += (waypoints[k] - waypoints[k - 1]).norm();
+  return length;
+}
+
+}  // namespace
+
 Status ReadWaypoints(const std::string& path, Route* route) {
   CsvReader csv;
   PATROLMAP_RETURN_IF_ERROR(csv.Open(path));
@@ -205,9 +219,18 @@ Status ReadWaypoints(const std::string& path, Route* route) {
     Eigen::Vector2d point;
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[0], "x [m]", &point.x()));
     PATROLMAP_RETURN_IF_ERROR(csv.ParseDouble(fields[1], "y [m]", &point.y()));
+    if (!(std::abs(point.x()) <= kMaxWaypointDistanceM && std::abs(point.y()) <= kMaxWaypointDistanceM)) {
+      return csv.Error("a waypoint lies beyond " + std::to_string(static_cast<int>(kMaxWaypointDistanceM)) +
+                       " m of the origin: the simulated village is a few hundred metres across");
+    }
     route->waypoints.push_back(point);
   }
   if (!status.end_of_stream()) return status;
+  if (RouteLength(route->waypoints) > kMaxRouteLengthM) {
+    return Status::InvalidArgument(path + ": the route is " + std::to_string(RouteLength(route->waypoints) / 1000.0) +
+                                   " km long; a simulated flight covers at most " +
+                                   std::to_string(static_cast<int>(kMaxRouteLengthM / 1000.0)) + " km");
+  }
   if (DistinctPoints(route->waypoints).size() < 2)
     return Status::DataLoss(path + ": a route needs two distinct waypoints");
   return Status::Ok();

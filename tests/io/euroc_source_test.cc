@@ -180,6 +180,10 @@ TEST(Euroc, SensorYamlOfTheWrongShapeIsRefusedNotThrown) {
   std::unique_ptr<FrameSource> source;
   for (const char* yaml : {"5\n", "- 1\n- 2\n", "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS: 5\n",
                            "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS:\n  data: [.nan, 0, 0, 0, 0, 1, 0, 0, "
+                           "0, 0, 1, 0, 0, 0, 0, 1]\n",
+                           "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS:\n  data: [0, 0, 0, 0, 0, 0, 0, 0, 0, "
+                           "0, 0, 0, 0, 0, 0, 0]\n",
+                           "intrinsics: [1, 1, 1, 1]\nresolution: [32, 24]\nT_BS:\n  data: [-1, 0, 0, 0, 0, 1, 0, 0, "
                            "0, 0, 1, 0, 0, 0, 0, 1]\n"}) {
     WriteText(log + "/cam0/sensor.yaml", yaml);
     const Status status = OpenLog(log, {}, &source);

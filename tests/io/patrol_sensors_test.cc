@@ -132,6 +132,9 @@ TEST(PatrolSensors, BadTablesNameFileAndLine) {
   WriteText(log + "/objects0/data.csv", "1000000000,crate,0.8,1,2,11,12\n900000000,crate,0.8,1,2,11,12\n");
   EXPECT_NE(ReadPatrolSensors(log, &sensors).message().find("objects0/data.csv:2: timestamp 900000000 is before"),
             std::string::npos);
+  WriteText(log + "/objects0/data.csv", "1000000000,crate,0.8,1,2,11,12,0.5,0.2\n");
+  EXPECT_NE(ReadPatrolSensors(log, &sensors).message().find("objects0/data.csv:1: a centroid needs three values"),
+            std::string::npos);
   std::filesystem::remove(log + "/objects0/data.csv");
   WriteText(log + "/state_groundtruth_estimate0/data.csv", "1000000000,0,0,2,0.5,0,0,0,0,0,0\n");
   EXPECT_NE(ReadPatrolSensors(log, &sensors).message().find("q_RS is not a unit quaternion"), std::string::npos);

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "patrolmap/core/files.h"
 #include "patrolmap/core/nearest_name.h"
 #include "progress.h"
 
@@ -74,6 +75,7 @@ bool UnknownOption(CLI::App& app, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  patrolmap::RemoveTemporariesOnSignal();  // an interrupted save leaves no map.pmap.tmp.PID behind
   CLI::App app{"patrolmap: key locations from optical flow, topological maps and change detection for UAV patrols"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "patrolmap 0.1.0");

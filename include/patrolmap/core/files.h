@@ -29,7 +29,12 @@ class AtomicFile {
 
   std::string path_, temporary_;
   int fd_ = -1;
+  int slot_ = -1;  // in the table RemoveTemporariesOnSignal's handler reads
 };
+
+// Makes SIGINT, SIGTERM and SIGHUP remove the AtomicFile temporaries being written before the process ends as the
+// signal would end it (a temporary left by SIGKILL is removed by the next writer of that file).
+void RemoveTemporariesOnSignal();
 
 // Writes `content` to `path` atomically (AtomicFile).
 Status WriteFileAtomically(const std::string& path, const std::string& content);
