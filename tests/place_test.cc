@@ -413,5 +413,29 @@ TEST(VerifyPair, RatioTestKeepsOnlyUnambiguousMatches) {
   EXPECT_DOUBLE_EQ(v.matched_fraction, 10.0 / 20.0);
 }
 
+// Query features of one repeated pattern all pass the ratio test to the same few candidate features; kept one to
+// one, each candidate feature keeps its closest query feature only.
+TEST(VerifyPair, OneToOneKeepsTheClosestMatchOfEachCandidateFeature) {
+  cv::RNG rng(12);
+  cv::Mat candidate(40, 128, CV_32F), query(24, 128, CV_32F);
+  rng.fill(candidate, cv::RNG::UNIFORM, 0.0, 1.0);
+  std::vector<cv::Point2f> query_points, candidate_points;
+  for (int j = 0; j < 40; ++j) candidate_points.emplace_back(5.0f * j, 3.0f * (j % 7));
+  for (int i = 0; i < 24; ++i) {
+    // Query features 0-19 are copies of candidate features 0-3, five each, 0.01 * i apart; 20-23 match 10-13.
+    cv::Mat noise(1, 128, CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+    const int source = i < 20 ? i % 4 : 10 + i - 20;
+    query.row(i) = candidate.row(source) + noise * (0.01 * (i + 1) / cv::norm(noise));
+    query_points.emplace_back(4.0f * i, 2.0f * (i % 5));
+  }
+  PlaceOptions options;
+  options.one_to_one = false;
+  EXPECT_EQ(VerifyPair(options, query_points, query, candidate_points, candidate).matches, 24);
+  options.one_to_one = true;
+  const Verification v = VerifyPair(options, query_points, query, candidate_points, candidate);
+  EXPECT_EQ(v.matches, 8);  // candidate features 0-3 (from query 0-3, the closest copies) and 10-13
+}
+
 }  // namespace
 }  // namespace patrolmap::place

@@ -39,10 +39,15 @@ void ToRootSift(cv::Mat* descriptors) {
   }
 }
 
+// A ratio-test match of query feature `query` to candidate feature `candidate`, at descriptor distance `distance`.
+struct Match {
+  int query = -1, candidate = -1;
+  float distance = 0.0f;
+};
+
 // Ratio-test matches of query features among the candidate features of the same group.
 void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& query_groups, const cv::Mat& candidate,
-                       const std::vector<std::uint32_t>& candidate_groups, double ratio,
-                       std::vector<std::pair<int, int>>* matches) {
+                       const std::vector<std::uint32_t>& candidate_groups, double ratio, std::vector<Match>* matches) {
   std::multimap<std::uint32_t, int> by_group;
   for (int j = 0; j < candidate.rows; ++j) by_group.emplace(candidate_groups[j], j);
   for (int i = 0; i < query.rows; ++i) {
@@ -56,18 +61,18 @@ void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& q
       else if (distance < second)
         second = distance;
     }
-    if (best_index >= 0 && best < ratio * second) matches->emplace_back(i, best_index);
+    if (best_index >= 0 && best < ratio * second) matches->push_back({i, best_index, static_cast<float>(best)});
   }
 }
 
-void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std::vector<std::pair<int, int>>* matches) {
+void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std::vector<Match>* matches) {
   if (query.type() == CV_8U && candidate.type() == CV_8U) {  // as a node keeps them: BFMatcher's result, faster
     std::vector<vocab::NearestTwo> nearest;
     vocab::FindNearestTwo(query, candidate, &nearest);
     for (int i = 0; i < query.rows; ++i) {
       const vocab::NearestTwo& pair = nearest[i];
       if (pair.second < 0 || pair.first_distance >= ratio * pair.second_distance) continue;
-      matches->emplace_back(i, pair.first);
+      matches->push_back({i, pair.first, pair.first_distance});
     }
     return;
   }
@@ -75,8 +80,24 @@ void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std:
   cv::BFMatcher(cv::NORM_L2).knnMatch(query, candidate, knn, 2);
   for (const auto& pair : knn) {
     if (pair.size() < 2 || pair[0].distance >= ratio * pair[1].distance) continue;
-    matches->emplace_back(pair[0].queryIdx, pair[0].trainIdx);
+    matches->push_back({pair[0].queryIdx, pair[0].trainIdx, pair[0].distance});
   }
+}
+
+// Keeps, of the matches that share a candidate feature, the one of smallest distance (the lower query index on a
+// tie), in query order. The ratio test looks one way only: query features of a repeated or blank-wall pattern all
+// reach the same few candidate features, and a fundamental matrix whose epipole lies there fits them all.
+void KeepOneToOne(int candidate_count, std::vector<Match>* matches) {
+  std::vector<int> best(candidate_count, -1);
+  for (int k = 0; k < static_cast<int>(matches->size()); ++k) {
+    int& kept = best[(*matches)[k].candidate];
+    if (kept < 0 || (*matches)[k].distance < (*matches)[kept].distance) kept = k;
+  }
+  std::size_t out = 0;
+  for (int k = 0; k < static_cast<int>(matches->size()); ++k) {
+    if (best[(*matches)[k].candidate] == k) (*matches)[out++] = (*matches)[k];
+  }
+  matches->resize(out);
 }
 
 // log10 of the binomial coefficient C(n, k).
@@ -204,16 +225,17 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point
   Verification verification;
   if (inliers != nullptr) inliers->clear();
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
-  std::vector<std::pair<int, int>> matches;
+  std::vector<Match> matches;
   if (query_groups != nullptr && candidate_groups != nullptr) {
     MatchWithinGroups(query, *query_groups, candidate, *candidate_groups, options.ratio, &matches);
   } else {
     MatchAll(query, candidate, options.ratio, &matches);
   }
+  if (options.one_to_one) KeepOneToOne(candidate.rows, &matches);
   std::vector<cv::Point2f> from, to;
-  for (const auto& [i, j] : matches) {
-    from.push_back(query_points[i]);
-    to.push_back(candidate_points[j]);
+  for (const Match& match : matches) {
+    from.push_back(query_points[match.query]);
+    to.push_back(candidate_points[match.candidate]);
   }
   verification.matches = static_cast<int>(from.size());
   verification.matched_fraction = static_cast<double>(from.size()) / std::min(query.rows, candidate.rows);
@@ -226,7 +248,7 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point
   if (f.rows < 3 || f.cols != 3) return verification;
   verification.inliers = cv::countNonZero(mask);
   for (std::size_t k = 0; inliers != nullptr && k < mask.size(); ++k) {
-    if (mask[k] != 0) inliers->push_back(matches[k]);
+    if (mask[k] != 0) inliers->emplace_back(matches[k].query, matches[k].candidate);
   }
   verification.log_nfa = LogNumberOfFalseAlarms(cv::Matx33d(f.rowRange(0, 3)), from, to, ExtentOf(query_points),
                                                 ExtentOf(candidate_points));

@@ -71,6 +71,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.min_inliers", &place.min_inliers);
   visitor->Field("place.max_log_nfa", &place.max_log_nfa);
   visitor->Field("place.accept_best", &place.accept_best);
+  visitor->Field("place.one_to_one", &place.one_to_one);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.descriptor_bits", &place.descriptor_bits);
   visitor->Field("place.max_topological_gap", &place.max_topological_gap);

@@ -33,7 +33,12 @@ struct PlaceOptions {
   // For logs without timestamps (image collections): nodes of the same flight at most this many images
   // before the query are not candidates (1: the image just before; 0: none excluded).
   int exclude_recent_images = 1;
-  double ratio = 0.8;                 // Lowe's ratio test for descriptor matches
+  double ratio = 0.8;  // Lowe's ratio test for descriptor matches
+  // Each candidate feature keeps only its closest query match (as COLMAP's cross check): many query features of a
+  // repeated pattern matched to a few candidate features fit a fundamental matrix by chance. Off by default: at
+  // max_log_nfa -20 it refuses no real pair more and loses one real revisit of seven (BENCHMARKS.md, "Verification
+  // on real revisits"); with a looser rule it keeps every real pair of different scenes out.
+  bool one_to_one = false;
   double min_matched_fraction = 0.1;  // matches / features of the smaller frame (paper: 0.5)
   FundamentalMethod method = FundamentalMethod::kUsacMagsac;
   double inlier_threshold_px = 1.5;  // epipolar distance for a RANSAC inlier [pixels]
