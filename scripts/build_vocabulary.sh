@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Rebuilds the shipped vocabulary (vocab/default.pmvoc) reproducibly, as vocab/README.md describes:
-#   scripts/build_vocabulary.sh [OUT]
+#   scripts/build_vocabulary.sh [OUT]        (PATROLMAP_BIN: the binary, build/tools/patrolmap unless set)
 # Installs the Debian packages whose photographs it trains on, simulates two training flights through
 # villages that evaluation never uses, and runs `patrolmap vocab build` over both.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:-$root/vocab/default.pmvoc}"
-bin="$root/build/tools/patrolmap"
+bin="${PATROLMAP_BIN:-$root/build/tools/patrolmap}"
 work="${TMPDIR:-/tmp}/patrolmap_vocabulary"
 "$root/scripts/install_deps.sh" mate-backgrounds lomiri-wallpapers-16.04 opencv-doc
 mkdir -p "$work"
