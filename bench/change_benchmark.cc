@@ -1,7 +1,8 @@
 // Change-stage speed on rendered village views at 376x240 (the processing
 // size of a 752x480 camera): object association per detection (paper 000
 // needed 15 ms per object), evidence-grid integration per depth frame, the
-// grid comparison of two patrols, the class-agnostic objects from it, the appearance comparison of one place, and
+// grid comparison of two patrols, the class-agnostic objects from it, the object comparison of two long patrols, the
+// appearance comparison of one place, and
 // appearance along the route (features per route frame, registration per candidate, comparison per pair, a whole
 // route).
 #include <array>
@@ -14,6 +15,7 @@
 #include "patrolmap/change/appearance.h"
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/geometry_objects.h"
+#include "patrolmap/change/object_diff.h"
 #include "patrolmap/change/object_map.h"
 #include "patrolmap/change/route_compare.h"
 #include "patrolmap/change/route_depth.h"
@@ -144,6 +146,40 @@ void BM_GeometryObjectsFortyMetres(benchmark::State& state) {
   state.counters["objects"] = static_cast<double>(objects.size());
 }
 BENCHMARK(BM_GeometryObjectsFortyMetres)->Unit(benchmark::kMillisecond);
+
+// Two patrols of a 1 km street with range(0) objects along it, 2 m apart on both sides, and a view each metre
+// looking along the street; every third object is gone or moved by 3 m in the second patrol.
+PatrolRecord StreetPatrol(int objects, bool second) {
+  PatrolRecord record;
+  record.camera = kCamera;
+  record.has_objects = true;
+  const double length = objects;  // [m]: one object a metre, alternately on either side
+  for (double x = 0.0; x <= length; x += 1.0) {
+    record.views.push_back({0, Eigen::Vector3d(x, 0.0, 3.0), Eigen::Quaterniond(sim::WorldFromCameraRotation(0.0))});
+  }
+  for (int i = 0; i < objects; ++i) {
+    if (second && i % 3 == 1) continue;  // removed
+    MapObject o;
+    o.id = i;
+    o.label = i % 2 == 0 ? "crate" : "vehicle";
+    o.confidence = 0.8;
+    o.detections = 10;
+    o.centroid = Eigen::Vector3d(i, i % 2 == 0 ? 6.0 : -6.0, 0.5);
+    if (second && i % 3 == 2) o.centroid.x() += 3.0;  // moved
+    o.box_min = o.centroid - Eigen::Vector3d::Constant(0.5);
+    o.box_max = o.centroid + Eigen::Vector3d::Constant(0.5);
+    record.objects.push_back(o);
+  }
+  return record;
+}
+
+void BM_DiffObjectsLongPatrol(benchmark::State& state) {
+  const PatrolRecord prior = StreetPatrol(static_cast<int>(state.range(0)), false);
+  const PatrolRecord current = StreetPatrol(static_cast<int>(state.range(0)), true);
+  for (auto _ : state) benchmark::DoNotOptimize(change::DiffObjects(prior, current, change::ObjectDiffOptions{}));
+  state.counters["views"] = static_cast<double>(prior.views.size());
+}
+BENCHMARK(BM_DiffObjectsLongPatrol)->Arg(1000)->Arg(5000)->Arg(20000)->Unit(benchmark::kMillisecond);
 
 // The move test of one vanished and one appeared cluster: the surfaces of a 4.4 x 1.8 x 1.6 m vehicle (0.2 m voxels,
 // about 1,000 each) 2 m apart, registered centroid onto centroid (argument 0) or at the best shift of up to 0.6 m

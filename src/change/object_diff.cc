@@ -92,6 +92,44 @@ struct Pair {
   double cost;
 };
 
+// Indices of points sorted by their x coordinate: the ones within `range` of a point, in index order, found without
+// looking at all (a long patrol has thousands of views and objects, and each object is compared only nearby).
+class ByX {
+ public:
+  template <typename Item, typename Position>
+  ByX(const std::vector<Item>& items, Position position) : order_(items.size()), x_(items.size()) {
+    for (std::size_t k = 0; k < items.size(); ++k) order_[k] = static_cast<int>(k);
+    std::sort(order_.begin(), order_.end(),
+              [&](int a, int b) { return position(items[a]).x() < position(items[b]).x(); });
+    for (std::size_t k = 0; k < order_.size(); ++k) x_[k] = position(items[order_[k]]).x();
+  }
+
+  // The indices whose x lies within `range` of `x` (a little more, so that rounding drops none), ascending: a
+  // superset of those within `range` in space, which the caller then tests as before.
+  std::vector<int> Near(double x, double range) const {
+    const double padded = range * (1.0 + 1e-9) + 1e-9;
+    const auto first = std::lower_bound(x_.begin(), x_.end(), x - padded);
+    const auto last = std::upper_bound(x_.begin(), x_.end(), x + padded);
+    std::vector<int> near;
+    near.reserve(static_cast<std::size_t>(last - first));
+    for (auto it = first; it != last; ++it) near.push_back(order_[it - x_.begin()]);
+    std::sort(near.begin(), near.end());
+    return near;
+  }
+
+ private:
+  std::vector<int> order_;
+  std::vector<double> x_;
+};
+
+ByX ViewsByX(const PatrolRecord& patrol) {
+  return ByX(patrol.views, [](const CameraPoseSample& view) { return view.position; });
+}
+
+ByX ObjectsByX(const std::vector<MapObject>& objects) {
+  return ByX(objects, [](const MapObject& object) { return object.centroid; });
+}
+
 // Paper 000's point-pair test for a moved object: the share of the current object's points that, shifted
 // by the centroid difference, lie within `distance` of the prior object's points. 1 without points.
 double MovedShapeOverlap(const MapObject& prior, const MapObject& current, double distance) {
@@ -166,12 +204,16 @@ double VisibleFraction(const MapObject& object, const CameraIntrinsics& camera, 
   return (box & cv::Rect2d(0, 0, camera.width, camera.height)).area() / box.area();
 }
 
-int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const ObjectDiffOptions& options,
-                  const std::vector<const MapObject*>& see_through) {
+namespace {
+
+// CoveringViews over the views `by_x` finds near the object.
+int CoveringViewsNear(const MapObject& object, const PatrolRecord& patrol, const ByX& by_x,
+                      const ObjectDiffOptions& options, const std::vector<const MapObject*>& see_through) {
   const bool grid = patrol.grid.voxel_size > 0.0 && !patrol.grid.voxels.empty();
   const double clearance = std::max(kMinClearance, 0.5 * (object.box_max - object.box_min).norm());
   int views = 0;
-  for (const CameraPoseSample& view : patrol.views) {
+  for (const int k : by_x.Near(object.centroid.x(), options.max_visible_range_m)) {
+    const CameraPoseSample& view = patrol.views[k];
     const Eigen::Vector3d c = view.ToCamera(object.centroid);
     if (c.z() < 0.3 || c.norm() > options.max_visible_range_m) continue;
     if (VisibleFraction(object, patrol.camera, view) < options.min_visible_fraction) continue;
@@ -179,6 +221,13 @@ int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const Obj
     ++views;
   }
   return views;
+}
+
+}  // namespace
+
+int CoveringViews(const MapObject& object, const PatrolRecord& patrol, const ObjectDiffOptions& options,
+                  const std::vector<const MapObject*>& see_through) {
+  return CoveringViewsNear(object, patrol, ViewsByX(patrol), options, see_through);
 }
 
 double ExpectedDetections(const MapObject& object, int own_views, int views) {
@@ -196,6 +245,8 @@ struct Matching {
   std::vector<double> expected;                // ... and the detections they would have given
   std::vector<double> prior_top, current_top;  // 95th percentile of the points' height; 0 without points
   std::vector<std::pair<int, int>> movable;    // (prior, current) pairs that may be one object moved
+  ByX current_by_x;                            // the current objects, and the views of both patrols, by x
+  ByX prior_views, current_views;
 };
 
 Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
@@ -207,7 +258,10 @@ Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
              {},
              {},
              {},
-             {}};
+             {},
+             ObjectsByX(current.objects),
+             ViewsByX(prior),
+             ViewsByX(current)};
   for (const MapObject& o : m.p) m.prior_top.push_back(PointQuantile(o.points, 2, 0.95));
   for (const MapObject& o : m.c) m.current_top.push_back(PointQuantile(o.points, 2, 0.95));
   return m;
@@ -217,7 +271,7 @@ Matching StartMatching(const PatrolRecord& prior, const PatrolRecord& current) {
 void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<ObjectChange>* changes) {
   std::vector<Pair> close, persistent;
   for (std::size_t i = 0; i < m->p.size(); ++i) {
-    for (std::size_t j = 0; j < m->c.size(); ++j) {
+    for (const int j : m->current_by_x.Near(m->p[i].centroid.x(), options.match_distance_m)) {
       const MapObject &a = m->p[i], &b = m->c[j];
       const double distance = (a.centroid - b.centroid).norm();
       if (a.label != b.label || distance > options.match_distance_m) continue;
@@ -228,7 +282,7 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
               options.min_pair_fraction) {
         continue;
       }
-      close.push_back({static_cast<int>(i), static_cast<int>(j), distance});
+      close.push_back({static_cast<int>(i), j, distance});
     }
   }
   AssignGreedy(close, &m->prior_used, &m->current_used, &persistent);
@@ -267,13 +321,14 @@ void MeasureCoverage(const PatrolRecord& prior, const PatrolRecord& current, con
   for (std::size_t i = 0; i < m->p.size(); ++i) {
     if (m->prior_used[i]) continue;
     std::vector<const MapObject*> candidates;  // unmatched current objects that may be this one, moved
-    for (std::size_t j = 0; j < m->c.size(); ++j) {
+    for (const int j : m->current_by_x.Near(m->p[i].centroid.x(), options.max_move_m)) {
       if (!MayHaveMoved(options, *m, i, j)) continue;
-      m->movable.emplace_back(static_cast<int>(i), static_cast<int>(j));
+      m->movable.emplace_back(static_cast<int>(i), j);
       candidates.push_back(&m->c[j]);
     }
-    m->views[i] = CoveringViews(m->p[i], current, options, candidates);
-    m->expected[i] = ExpectedDetections(m->p[i], CoveringViews(m->p[i], prior, options), m->views[i]);
+    m->views[i] = CoveringViewsNear(m->p[i], current, m->current_views, options, candidates);
+    m->expected[i] =
+        ExpectedDetections(m->p[i], CoveringViewsNear(m->p[i], prior, m->prior_views, options, {}), m->views[i]);
   }
 }
 
