@@ -10,6 +10,7 @@
 #include "patrolmap/core/checksum.h"
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/image_header.h"
 #include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/rate_gate.h"
 #include "patrolmap/core/types.h"
@@ -72,6 +73,27 @@ TEST(AtomicFile, ASignalWhileWritingRemovesTheTemporary) {
   int files = 0;
   for (const auto& item : std::filesystem::directory_iterator(dir.path())) files += item.is_regular_file();
   EXPECT_EQ(files, 1);
+}
+
+TEST(DeclaredImageSize, PngAndJpegHeadersAreReadWithoutDecoding) {
+  std::int64_t width = 0, height = 0;
+  // PNG: the signature, then IHDR's length, type, width and height (big endian).
+  const std::vector<unsigned char> png = {0x89, 'P', 'N', 'G', 13, 10, 26,   10,   0, 0, 0,    13,
+                                          'I',  'H', 'D', 'R', 0,  0,  0x3E, 0x80, 0, 0, 0x1F, 0x40};
+  ASSERT_TRUE(DeclaredImageSize(png.data(), png.size(), &width, &height));
+  EXPECT_EQ(width, 16000);
+  EXPECT_EQ(height, 8000);
+  EXPECT_FALSE(DeclaredImageSize(png.data(), png.size() - 1, &width, &height));  // cut inside the size
+  // JPEG: start of image, an APP0 segment, a fill byte, then SOF0 (precision, height, width).
+  std::vector<unsigned char> jpeg = {0xFF, 0xD8, 0xFF, 0xE0, 0,    4,    'J',  'F',  0xFF, 0xFF,
+                                     0xC0, 0,    11,   8,    0x20, 0x00, 0x10, 0x00, 1};
+  ASSERT_TRUE(DeclaredImageSize(jpeg.data(), jpeg.size(), &width, &height));
+  EXPECT_EQ(width, 4096);
+  EXPECT_EQ(height, 8192);
+  jpeg[10] = 0xDA;  // the scan starts before any frame header
+  EXPECT_FALSE(DeclaredImageSize(jpeg.data(), jpeg.size(), &width, &height));
+  const std::vector<unsigned char> text = {'n', 'o', 't', ' ', 'a', 'n', ' ', 'i', 'm', 'a', 'g', 'e'};
+  EXPECT_FALSE(DeclaredImageSize(text.data(), text.size(), &width, &height));
 }
 
 TEST(WriteFileAtomically, MissingFolderFailsAndNamesThePath) {

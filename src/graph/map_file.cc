@@ -14,6 +14,7 @@
 #include "patrolmap/core/csv.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/flight_id.h"
+#include "patrolmap/core/image_header.h"
 #include "patrolmap/vocab/descriptors.h"
 
 #include <opencv2/core.hpp>
@@ -519,36 +520,6 @@ std::vector<RouteFrame> ReadRoute(Reader* r) {
   return route;
 }
 
-// The width and height a JPEG's start-of-frame segment states, found by walking its segments; false when the
-// bytes end, or the scan starts, before a start-of-frame segment.
-bool JpegSize(const std::vector<unsigned char>& jpeg, int* width, int* height) {
-  std::size_t i = 2;  // after the start-of-image marker
-  while (i + 4 <= jpeg.size()) {
-    if (jpeg[i] != 0xFF) return false;
-    const unsigned char marker = jpeg[i + 1];
-    if (marker == 0xFF) {  // fill byte
-      ++i;
-      continue;
-    }
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // segments without a length
-      i += 2;
-      continue;
-    }
-    if (marker == 0xDA || marker == 0xD9) return false;  // the scan or the end before a frame header
-    const std::size_t length = (static_cast<std::size_t>(jpeg[i + 2]) << 8) | jpeg[i + 3];
-    const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
-    if (frame) {
-      if (i + 9 > jpeg.size()) return false;
-      *height = (jpeg[i + 5] << 8) | jpeg[i + 6];
-      *width = (jpeg[i + 7] << 8) | jpeg[i + 8];
-      return true;
-    }
-    if (length < 2) return false;
-    i += 2 + length;
-  }
-  return false;
-}
-
 // Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and
 // JPEG bytes: the start-of-image marker, and a frame header stating at most kMaxRouteFrameSide pixels a side
 // (what change.route_frames.max_width allows), so no crafted map makes the report or the route comparison
@@ -561,9 +532,9 @@ bool ValidRoute(const std::vector<RouteFrame>& route) {
     if (f.pose && !ValidPose(*f.pose)) return false;
     if (f.gps && !(std::abs(f.gps->x()) <= 90.0 && std::abs(f.gps->y()) <= 180.0)) return false;
     if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8) return false;
-    int width = 0, height = 0;
-    if (!JpegSize(f.jpeg, &width, &height) || width < 1 || height < 1 || width > kMaxRouteFrameSide ||
-        height > kMaxRouteFrameSide) {
+    std::int64_t width = 0, height = 0;
+    if (!DeclaredImageSize(f.jpeg.data(), f.jpeg.size(), &width, &height) || width < 1 || height < 1 ||
+        width > kMaxRouteFrameSide || height > kMaxRouteFrameSide) {
       return false;
     }
   }

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "patrolmap/core/image_header.h"
 #include "patrolmap/io/camera_file.h"
 #include "patrolmap/io/pose_file.h"
 
@@ -20,32 +21,12 @@ namespace {
 // seconds and gigabytes to decode.
 constexpr std::int64_t kMaxFramePixels = 64 << 20;
 
-// The size a PNG or JPEG file's header declares, read without decoding; false for other kinds or a header cut short.
+// The size a PNG or JPEG file's header declares (DeclaredImageSize of its first 64 kB).
 bool DeclaredSize(const std::string& path, std::int64_t* width, std::int64_t* height) {
   std::ifstream stream(path, std::ios::binary);
   std::vector<unsigned char> head(64 * 1024);
   stream.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(stream.gcount()));
-  const auto big_endian = [&](std::size_t at, int bytes) {
-    std::int64_t value = 0;
-    for (int k = 0; k < bytes; ++k) value = value << 8 | head[at + k];
-    return value;
-  };
-  if (head.size() >= 24 && head[0] == 0x89 && head[1] == 'P' && head[2] == 'N' && head[3] == 'G') {
-    *width = big_endian(16, 4), *height = big_endian(20, 4);
-    return true;
-  }
-  if (head.size() < 4 || head[0] != 0xff || head[1] != 0xd8) return false;
-  for (std::size_t at = 2; at + 9 <= head.size();) {  // JPEG segments up to the frame header (SOF0-SOF15)
-    if (head[at] != 0xff) return false;
-    const unsigned char marker = head[at + 1];
-    if (marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc) {
-      *height = big_endian(at + 5, 2), *width = big_endian(at + 7, 2);
-      return true;
-    }
-    at += 2 + static_cast<std::size_t>(big_endian(at + 2, 2));
-  }
-  return false;
+  return DeclaredImageSize(head.data(), static_cast<std::size_t>(stream.gcount()), width, height);
 }
 
 }  // namespace
