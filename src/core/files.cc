@@ -36,13 +36,15 @@ void RemoveStaleTemporaries(const std::string& path) {
 // allocates nor locks. A slot's path is written before the slot is marked used.
 constexpr int kTemporarySlots = 16;
 constexpr std::size_t kTemporaryPathBytes = 4096;
-std::atomic<bool> slot_used[kTemporarySlots];
+std::atomic<bool> slot_claimed[kTemporarySlots];  // taken by a writer
+std::atomic<bool> slot_used[kTemporarySlots];     // its path written: the handler may read it
 char slot_path[kTemporarySlots][kTemporaryPathBytes];
 
 int RegisterTemporary(const std::string& path) {
   if (path.size() >= kTemporaryPathBytes) return -1;
   for (int slot = 0; slot < kTemporarySlots; ++slot) {
-    if (slot_used[slot].load()) continue;
+    bool expected = false;
+    if (!slot_claimed[slot].compare_exchange_strong(expected, true)) continue;  // another file's, or thread's
     std::memcpy(slot_path[slot], path.c_str(), path.size() + 1);
     slot_used[slot].store(true);
     return slot;
@@ -51,7 +53,9 @@ int RegisterTemporary(const std::string& path) {
 }
 
 void UnregisterTemporary(int slot) {
-  if (slot >= 0) slot_used[slot].store(false);
+  if (slot < 0) return;
+  slot_used[slot].store(false);
+  slot_claimed[slot].store(false);
 }
 
 extern "C" void RemoveTemporariesAndDie(int signal_number) {

@@ -21,12 +21,14 @@ namespace {
 // seconds and gigabytes to decode.
 constexpr std::int64_t kMaxFramePixels = 64 << 20;
 
-// The size a PNG or JPEG file's header declares (DeclaredImageSize of its first 64 kB).
-bool DeclaredSize(const std::string& path, std::int64_t* width, std::int64_t* height) {
+// The size a PNG or JPEG file's header declares (DeclaredImageSize of its first 64 kB, read into `head`, which a
+// caller reading frame after frame keeps).
+bool DeclaredSize(const std::string& path, std::vector<unsigned char>* head, std::int64_t* width,
+                  std::int64_t* height) {
   std::ifstream stream(path, std::ios::binary);
-  std::vector<unsigned char> head(64 * 1024);
-  stream.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  return DeclaredImageSize(head.data(), static_cast<std::size_t>(stream.gcount()), width, height);
+  head->resize(64 * 1024);
+  stream.read(reinterpret_cast<char*>(head->data()), static_cast<std::streamsize>(head->size()));
+  return DeclaredImageSize(head->data(), static_cast<std::size_t>(stream.gcount()), width, height);
 }
 
 }  // namespace
@@ -63,9 +65,10 @@ Status ImageListSource::UsePoseFile(const std::string& path) {
 
 Status ImageListSource::CheckResolution(const CameraIntrinsics& camera, const std::string& path) const {
   // The first image whose header declares its size, or else the first that decodes.
+  std::vector<unsigned char> head;
   for (const ImageEntry& entry : entries_) {
     std::int64_t width = 0, height = 0;
-    if (!DeclaredSize(entry.path, &width, &height)) {
+    if (!DeclaredSize(entry.path, &head, &width, &height)) {
       const cv::Mat image = cv::imread(entry.path, cv::IMREAD_UNCHANGED);
       if (image.empty()) continue;
       width = image.cols, height = image.rows;
@@ -116,7 +119,7 @@ Status ImageListSource::Next(bool decode_image, Frame* frame) {
 
 bool ImageListSource::Decode(std::int64_t index, const std::string& path, cv::Mat* image, cv::Mat* colour) {
   std::int64_t width = 0, height = 0;
-  if (DeclaredSize(path, &width, &height) && width * height > kMaxFramePixels) {
+  if (DeclaredSize(path, &header_, &width, &height) && width * height > kMaxFramePixels) {
     RecordSkipped(index, path + ": declares " + std::to_string(width) + "x" + std::to_string(height) +
                              " pixels, more than a camera frame has (" + std::to_string(kMaxFramePixels) + ")");
     return false;

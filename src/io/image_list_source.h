@@ -56,6 +56,7 @@ class ImageListSource : public FrameSource {
   std::size_t next_entry_ = 0;
   std::size_t next_imu_ = 0;
   cv::Size first_size_;
+  std::vector<unsigned char> header_;  // the head of the frame being decoded (DeclaredSize), kept between frames
 };
 
 }  // namespace patrolmap::io

@@ -226,8 +226,9 @@ Status ReadWaypoints(const std::string& path, Route* route) {
     route->waypoints.push_back(point);
   }
   if (!status.end_of_stream()) return status;
-  if (RouteLength(route->waypoints) > kMaxRouteLengthM) {
-    return Status::InvalidArgument(path + ": the route is " + std::to_string(RouteLength(route->waypoints) / 1000.0) +
+  const double length = RouteLength(route->waypoints);
+  if (length > kMaxRouteLengthM) {
+    return Status::InvalidArgument(path + ": the route is " + std::to_string(length / 1000.0) +
                                    " km long; a simulated flight covers at most " +
                                    std::to_string(static_cast<int>(kMaxRouteLengthM / 1000.0)) + " km");
   }
