@@ -343,6 +343,18 @@ def attack_reported(attack, work, log, prior):
         metadata.write_text(re.sub(r"compression_format: [^\n]*", "compression_format: zstd", metadata.read_text()))
         attack.judge("reported: compressed ROS 2 bag", [attack.patrolmap, "map", str(bag), "--out",
                                                         str(work / "rout")], ["compression_format"])
+    # Route frames whose JPEG headers state 8192 x 8192 pixels (a few kB each): every decode would allocate and
+    # describe 67 Mpx; the map is refused as larger than its camera could have kept.
+    data = bytearray(prior.read_bytes())
+    for sof in (b"\xff\xc0\x00\x0b\x08", b"\xff\xc0\x00\x11\x08"):  # baseline frame headers, grey and colour
+        at = data.find(sof)
+        while at >= 0:
+            data[at + 5:at + 9] = b"\x20\x00\x20\x00"
+            at = data.find(sof, at + 9)
+    huge = work / "huge_route.pmap"
+    huge.write_bytes(recompute_map_checksums(bytes(data)))
+    attack.judge("reported: route frames declaring 8192x8192", [attack.patrolmap, "diff", str(huge), "--out",
+                                                                 str(work / "rdiff")], [str(huge)], keep=huge)
     route = work / "far.csv"
     for rows_text in ("0,0\n1e9,0\n", "0,0\n9000,0\n" * 5):
         route.write_text(rows_text)

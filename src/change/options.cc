@@ -118,7 +118,7 @@ void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
 
 void CheckRouteFrames(const RouteFrameOptions& r, OptionCheck* check) {
   check->InRange("change.route_frames.interval_s", r.interval_s, 0.0, 3600.0)
-      .InRange("change.route_frames.max_width", r.max_width, 16, 8192)
+      .InRange("change.route_frames.max_width", r.max_width, 16, 2048)
       .InRange("change.route_frames.jpeg_quality", r.jpeg_quality, 1, 100)
       .InRange("change.route_frames.memory_mb", r.memory_mb, 0.1, 65536.0);
 }

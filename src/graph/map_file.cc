@@ -29,7 +29,7 @@ constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 9: where the patrol's camera poses came from; 10: the patrol's lens distortion; 11: the patrol's log and its digest
 constexpr std::uint32_t kVersion = 11;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
-constexpr int kMaxRouteFrameSide = 8192;  // change.route_frames.max_width's largest value
+constexpr int kMaxRouteFrameSide = 2048;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
 
 // Where a section's bytes go: counted (its length), checksummed, or written to the file. A section is built
@@ -521,10 +521,11 @@ std::vector<RouteFrame> ReadRoute(Reader* r) {
 }
 
 // Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and
-// JPEG bytes: the start-of-image marker, and a frame header stating at most kMaxRouteFrameSide pixels a side
-// (what change.route_frames.max_width allows), so no crafted map makes the report or the route comparison
-// decode a huge image.
-bool ValidRoute(const std::vector<RouteFrame>& route) {
+// JPEG bytes: the start-of-image marker and a frame header stating a size no larger than the patrol's camera
+// (where it is known; key frames are kept at the feature scale, the others at max_width) and at most
+// kMaxRouteFrameSide a side (what change.route_frames.max_width allows), so no crafted map makes the report or the
+// route comparison decode and describe images larger than the flight that wrote it could have kept.
+bool ValidRoute(const std::vector<RouteFrame>& route, const CameraIntrinsics& camera) {
   for (std::size_t i = 0; i < route.size(); ++i) {
     const RouteFrame& f = route[i];
     if (!ValidTimestamp(f.timestamp_ns) || f.frame_index < 0) return false;
@@ -537,6 +538,7 @@ bool ValidRoute(const std::vector<RouteFrame>& route) {
         width > kMaxRouteFrameSide || height > kMaxRouteFrameSide) {
       return false;
     }
+    if (camera.width > 0 && (width > camera.width || height > camera.height)) return false;
   }
   return true;
 }
@@ -574,7 +576,7 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
         (p.depth_source != "" && p.depth_source != "images" && p.depth_source != "stereo")) {
       return Corrupt(path, "evidence grid of " + p.flight);
     }
-    if (!ValidRoute(p.route)) return Corrupt(path, "route frames of " + p.flight);
+    if (!ValidRoute(p.route, p.camera)) return Corrupt(path, "route frames of " + p.flight);
     if (!KnownPoseSource(p.pose_source)) return Corrupt(path, "pose source of " + p.flight);
     if (!ValidSource(p)) return Corrupt(path, "log of " + p.flight);
     // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.

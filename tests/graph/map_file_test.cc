@@ -357,11 +357,11 @@ std::size_t FrameHeader(const std::vector<unsigned char>& jpeg) {
   return 0;
 }
 
-// Route frames out of time order, bytes that are not JPEG, or a JPEG stating a huge image (which decoding
-// would allocate) make the map corrupt, named.
+// Route frames out of time order, bytes that are not JPEG, a JPEG stating a huge image (which decoding
+// would allocate), or one larger than the patrol's camera make the map corrupt, named.
 TEST(MapFile, DamagedRouteFramesAreNamed) {
   testing::TempDir dir;
-  for (int damage = 0; damage < 4; ++damage) {
+  for (int damage = 0; damage < 6; ++damage) {
     TopoMap map = WithRoute();
     PatrolRecord record = *map.Patrol("b");
     std::vector<unsigned char>& jpeg = record.route[0].jpeg;
@@ -370,7 +370,11 @@ TEST(MapFile, DamagedRouteFramesAreNamed) {
     if (damage == 0) record.route[1].timestamp_ns = 1;
     if (damage == 1) jpeg[0] = 'P';
     if (damage == 2) jpeg[header + 5] = jpeg[header + 6] = jpeg[header + 7] = jpeg[header + 8] = 0xEA;  // 60138 px
-    if (damage == 3) jpeg.resize(header);  // ends before its frame header
+    if (damage == 3) jpeg.resize(header);                           // ends before its frame header
+    if (damage == 4) jpeg[header + 5] = 0, jpeg[header + 6] = 200;  // 32x200, taller than the 188x120 camera
+    if (damage == 5) {                                              // both 300x24, wider than the 188x120 camera
+      for (RouteFrame& f : record.route) f.jpeg[header + 7] = 1, f.jpeg[header + 8] = 0x2C;
+    }
     map.SetPatrol(record);
     ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
     TopoMap loaded;
