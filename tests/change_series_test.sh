@@ -99,9 +99,9 @@ report = json.load(open('$2/changes.json'))
 dom = open('$work/page.html').read()
 console = [l for l in open('$work/page.log') if ':CONSOLE' in l]
 assert not console, console
-placed = sum(1 for c in report['changes'] if c['position'])
+placed = sum(1 for c in report['changes'] if c['position'] or c['bearing'])  # a point, or the ray of a bearing
 assert 'data-ready=\"%d markers\"' % placed in dom, re.findall('data-ready=\"[^\"]*\"', dom)
-assert dom.count('class=\"marker\"') == placed
+assert dom.count('class=\"marker\"') + dom.count('class=\"marker bearing\"') == placed
 images = [v['image'] for c in report['changes'] for v in (c['before'], c['after']) if v['image']]
 assert len(images) >= len(report['changes']), (len(images), len(report['changes']))
 # A picture's file is in data-src until its row comes near the view, then in src (added last).

@@ -162,6 +162,9 @@ bool ChangeOptions::IsValid(std::string* error) const {
   CheckGeometryObjects(geometry_objects, &check);
   CheckRouteFrames(route_frames, &check);
   CheckRoute(route, &check);
+  check.InRange("change.location.min_depth_share", location.min_depth_share, 0.0, 1.0)
+      .InRange("change.location.min_ray_angle_deg", location.min_ray_angle_deg, 0.0, 90.0)
+      .AboveAtMost("change.location.max_range_m", location.max_range_m, 0.0, 10000.0);
   return check.ok();
 }
 

@@ -181,17 +181,17 @@ ChangeView RouteView(const std::string& flight, const RouteFrame& frame, const c
   return view;
 }
 
-// The camera position of the view of `flight` nearest in time to `timestamp_ns` (within a second).
-std::optional<Eigen::Vector3d> CameraAt(const graph::TopoMap& map, const std::string& flight,
-                                        TimestampNs timestamp_ns) {
-  const PatrolRecord* record = map.Patrol(flight);
-  if (record == nullptr || record->views.empty()) return std::nullopt;
-  const auto nearest = std::min_element(
-      record->views.begin(), record->views.end(), [timestamp_ns](const CameraPoseSample& a, const CameraPoseSample& b) {
-        return std::llabs(a.timestamp_ns - timestamp_ns) < std::llabs(b.timestamp_ns - timestamp_ns);
-      });
-  if (std::llabs(nearest->timestamp_ns - timestamp_ns) > SecondsToNs(1.0)) return std::nullopt;
-  return nearest->position;
+// An appearance change's place: its point where it has one, its bearing from the camera otherwise.
+void SetLocation(const ChangeLocation& location, const ReportOptions& options, ChangeItem* item) {
+  item->located = ToString(location.by);
+  item->channels = {"appearance"};
+  if (location.HasPoint()) {
+    item->position = location.point;
+    item->extent = {Eigen::AlignedBox3d(location.point, location.point)};
+  }
+  if (location.by == LocatedBy::kNone) return;
+  item->bearing = location.bearing;
+  item->bearing_range_m = options.max_view_range_m;
 }
 
 bool Reported(ObjectState state) {
@@ -220,11 +220,19 @@ ChangeItem ObjectItem(const ChangeReport& report, const graph::TopoMap& map, con
   item.position = o.after ? o.after : o.before;
   if (o.state == ObjectState::kMoved) item.from = o.before;
   if (o.class_agnostic) {
+    item.channels = {"geometry objects"};
+    for (const Eigen::AlignedBox3d& box : {o.box_before, o.box_after}) {
+      if (!box.isEmpty()) item.extent.push_back(box);
+    }
     AddClassAgnosticViews(report, map, o, options, &item);
     return item;
   }
+  item.channels = {"detections"};
   const MapObject* prior = FindObject(map.Patrol(report.prior_flight), o.prior_id);
   const MapObject* current = FindObject(map.Patrol(report.current_flight), o.current_id);
+  for (const MapObject* object : {prior, current}) {
+    if (object != nullptr) item.extent.emplace_back(object->box_min, object->box_max);
+  }
   // New: where it is now, then and now; removed: where it was; moved: each where it was seen. A patrol
   // that detected the object shows it from a frame of the time it did.
   const MapObject* then = prior != nullptr ? prior : current;
@@ -251,6 +259,8 @@ ChangeItem GeometryItem(const ChangeReport& report, const graph::TopoMap& map, c
   item.confidence = std::clamp(r.score, 0.0, 1.0);
   item.position = r.centroid;
   const Eigen::Vector3d half = Eigen::Vector3d::Constant(report.geometry.voxel_size / 2.0);
+  item.channels = {"geometry"};
+  item.extent = {Eigen::AlignedBox3d(r.box_min - half, r.box_max + half)};
   item.before = ViewOfBox(map, report.prior_flight, r.box_min - half, r.box_max + half, TimeWindow(), options);
   item.after = ViewOfBox(map, report.current_flight, r.box_min - half, r.box_max + half, TimeWindow(), options);
   return item;
@@ -264,8 +274,7 @@ ChangeItem AppearanceItem(const graph::TopoMap& map, const PlaceChange& place, c
   const std::size_t regions = place.appearance.regions.size();
   item.label = std::to_string(regions) + (regions == 1 ? " region" : " regions");
   item.confidence = std::clamp(place.appearance.regions[0].score, 0.0, 1.0);
-  const graph::NodeData& node = map.node(place.current_node);
-  item.position = CameraAt(map, node.flight, node.timestamp_ns);
+  SetLocation(place.location, options, &item);
   std::vector<cv::Rect> prior_boxes, current_boxes;
   for (const AppearanceRegion& r : place.appearance.regions) {
     prior_boxes.push_back(r.prior_box);
@@ -294,8 +303,7 @@ ChangeItem RouteItem(const ChangeReport& report, const graph::TopoMap& map, cons
                   " % of it";
   }
   item.confidence = change.confidence;
-  item.position = current.pose ? std::optional<Eigen::Vector3d>(current.pose->position)
-                               : CameraAt(map, report.current_flight, current.timestamp_ns);
+  SetLocation(change.location, options, &item);
   item.before = RouteView(report.prior_flight, prior, region.prior_box, options);
   item.after = RouteView(report.current_flight, current, region.current_box, options);
   return item;
@@ -352,22 +360,35 @@ std::string RouteChangeId(const RouteFrame& prior, const RouteFrame& current) {
 std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::TopoMap& map,
                                     const ReportOptions& options) {
   std::vector<ChangeItem> items;
-  for (const ObjectChange& o : report.objects) {
-    if (Reported(o.state)) items.push_back(ObjectItem(report, map, o, options));
+  const auto add = [&items](ChangeItem item, const char* list, std::size_t index) {
+    item.source = {list, static_cast<int>(index)};
+    items.push_back(std::move(item));
+  };
+  for (std::size_t i = 0; i < report.objects.size(); ++i) {
+    if (Reported(report.objects[i].state)) add(ObjectItem(report, map, report.objects[i], options), "objects", i);
   }
-  for (const GeometryRegion& r : report.geometry.regions) items.push_back(GeometryItem(report, map, r, options));
-  for (const PlaceChange& place : report.places) {
-    if (!place.appearance.regions.empty()) items.push_back(AppearanceItem(map, place, options));
+  for (std::size_t i = 0; i < report.geometry.regions.size(); ++i) {
+    add(GeometryItem(report, map, report.geometry.regions[i], options), "geometry", i);
   }
-  for (const RouteChange& change : report.route.changes) items.push_back(RouteItem(report, map, change, options));
+  for (std::size_t i = 0; i < report.places.size(); ++i) {
+    if (!report.places[i].appearance.regions.empty()) add(AppearanceItem(map, report.places[i], options), "places", i);
+  }
+  for (std::size_t i = 0; i < report.route.changes.size(); ++i) {
+    add(RouteItem(report, map, report.route.changes[i], options), "route", i);
+  }
   // Regions in one 2 m cell share their id (one onboard event each); in the report the later ones get "-2", ...
   std::map<std::string, int> seen;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    items[i].number = static_cast<int>(i) + 1;
-    const int repeat = ++seen[items[i].id];
-    if (repeat > 1) items[i].id += "-" + std::to_string(repeat);
+  for (ChangeItem& item : items) {
+    const int repeat = ++seen[item.id];
+    if (repeat > 1) item.id += "-" + std::to_string(repeat);
   }
+  items = FuseItems(std::move(items), options.fuse_distance_m);
+  for (std::size_t i = 0; i < items.size(); ++i) items[i].number = static_cast<int>(i) + 1;
   return items;
+}
+
+Eigen::Vector3d BearingEnd(const ChangeItem& item) {
+  return item.bearing->origin + item.bearing_range_m * item.bearing->direction;
 }
 
 std::string ViewFileName(const ChangeItem& item, bool before) {

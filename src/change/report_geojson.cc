@@ -1,5 +1,6 @@
-// changes.geojson (RFC 7946): every change as a point at [longitude, latitude] with its properties, moved
-// objects' paths, and each flight's GPS track (the fixes of its kept frames) as a line.
+// changes.geojson (RFC 7946): every change as a point at [longitude, latitude] with its properties (an appearance
+// change known only by its bearing as the ray from the camera it lies on), moved objects' paths, and each flight's
+// GPS track (the fixes of its kept frames) as a line.
 #include <nlohmann/json.hpp>
 
 #include "patrolmap/change/report.h"
@@ -19,10 +20,16 @@ json ViewProperties(const ChangeView& view) {
   return {{"flight", view.flight}, {"time_s", NsToSeconds(view.timestamp_ns)}, {"frame", view.frame_index}};
 }
 
+// A change at its point, or, placed by a bearing only, as the ray from the camera it lies on.
 json ChangeFeature(const ChangeItem& item, const GeoReference& geo) {
+  const json geometry =
+      item.position
+          ? json({{"type", "Point"}, {"coordinates", LonLat(geo, *item.position)}})
+          : json({{"type", "LineString"},
+                  {"coordinates", json::array({LonLat(geo, item.bearing->origin), LonLat(geo, BearingEnd(item))})}});
   return {{"type", "Feature"},
           {"id", item.id},
-          {"geometry", {{"type", "Point"}, {"coordinates", LonLat(geo, *item.position)}}},
+          {"geometry", geometry},
           {"properties",
            {{"id", item.id},
             {"number", item.number},
@@ -30,7 +37,8 @@ json ChangeFeature(const ChangeItem& item, const GeoReference& geo) {
             {"state", item.state},
             {"label", item.label},
             {"confidence", item.confidence},
-            {"height_m", item.position->z()},
+            {"located", item.located.empty() ? json(nullptr) : json(item.located)},
+            {"height_m", item.position ? json(item.position->z()) : json(nullptr)},
             {"before", ViewProperties(item.before)},
             {"after", ViewProperties(item.after)}}}};
 }
@@ -61,7 +69,7 @@ std::string ToGeoJson(const ChangeReport& report, const graph::TopoMap& map, con
     FlightFeatures(map, flight, geo, &features);
   }
   for (const ChangeItem& item : items) {
-    if (!item.position) continue;
+    if (!item.position && !item.bearing) continue;
     features.push_back(ChangeFeature(item, geo));
     if (!item.from) continue;
     features.push_back({{"type", "Feature"},

@@ -75,6 +75,13 @@ document.body.dataset.readyMs = Math.round(performance.now());  // since navigat
 )";
 
 std::string Where(const ChangeItem& item, const std::optional<GeoReference>& geo) {
+  if (!item.position && item.bearing) {
+    const Eigen::Vector3d& o = item.bearing->origin;
+    const double heading = std::atan2(item.bearing->direction.x(), item.bearing->direction.y()) * 180.0 / M_PI;
+    return "<span class='none'>on a bearing, no depth:</span> within " + Number(item.bearing_range_m, 0) +
+           " m of the camera at " + Number(o.x(), 1) + ", " + Number(o.y(), 1) + ", " + Number(o.z(), 1) +
+           " m, heading " + Number(std::fmod(heading + 360.0, 360.0), 0) + "&#176; (from +y, clockwise)";
+  }
   if (!item.position) return "<span class='none'>no pose</span>";
   const Eigen::Vector3d& p = *item.position;
   std::string where = Number(p.x(), 1) + ", " + Number(p.y(), 1) + ", " + Number(p.z(), 1) + " m";
@@ -105,17 +112,33 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   return out.str();
 }
 
+// What the other channels found of the change, each with its confidence.
+std::string SeenBy(const ChangeItem& item) {
+  if (item.evidence.empty()) return "";
+  std::string text = "<br>also seen as:";
+  for (const ChangeEvidence& e : item.evidence) {
+    text += "<br>&#8226; " + graph::EscapeXml(e.kind + " " + e.state) + ", " + graph::EscapeXml(e.label) + " (" +
+            Number(e.confidence) + ")";
+  }
+  return text;
+}
+
 void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoReference>& geo, const std::string& images,
                 std::ostringstream* html) {
+  *html << "<p class='note'>Confidence, from 0 to 1: how sure each channel is (detections: the detector's mean score; "
+           "geometry: the changed voxels' evidence; appearance: the structure change, the depth that marked it and "
+           "the views that agree). A change several channels saw counts them as independent witnesses: 1 minus the "
+           "product of (1 - each one's).</p>\n";
   *html << "<table id='changes'><tr><th>#</th><th>change</th><th>confidence</th><th>where</th><th>before</th>"
            "<th>after</th></tr>\n";
   for (const ChangeItem& item : items) {
     *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id)
           << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
           << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
-          << "</b>: " << graph::EscapeXml(item.label) << "<br><span class='id'>" << graph::EscapeXml(item.id)
-          << "</span></td><td>" << Number(item.confidence) << "</td><td>" << Where(item, geo) << "</td><td>"
-          << Figure(item, true, images) << "</td><td>" << Figure(item, false, images) << "</td></tr>\n";
+          << "</b>: " << graph::EscapeXml(item.label) << SeenBy(item) << "<br><span class='id'>"
+          << graph::EscapeXml(item.id) << "</span></td><td>" << Number(item.confidence) << "</td><td>"
+          << Where(item, geo) << "</td><td>" << Figure(item, true, images) << "</td><td>" << Figure(item, false, images)
+          << "</td></tr>\n";
   }
   *html << "</table>\n";
 }

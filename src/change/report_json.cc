@@ -67,6 +67,8 @@ json RouteJson(const ChangeReport& report, const graph::TopoMap& map, const std:
                        {"confidence", change.confidence},
                        {"score", change.score},
                        {"marked_share", change.marked_share},
+                       {"located", ToString(change.location.by)},
+                       {"position", change.location.HasPoint() ? Vector(change.location.point) : json(nullptr)},
                        {"views", views}});
   }
   return {{"frames", report.route.current_frames},
@@ -105,14 +107,11 @@ json ObjectJson(const ObjectChange& o) {
 
 // Region ids as the changes list has them (made unique there), in region order.
 json GeometryJson(const GeometryChange& g, const std::vector<ChangeItem>& items) {
-  std::vector<std::string> ids;
-  for (const ChangeItem& item : items) {
-    if (item.kind == "geometry") ids.push_back(item.id);
-  }
+  const std::vector<std::string> ids = IdsOf(items, "geometry", g.regions.size());
   json regions = json::array();
   for (std::size_t k = 0; k < g.regions.size(); ++k) {
     const GeometryRegion& r = g.regions[k];
-    regions.push_back({{"id", k < ids.size() ? ids[k] : GeometryChangeId(r.centroid)},
+    regions.push_back({{"id", ids[k].empty() ? GeometryChangeId(r.centroid) : ids[k]},
                        {"centroid", Vector(r.centroid)},
                        {"box_min", Vector(r.box_min)},
                        {"box_max", Vector(r.box_max)},
@@ -144,6 +143,21 @@ json ViewJson(const ChangeItem& item, bool before, const std::string& images) {
           {"image", image}};
 }
 
+// The other channels' findings fused into the entry.
+json EvidenceJson(const ChangeItem& item) {
+  json evidence = json::array();
+  for (const ChangeEvidence& e : item.evidence) {
+    evidence.push_back({{"id", e.id},
+                        {"kind", e.kind},
+                        {"state", e.state},
+                        {"label", e.label},
+                        {"confidence", e.confidence},
+                        {"position", e.position ? Vector(*e.position) : json(nullptr)},
+                        {"located", e.located.empty() ? json(nullptr) : json(e.located)}});
+  }
+  return evidence;
+}
+
 json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, const std::string& images) {
   json change = {{"id", item.id},
                  {"number", item.number},
@@ -153,8 +167,15 @@ json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, 
                  {"confidence", item.confidence},
                  {"position", item.position ? Vector(*item.position) : json(nullptr)},
                  {"from", item.from ? Vector(*item.from) : json(nullptr)},
+                 {"located", item.located.empty() ? json(nullptr) : json(item.located)},
+                 {"bearing", item.bearing ? json({{"origin", Vector(item.bearing->origin)},
+                                                  {"direction", Vector(item.bearing->direction)},
+                                                  {"range_m", item.bearing_range_m}})
+                                          : json(nullptr)},
                  {"latitude", nullptr},
                  {"longitude", nullptr},
+                 {"channels", item.channels},
+                 {"evidence", EvidenceJson(item)},
                  {"before", ViewJson(item, true, images)},
                  {"after", ViewJson(item, false, images)}};
   if (geo && item.position) {
@@ -177,9 +198,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
     counts[ToString(s)] = report.ObjectsIn(s);
   }
   for (const ChangeItem& item : items) changes.push_back(ChangeJson(item, geo, images));
-  std::vector<std::string> route_ids;  // the route's changes are the last items
-  for (std::size_t i = items.size() - std::min(items.size(), report.route.changes.size()); i < items.size(); ++i)
-    route_ids.push_back(items[i].id);
+  const std::vector<std::string> route_ids = IdsOf(items, "route", report.route.changes.size());
   json geo_json = nullptr;
   if (geo) {
     geo_json = {{"origin_latitude", geo->origin_latitude},

@@ -54,16 +54,27 @@ std::string ToKml(const ChangeReport& report, const graph::TopoMap& map, const s
   Track(map, report.prior_flight, &out);
   Track(map, report.current_flight, &out);
   for (const ChangeItem& item : items) {
-    if (!item.position) continue;
+    if (!item.position && !item.bearing) continue;
     char summary[96];
-    std::snprintf(summary, sizeof(summary), "confidence %.2f, height %.1f m", item.confidence, item.position->z());
+    if (item.position) {
+      std::snprintf(summary, sizeof(summary), "confidence %.2f, height %.1f m", item.confidence, item.position->z());
+    } else {
+      std::snprintf(summary, sizeof(summary), "confidence %.2f, somewhere along this bearing from the camera",
+                    item.confidence);
+    }
     const std::string description = "<p>" + graph::EscapeXml(item.id) + ": " + graph::EscapeXml(item.kind) + " " +
                                     graph::EscapeXml(item.state) + ", " + graph::EscapeXml(item.label) + ", " +
                                     summary + "</p>" + Picture(item, true, images) + Picture(item, false, images);
     out << "<Placemark id=\"" << graph::EscapeXml(item.id) << "\"><name>" << item.number << " "
         << graph::EscapeXml(item.kind + " " + item.state) << "</name><description><![CDATA[" << description
-        << "]]></description><Point><coordinates>" << Coordinate(geo, *item.position)
-        << "</coordinates></Point></Placemark>\n";
+        << "]]></description>";
+    if (item.position) {
+      out << "<Point><coordinates>" << Coordinate(geo, *item.position) << "</coordinates></Point>";
+    } else {
+      out << "<LineString><coordinates>" << Coordinate(geo, item.bearing->origin) << " "
+          << Coordinate(geo, BearingEnd(item)) << "</coordinates></LineString>";
+    }
+    out << "</Placemark>\n";
   }
   out << "</Document>\n</kml>\n";
   return out.str();

@@ -125,6 +125,19 @@ void Places(const ChangeReport& report, const graph::TopoMap& map, const PlanFra
   }
 }
 
+// A change placed by a bearing only: the ray from the camera it lies on, dashed, its number at the far end.
+void BearingMarker(const ChangeItem& item, const PlanFrame& frame, std::ostringstream* svg) {
+  const Eigen::Vector2d o = frame(item.bearing->origin.head<2>()), e = frame(BearingEnd(item).head<2>());
+  *svg << "<g class='marker bearing' data-id='" << graph::EscapeXml(item.id) << "'><line x1='" << Number(o.x())
+       << "' y1='" << Number(o.y()) << "' x2='" << Number(e.x()) << "' y2='" << Number(e.y()) << "' stroke='"
+       << ChangeColour(item) << "' stroke-width='2' stroke-dasharray='6 4'/><circle cx='" << Number(e.x()) << "' cy='"
+       << Number(e.y()) << "' r='9' fill='white' stroke='" << ChangeColour(item) << "' stroke-width='2'/><text x='"
+       << Number(e.x()) << "' y='" << Number(e.y() + 4) << "' text-anchor='middle' font-size='11' fill='"
+       << ChangeColour(item) << "' font-weight='bold'>" << item.number << "</text><title>" << item.number << ": "
+       << graph::EscapeXml(item.kind + " " + item.state)
+       << ", somewhere along this bearing from the camera (no depth there)</title></g>\n";
+}
+
 void Marker(const ChangeItem& item, const PlanFrame& frame, std::ostringstream* svg) {
   const Eigen::Vector2d p = frame(item.position->head<2>());
   if (item.from) {
@@ -162,6 +175,7 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
   for (const ChangeItem& item : items) {
     if (item.position) points.push_back(item.position->head<2>());
     if (item.from) points.push_back(item.from->head<2>());
+    if (!item.position && item.bearing) points.push_back(BearingEnd(item).head<2>());
   }
   if (points.empty()) return "";
   const PlanFrame frame(points, geo);
@@ -182,6 +196,7 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
   Places(report, map, frame, &svg);
   for (const ChangeItem& item : items) {
     if (item.position) Marker(item, frame, &svg);
+    if (!item.position && item.bearing) BearingMarker(item, frame, &svg);
   }
   ScaleBar(frame, &svg);
   if (geo) NorthArrow(frame, &svg);

@@ -144,7 +144,7 @@ bool AlignFrame(int c, const std::vector<int>& candidates, const std::vector<Key
 // Compares the aligned frame with its partner; a region must be found against the runner-up too.
 RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView>& prior_views,
                       const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
-                      const AppearanceOptions& appearance) {
+                      const AppearanceOptions& appearance, const ChangeLocationOptions& location) {
   RoutePair pair;
   const auto& [registration, prior] = alignment.registered[0];
   pair.prior = prior;
@@ -169,6 +169,8 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
       KeepSeenFromBoth(second, prior_views[second_prior].image.size(), options.min_overlap, &pair.appearance);
     }
   }
+  for (AppearanceRegion& region : pair.appearance.regions)
+    region.world = PointFromDepth(current, region.current_box, location);
   return pair;
 }
 
@@ -328,6 +330,49 @@ class RouteDepths {
   std::vector<bool> held_, given_;
 };
 
+// The component-wise median of `points` (not empty).
+Eigen::Vector3d Median(std::vector<Eigen::Vector3d> points) {
+  Eigen::Vector3d median;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> values;
+    for (const Eigen::Vector3d& p : points) values.push_back(p[axis]);
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    median[axis] = values[values.size() / 2];
+  }
+  return median;
+}
+
+// Where `change` stands (RouteChange::location): its views' depth points, else their rays triangulated where the
+// poses lie in one world frame, else its best view's bearing; nothing without a pose or a camera.
+ChangeLocation LocateRouteChange(const RouteComparison& comparison, const RouteChange& change,
+                                 const std::vector<RouteFrame>& current, const std::vector<KeyFrameView>& current_views,
+                                 const RouteCameras& cameras, const ChangeLocationOptions& options) {
+  ChangeLocation location;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Bearing> rays;
+  for (std::size_t k = 0; k < change.views.size(); ++k) {
+    const RoutePair& pair = comparison.pairs[change.views[k].pair];
+    const AppearanceRegion& region = pair.appearance.regions[change.views[k].region];
+    if (region.world) points.push_back(*region.world);
+    const RouteFrame& frame = current[pair.current];
+    if (!frame.pose || !cameras.current.valid() || current_views[pair.current].image.empty()) continue;
+    rays.push_back(BearingThrough(cameras.current, cameras.current_distortion, current_views[pair.current].image.cols,
+                                  *frame.pose, region.current_box));
+    if (static_cast<int>(k) == change.best || rays.size() == 1) location.bearing = rays.back();
+  }
+  if (!points.empty()) {
+    location.by = LocatedBy::kDepth;
+    location.point = Median(points);
+    return location;
+  }
+  if (rays.empty()) return location;
+  const std::optional<Eigen::Vector3d> met =
+      cameras.poses_comparable ? Triangulate(rays, options) : std::optional<Eigen::Vector3d>();
+  location.by = met ? LocatedBy::kTriangulated : LocatedBy::kBearing;
+  if (met) location.point = *met;
+  return location;
+}
+
 // Aligned pairs compared at a time: with depth, the depth of at most this many current frames and their prior
 // frames is held (0.36 MB a 376x240 frame). The results do not depend on it.
 constexpr std::size_t kPairsPerBlock = 32;
@@ -335,8 +380,8 @@ constexpr std::size_t kPairsPerBlock = 32;
 // Compares the aligned pairs, block by block, the frames of each block given depth first when `depths` are given.
 void CompareBlocks(const std::vector<Alignment>& alignments, const std::vector<KeyFrameView>& prior_views,
                    const std::vector<KeyFrameView>& current_views, const RouteCompareOptions& options,
-                   const AppearanceOptions& appearance, RouteDepths* prior_depths, RouteDepths* current_depths,
-                   std::vector<RoutePair>* pairs) {
+                   const AppearanceOptions& appearance, const ChangeLocationOptions& location,
+                   RouteDepths* prior_depths, RouteDepths* current_depths, std::vector<RoutePair>* pairs) {
   pairs->resize(alignments.size());
   for (std::size_t start = 0; start < alignments.size(); start += kPairsPerBlock) {
     const std::size_t end = std::min(alignments.size(), start + kPairsPerBlock);
@@ -351,7 +396,7 @@ void CompareBlocks(const std::vector<Alignment>& alignments, const std::vector<K
     }
     cv::parallel_for_(cv::Range(static_cast<int>(start), static_cast<int>(end)), [&](const cv::Range& range) {
       for (int i = range.start; i < range.end; ++i) {
-        (*pairs)[i] = ComparePair(alignments[i], prior_views, current_views, options, appearance);
+        (*pairs)[i] = ComparePair(alignments[i], prior_views, current_views, options, appearance, location);
       }
     });
   }
@@ -409,7 +454,8 @@ RouteCameras RouteCamerasOf(const PatrolRecord& prior, const PatrolRecord& curre
 
 RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
-                              const AppearanceOptions& appearance, const RouteCameras& cameras) {
+                              const AppearanceOptions& appearance, const RouteCameras& cameras,
+                              const ChangeLocationOptions& location) {
   RouteComparison comparison;
   const std::vector<bool> prior_repeats = Repeats(prior), current_repeats = Repeats(current);
   comparison.current_frames = static_cast<int>(std::count(current_repeats.begin(), current_repeats.end(), false));
@@ -452,17 +498,21 @@ RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::v
                              &prior_views);
     RouteDepths current_depths(current, current_repeats, cameras.current, cameras.current_distortion, options.depth,
                                &current_views);
-    CompareBlocks(alignments, prior_views, current_views, options, appearance, &prior_depths, &current_depths,
+    CompareBlocks(alignments, prior_views, current_views, options, appearance, location, &prior_depths, &current_depths,
                   &comparison.pairs);
     comparison.prior_depth_frames = prior_depths.frames_given();
     comparison.current_depth_frames = current_depths.frames_given();
   } else {
-    CompareBlocks(alignments, prior_views, current_views, options, appearance, nullptr, nullptr, &comparison.pairs);
+    CompareBlocks(alignments, prior_views, current_views, options, appearance, location, nullptr, nullptr,
+                  &comparison.pairs);
   }
   std::vector<int> next(current.size(), -1);  // per frame: the next frame that is no repeat
   for (int c = static_cast<int>(current.size()) - 2; c >= 0; --c)
     next[c] = current_repeats[c + 1] ? next[c + 1] : c + 1;
   comparison.changes = Vote(comparison, current_views, next, options, appearance);
+  for (RouteChange& change : comparison.changes) {
+    change.location = LocateRouteChange(comparison, change, current, current_views, cameras, location);
+  }
   return comparison;
 }
 

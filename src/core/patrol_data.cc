@@ -1,6 +1,7 @@
 #include "patrolmap/core/patrol_data.h"
 
 #include <algorithm>
+#include <cstdlib>
 
 namespace patrolmap {
 
@@ -15,6 +16,17 @@ cv::Rect2d ProjectCorners(const CameraIntrinsics& camera, const CameraPoseSample
     x0 = std::min(x0, u), y0 = std::min(y0, v), x1 = std::max(x1, u), y1 = std::max(y1, v);
   }
   return cv::Rect2d(x0, y0, x1 - x0, y1 - y0);
+}
+
+std::optional<CameraPoseSample> ViewAt(const PatrolRecord& record, TimestampNs timestamp_ns, TimestampNs tolerance_ns) {
+  const auto nearest = std::min_element(
+      record.views.begin(), record.views.end(), [timestamp_ns](const CameraPoseSample& a, const CameraPoseSample& b) {
+        return std::llabs(a.timestamp_ns - timestamp_ns) < std::llabs(b.timestamp_ns - timestamp_ns);
+      });
+  if (nearest == record.views.end() || std::llabs(nearest->timestamp_ns - timestamp_ns) > tolerance_ns) {
+    return std::nullopt;
+  }
+  return *nearest;
 }
 
 }  // namespace patrolmap

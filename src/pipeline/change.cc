@@ -1,17 +1,54 @@
 #include "patrolmap/pipeline/change.h"
 
 #include <algorithm>
-#include <chrono>
 
 #include <spdlog/spdlog.h>
 
-#include "patrolmap/change/geometry_objects.h"
+#include "patrolmap/change/change_detector.h"
 
 namespace patrolmap::pipeline {
 namespace {
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+// A node's camera pose is the patrol's view nearest its time, within this [s].
+constexpr double kNodePoseToleranceS = 1.0;
+
+// The loop closures between nodes of `prior` and of `current`, each with its two key frames.
+std::vector<change::PlacePair> PlacesOf(const graph::TopoMap& map, const PatrolRecord& prior,
+                                        const PatrolRecord& current) {
+  const auto view = [&map](int node, const PatrolRecord& record) {
+    const graph::NodeData& n = map.node(node);
+    return change::KeyFrameOf(n.thumbnail, n.points, n.descriptors, record.feature_image_width);
+  };
+  std::vector<change::PlacePair> places;
+  for (const graph::TopoMap::Edge& edge : map.Edges()) {
+    if (edge.data.kind != graph::EdgeKind::kLoopClosure) continue;
+    int a = edge.a, b = edge.b;
+    if (map.node(a).flight == current.flight) std::swap(a, b);
+    if (map.node(a).flight != prior.flight || map.node(b).flight != current.flight) continue;
+    places.push_back({a, b, map.node(a).timestamp_ns, map.node(b).timestamp_ns, view(a, prior), view(b, current),
+                      ViewAt(current, map.node(b).timestamp_ns, SecondsToNs(kNodePoseToleranceS))});
+  }
+  return places;
+}
+
+// `flight`'s patrol record, or `places_only` named after it when the map has none.
+const PatrolRecord& RecordOf(const graph::TopoMap& map, const std::string& flight, PatrolRecord* places_only) {
+  const PatrolRecord* record = map.Patrol(flight);
+  if (record != nullptr) return *record;
+  places_only->flight = flight;
+  return *places_only;
+}
+
+// What the comparison is about to do, for the log: its two long phases.
+void LogPhases(const PatrolRecord& prior, const PatrolRecord& current, const change::ChangeOptions& options) {
+  if (options.route.enabled && !prior.route.empty() && !current.route.empty()) {
+    spdlog::info("{}: comparing its {} route frames with the {} of {} (appearance along the route)", current.flight,
+                 current.route.size(), prior.route.size(), prior.flight);
+  }
+  if (!prior.grid.voxels.empty() && !current.grid.voxels.empty()) {
+    spdlog::info("{}: comparing its evidence grid ({} voxels) with {}'s ({}; geometry and objects)", current.flight,
+                 current.grid.voxels.size(), prior.flight, prior.grid.voxels.size());
+  }
 }
 
 }  // namespace
@@ -24,90 +61,21 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
       return Status::InvalidArgument("flight '" + flight + "' is not in the map");
     }
   }
-  *report = change::ChangeReport();
-  report->prior_flight = prior;
-  report->current_flight = current;
-  const PatrolRecord* prior_record = map.Patrol(prior);
-  const PatrolRecord* current_record = map.Patrol(current);
-
-  auto start = std::chrono::steady_clock::now();
-  const bool along_route = options.route.enabled && prior_record != nullptr && current_record != nullptr &&
-                           !prior_record->route.empty() && !current_record->route.empty();
-  std::vector<change::RouteAnchor> anchors;
-  for (const graph::TopoMap::Edge& edge : map.Edges()) {
-    if (edge.data.kind != graph::EdgeKind::kLoopClosure) continue;
-    int a = edge.a, b = edge.b;
-    if (map.node(a).flight == current) std::swap(a, b);
-    if (map.node(a).flight != prior || map.node(b).flight != current) continue;
-    const auto view = [&map](int node, const PatrolRecord* record) {
-      const graph::NodeData& n = map.node(node);
-      change::KeyFrameView v;
-      v.image = n.thumbnail;
-      v.points = n.points;
-      v.descriptors = n.descriptors;
-      if (record != nullptr && record->feature_image_width > 0 && !n.thumbnail.empty()) {
-        v.feature_scale = static_cast<double>(record->feature_image_width) / n.thumbnail.cols;
-      }
-      return v;
-    };
-    change::PlaceChange place;
-    place.prior_node = a, place.current_node = b;
-    anchors.push_back({map.node(a).timestamp_ns, map.node(b).timestamp_ns});
-    if (!along_route) {
-      place.appearance =
-          change::DetectAppearanceChange(view(a, prior_record), view(b, current_record), options.appearance);
-    }
-    report->places.push_back(std::move(place));
-  }
-  if (along_route) {
-    spdlog::info("{}: comparing its {} route frames with the {} of {} (appearance along the route)", current,
-                 current_record->route.size(), prior_record->route.size(), prior);
-    report->route = change::CompareRoutes(prior_record->route, current_record->route, anchors, options.route,
-                                          options.appearance, change::RouteCamerasOf(*prior_record, *current_record));
-  }
-  report->seconds_appearance = SecondsSince(start);
-  if (prior_record == nullptr || current_record == nullptr) return Status::Ok();
-  report->pose_prior = prior_record->pose_source;
-  report->pose_current = current_record->pose_source;
-
-  start = std::chrono::steady_clock::now();
-  if (!prior_record->grid.voxels.empty() && !current_record->grid.voxels.empty()) {
-    spdlog::info("{}: comparing its evidence grid ({} voxels) with {}'s ({}; geometry and objects)", current,
-                 current_record->grid.voxels.size(), prior, prior_record->grid.voxels.size());
-  }
-  report->geometry_compared = change::DiffGrids(
-      prior_record->grid, current_record->grid,
-      change::ForPoseSources(options.geometry, prior_record->pose_source, current_record->pose_source),
-      &report->geometry);
-  report->geometry.depth_prior = prior_record->depth_source;
-  report->geometry.depth_current = current_record->depth_source;
+  // A flight without a patrol record (a map of key frames only) is compared at its places.
+  PatrolRecord prior_places, current_places;
+  const PatrolRecord& prior_record = RecordOf(map, prior, &prior_places);
+  const PatrolRecord& current_record = RecordOf(map, current, &current_places);
+  LogPhases(prior_record, current_record, options);
+  const change::ChangeDetector detector(prior_record, options);
+  detector.Compare(current_record, PlacesOf(map, prior_record, current_record), report);
   if (report->geometry.poses_disagree) {
-    // Objects are placed by the same poses: their comparison would be as wrong.
     spdlog::warn(
         "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed ({} of {}; more than "
         "change.geometry.max_differing_share, {:.0f} %): the two flights' camera poses disagree (GPS without "
         "RTK, or another world frame), so no geometry or object change is reported",
         prior, current, 100.0 * report->geometry.DifferingShare(), report->geometry.differing_voxels,
         report->geometry.surface_voxels, 100.0 * options.geometry.max_differing_share);
-    report->seconds_geometry = SecondsSince(start);
-    return Status::Ok();
   }
-  if (report->geometry_compared && options.geometry_objects.enabled) {
-    // Objects no detector named: clusters of changed space (paper 003); detected objects take precedence.
-    report->objects = change::GeometryObjects(
-        report->geometry, change::LookupIn(prior_record->grid), change::LookupIn(current_record->grid),
-        prior_record->objects, current_record->objects,
-        change::ForPoseSources(options.geometry_objects, prior_record->pose_source, current_record->pose_source));
-    report->objects_compared = true;
-  }
-  report->seconds_geometry = SecondsSince(start);
-  start = std::chrono::steady_clock::now();
-  if (prior_record->has_objects && current_record->has_objects) {
-    std::vector<change::ObjectChange> detected = change::DiffObjects(*prior_record, *current_record, options.objects);
-    report->objects.insert(report->objects.begin(), detected.begin(), detected.end());
-    report->objects_compared = true;
-  }
-  report->seconds_objects = SecondsSince(start);
   return Status::Ok();
 }
 

@@ -11,10 +11,6 @@
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
-#include "patrolmap/change/appearance.h"
-#include "patrolmap/change/geometry_objects.h"
-#include "patrolmap/change/grid_alignment.h"
-#include "patrolmap/change/object_diff.h"
 #include "patrolmap/core/option_check.h"
 
 namespace patrolmap::pipeline {
@@ -40,17 +36,6 @@ bool Reported(change::ObjectState state) {
          state == change::ObjectState::kMoved;
 }
 
-// The key frame of a node as the appearance comparison needs it (as pipeline::CompareFlights builds it).
-change::KeyFrameView ViewOf(const cv::Mat& thumbnail, std::vector<cv::Point2f> points, cv::Mat descriptors,
-                            int feature_width) {
-  change::KeyFrameView view;
-  view.image = thumbnail;
-  view.points = std::move(points);
-  view.descriptors = std::move(descriptors);
-  if (feature_width > 0 && !thumbnail.empty()) view.feature_scale = static_cast<double>(feature_width) / thumbnail.cols;
-  return view;
-}
-
 Event ObjectEvent(const change::ObjectChange& change, TimestampNs timestamp_ns) {
   Event event;
   event.id = change::ObjectChangeId(change);
@@ -73,19 +58,28 @@ Event GeometryEvent(const change::GeometryRegion& region, TimestampNs timestamp_
   return event;
 }
 
-Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns,
-                      const std::optional<Eigen::Vector3d>& position, const change::AppearanceChange& appearance) {
+// An appearance change's place: its point, and the bearing from the camera it lies on.
+void Locate(const change::ChangeLocation& location, Event* event) {
+  if (location.HasPoint()) event->position = location.point;
+  event->details["located"] = change::ToString(location.by);
+  if (location.by == change::LocatedBy::kNone) return;
+  event->details["bearing"] = {{"origin", Position(location.bearing.origin)},
+                               {"direction", Position(location.bearing.direction)}};
+}
+
+Event AppearanceEvent(int prior_node, int node, TimestampNs timestamp_ns, const change::ChangeLocation& location,
+                      const change::AppearanceChange& appearance) {
   Event event;
   event.id = change::AppearanceChangeId(prior_node, node);
   event.type = "appearance";
   event.timestamp_ns = timestamp_ns;
-  event.position = position;
   event.confidence = std::min(1.0, appearance.regions.front().score);
   event.details = {{"node", node}, {"prior_node", prior_node}, {"regions", appearance.regions.size()}};
+  Locate(location, &event);
   return event;
 }
 
-// A change found along the route, at the time and camera position of its best view's current frame.
+// A change found along the route, at the time of its best view's current frame, where it stands.
 Event RouteEvent(const change::RouteChange& change, const change::ChangeReport& report, const graph::TopoMap& map) {
   const change::RoutePair& pair = report.route.pairs[change.views[change.best].pair];
   const RouteFrame& prior = map.Patrol(report.prior_flight)->route[pair.prior];
@@ -94,9 +88,9 @@ Event RouteEvent(const change::RouteChange& change, const change::ChangeReport& 
   event.id = change::RouteChangeId(prior, current);
   event.type = "appearance";
   event.timestamp_ns = current.timestamp_ns;
-  if (current.pose) event.position = current.pose->position;
   event.confidence = change.confidence;
   event.details = {{"prior_frame", prior.frame_index}, {"frame", current.frame_index}, {"views", change.views.size()}};
+  Locate(change.location, &event);
   if (current.gps) event.details["gps"] = json::array({current.gps->x(), current.gps->y()});
   return event;
 }
@@ -131,8 +125,10 @@ ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& pri
       config_(config),
       options_(options),
       fd_(fd) {
-  check_geometry_ = config.change.geometry;
-  check_geometry_.min_observations = options.min_observations;
+  if (prior_record_ == nullptr) return;
+  change::ChangeOptions live = config.change;
+  live.geometry.min_observations = options.min_observations;
+  detector_.emplace(*prior_record_, live);
 }
 
 ChangeMonitor::~ChangeMonitor() { ::close(fd_); }
@@ -163,20 +159,22 @@ void ChangeMonitor::Send(const Event& event, bool final_event) {
 }
 
 void ChangeMonitor::OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose,
-                           const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer) {
-  if (pose) node_positions_[node.node] = pose->position;
+                           const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer,
+                           const io::LogInfo& info) {
   if (closure == nullptr || closure->matched_node >= prior_->node_count()) return;
   const graph::NodeData& before = prior_->node(closure->matched_node);
   if (before.flight != prior_flight_) return;
+  if (!detector_) return;
   place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
-  const change::AppearanceChange appearance = change::DetectAppearanceChange(
-      ViewOf(before.thumbnail, before.points, before.descriptors,
-             prior_record_ != nullptr ? prior_record_->feature_image_width : 0),
-      ViewOf(node.thumbnail, std::move(features.points), std::move(features.descriptors), node.feature_width),
-      config_.change.appearance);
+  const change::AppearanceChange appearance = detector_->ComparePlace(
+      change::KeyFrameOf(before.thumbnail, before.points, before.descriptors, prior_record_->feature_image_width),
+      change::KeyFrameOf(node.thumbnail, std::move(features.points), std::move(features.descriptors),
+                         node.feature_width));
   if (appearance.regions.empty()) return;
-  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns,
-                                pose ? std::optional<Eigen::Vector3d>(pose->position) : std::nullopt, appearance);
+  // A bearing only: the grid belongs to the change thread.
+  const change::ChangeLocation location = change::BearingOfLargest(appearance, info.camera.value_or(CameraIntrinsics()),
+                                                                   info.camera_distortion, node.thumbnail.cols, pose);
+  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns, location, appearance);
   if (node.gps) event.details["gps"] = json::array({node.gps->x(), node.gps->y()});
   Send(event, false);
 }
@@ -198,43 +196,24 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   // The grid is compared where it is built: a copy of it each check (1.2 million voxels after an hour, 19 MB,
   // sorted) was the onboard run's memory peak.
   PatrolRecord now = recorder.Snapshot(timestamp_ns - SecondsToNs(options_.settle_s), false);
-  const change::EvidenceGrid* grid = recorder.grid();
-  std::vector<Event> candidates;
-  change::GeometryChange geometry;
-  const change::GeometryDiffOptions diff =
-      change::ForPoseSources(check_geometry_, prior_record_->pose_source, now.pose_source);
-  const bool compared = prior_record_->grid.voxel_size > 0 && grid != nullptr &&
-                        change::DiffGrids(prior_record_->grid, *grid, diff, &geometry, shift_);
-  // More differs than right poses give while no shift is taken, or the poses disagree again: a shift is searched.
-  const bool search =
-      geometry.poses_disagree ||
-      (shift_ == Eigen::Vector3i::Zero() && geometry.DifferingShare() > config_.change.alignment.min_differing_share);
-  change::GridShift found;
-  if (compared && search) {
-    const Eigen::Vector3i before = shift_;
-    found = Realign(now.flight, *grid);
-    if (shift_ != before) change::DiffGrids(prior_record_->grid, *grid, diff, &geometry, shift_);
+  const std::string flight = now.flight;
+  const change::LiveFindings found = detector_->Check(std::move(now), recorder.grid());
+  if (found.shift_changed) {
+    spdlog::info("{}: compared while flying, {}", flight,
+                 change::DescribeShift(found.search, recorder.grid()->voxel_size(), prior_flight_));
   }
-  if (HoldBack(now.flight, geometry, found)) {
+  if (found.held != change::HoldReason::kNone) {
+    WarnHeldBack(flight, found);
     seen_before_.clear();
     return;
   }
-  if (shift_ != Eigen::Vector3i::Zero()) change::MoveRecordPoses(shift_.cast<double>() * grid->voxel_size(), &now);
-  if (prior_record_->has_objects && now.has_objects) {
-    for (const change::ObjectChange& change : change::DiffObjects(*prior_record_, now, config_.change.objects)) {
-      if (Reported(change.state)) candidates.push_back(ObjectEvent(change, timestamp_ns));
-    }
+  std::vector<Event> candidates;
+  for (const change::ObjectChange& change : found.objects) {
+    if (Reported(change.state)) candidates.push_back(ObjectEvent(change, timestamp_ns));
   }
-  if (compared) {
-    for (const change::GeometryRegion& region : geometry.regions) {
+  if (found.geometry_compared) {
+    for (const change::GeometryRegion& region : found.geometry.regions) {
       candidates.push_back(GeometryEvent(region, timestamp_ns));
-    }
-    // Objects no detector named: clusters of the changed space (as the report finds them).
-    for (const change::ObjectChange& change : change::GeometryObjects(
-             geometry, change::LookupIn(prior_record_->grid), change::LookupIn(*grid, shift_), prior_record_->objects,
-             now.objects,
-             change::ForPoseSources(config_.change.geometry_objects, prior_record_->pose_source, now.pose_source))) {
-      candidates.push_back(ObjectEvent(change, timestamp_ns));
     }
   }
   // A change is sent once two checks in a row found it: a region or object state of a grid or map still
@@ -247,35 +226,19 @@ void ChangeMonitor::CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& 
   seen_before_ = std::move(seen);
 }
 
-change::GridShift ChangeMonitor::Realign(const std::string& flight, const change::EvidenceGrid& grid) {
-  if (!shift_search_) shift_search_.emplace(prior_record_->grid, config_.change.alignment);
-  const change::GridShift found = shift_search_->Find(grid);
-  if (found.applied && found.voxels != shift_) {
-    shift_ = found.voxels;
-    spdlog::info("{}: compared while flying, {}", flight,
-                 change::DescribeShift(found, grid.voxel_size(), prior_flight_));
+void ChangeMonitor::WarnHeldBack(const std::string& flight, const change::LiveFindings& found) {
+  if (found.held == change::HoldReason::kPosesDisagree && !warned_poses_) {
+    // The objects are placed by the same poses (change_detector.h): nothing is sent while they disagree.
+    spdlog::warn(
+        "{}: its surfaces differ from {}'s in {:.0f} % of the voxels both observed: the camera poses "
+        "disagree (GPS without RTK, or another world frame), so no geometry or object change is sent "
+        "while they do",
+        flight, prior_flight_, 100.0 * found.geometry.DifferingShare());
+    warned_poses_ = true;
   }
-  return found;
-}
-
-bool ChangeMonitor::HoldBack(const std::string& flight, const change::GeometryChange& geometry,
-                             const change::GridShift& search) {
-  if (geometry.poses_disagree) {
-    // The objects are placed by the same poses (pipeline/change.cc): nothing is sent while they disagree.
-    if (!warned_poses_) {
-      spdlog::warn(
-          "{}: its surfaces differ from {}'s in {:.0f} % of the voxels both observed: the camera poses "
-          "disagree (GPS without RTK, or another world frame), so no geometry or object change is sent "
-          "while they do",
-          flight, prior_flight_, 100.0 * geometry.DifferingShare());
-      warned_poses_ = true;
-    }
-    return true;
-  }
-  if (!search.Undecided()) return false;
-  // What differs may be a shift the grid built so far cannot yet tell (a few facades over much flat ground).
-  if (!warned_undecided_) {
-    const Eigen::Vector3d m = search.best.cast<double>() * prior_record_->grid.voxel_size;
+  if (found.held == change::HoldReason::kUndecidedShift && !warned_undecided_) {
+    // What differs may be a shift the grid built so far cannot yet tell (a few facades over much flat ground).
+    const Eigen::Vector3d m = found.search.best.cast<double>() * prior_record_->grid.voxel_size;
     spdlog::info(
         "{}: moved by ({:.2f}, {:.2f}, {:.2f}) m its surfaces meet {}'s better than where they are, but not yet by "
         "change.alignment.min_gain: no geometry or object change is sent until the shift is taken or no longer fits "
@@ -283,17 +246,13 @@ bool ChangeMonitor::HoldBack(const std::string& flight, const change::GeometryCh
         flight, m.x(), m.y(), m.z(), prior_flight_);
     warned_undecided_ = true;
   }
-  return true;
 }
 
 Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map) {
   for (const change::PlaceChange& place : report.places) {
     if (place.appearance.regions.empty()) continue;
     const TimestampNs t = map.node(place.current_node).timestamp_ns;
-    const auto at = node_positions_.find(place.current_node);
-    const std::optional<Eigen::Vector3d> position =
-        at == node_positions_.end() ? std::nullopt : std::optional<Eigen::Vector3d>(at->second);
-    Send(AppearanceEvent(place.prior_node, place.current_node, t, position, place.appearance), true);
+    Send(AppearanceEvent(place.prior_node, place.current_node, t, place.location, place.appearance), true);
   }
   for (const change::RouteChange& change : report.route.changes) Send(RouteEvent(change, report, map), true);
   const TimestampNs end_ns = last_ns_;

@@ -144,7 +144,7 @@ Status FlightPass::AddPlace(KeyFrameInput&& input) {
   if (monitor_ == nullptr) return Status::Ok();
   const MapResult& result = places_.result();
   const MapLoopClosure* closure = result.loop_closures.size() > closures ? &result.loop_closures.back() : nullptr;
-  monitor_->OnNode(result.nodes.back(), input.pose, closure, places_.recognizer());
+  monitor_->OnNode(result.nodes.back(), input.pose, closure, places_.recognizer(), info_);
   return Status::Ok();
 }
 

@@ -8,7 +8,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "patrolmap/change/grid_alignment.h"
+#include "patrolmap/change/change_detector.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/flight_id.h"
 #include "patrolmap/graph/map_file.h"
@@ -217,26 +217,26 @@ const PatrolRecord* LatestGrid(const graph::TopoMap& map) {
 
 // Moves a new patrol onto the map's latest one with a grid, when a whole-voxel shift overlaps their surfaces
 // clearly better (change/grid_alignment.h): the poses of two flights can share an offset.
-void AlignToMap(const graph::TopoMap& map, const change::GridAlignmentOptions& options, PatrolRecord* record) {
+void AlignToMap(const graph::TopoMap& map, const change::ChangeOptions& options, PatrolRecord* record) {
   const PatrolRecord* reference = LatestGrid(map);
-  if (reference == nullptr || record->grid.voxels.empty()) return;
-  const change::GridShift shift = change::FindGridShift(reference->grid, record->grid, options);
-  if (!shift.applied) return;
-  change::ShiftRecord(shift.voxels, record);
-  spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference->flight));
+  if (reference == nullptr) return;
+  const change::GridShift shift = change::ChangeDetector(*reference, options).Align(record);
+  if (shift.applied) {
+    spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference->flight));
+  }
 }
 
 // The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight, each aligned to
 // the map's patrol before it. A flight too short for a key location keeps its record: its route frames, grid and
 // objects can still be compared.
 graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecognizer& recognizer,
-                           const graph::TopoMap::VocabularyTag& tag, const change::GridAlignmentOptions& alignment,
+                           const graph::TopoMap::VocabularyTag& tag, const change::ChangeOptions& options,
                            MappingOutcome* outcome) {
   graph::TopoMap map = BuildTopoMap(outcome->places, recognizer, &prior);
   map.set_vocabulary(tag);
   for (FlightRun& run : outcome->flights) {
     PatrolRecord& record = run.result.record;
-    AlignToMap(map, alignment, &record);
+    AlignToMap(map, options, &record);
     map.SetPatrol(std::move(record));
   }
   return map;
@@ -266,8 +266,7 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   for (const std::string& source : request.sources) {
     PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, prior, &recognizer, monitor.get(), outcome));
   }
-  graph::TopoMap map =
-      AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change.alignment, outcome);
+  graph::TopoMap map = AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change, outcome);
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(
         ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared));

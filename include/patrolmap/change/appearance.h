@@ -16,6 +16,7 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
@@ -45,12 +46,13 @@ struct AppearanceRegion {
   cv::Rect current_box;  // in the current key frame
   cv::Rect prior_box;    // the same region in the prior key frame
   int area_px = 0;
-  double score = 0.0;                  // mean structure change in the region (1 - contrast-structure term)
-  double marked_share = 0.0;           // share of its pixels that depth marked as changed (`also_changed`)
-  int prior_features = 0;              // prior features inside the region's box (mapped into the current frame)
-  int unmatched_prior_features = 0;    // ... of which no current feature matches (they support the change)
-  int current_features = 0;            // current features inside the box
-  int unmatched_current_features = 0;  // ... of which no prior feature matches
+  double score = 0.0;                    // mean structure change in the region (1 - contrast-structure term)
+  double marked_share = 0.0;             // share of its pixels that depth marked as changed (`also_changed`)
+  int prior_features = 0;                // prior features inside the region's box (mapped into the current frame)
+  int unmatched_prior_features = 0;      // ... of which no current feature matches (they support the change)
+  int current_features = 0;              // current features inside the box
+  int unmatched_current_features = 0;    // ... of which no prior feature matches
+  std::optional<Eigen::Vector3d> world;  // where the current frame's depth puts its centre (route frames with depth)
 };
 
 // Why a region of changed pixels was not kept, in the order the tests run.

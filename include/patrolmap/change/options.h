@@ -257,6 +257,13 @@ struct GridAlignmentOptions {
   double min_differing_share = 0.05;
 };
 
+// Where a change seen in images stands (change_location.h).
+struct ChangeLocationOptions {
+  double min_depth_share = 0.3;    // a region is placed by its frame's depth when this share of its pixels know it
+  double min_ray_angle_deg = 2.0;  // views triangulate a change when their rays open at least this wide [deg]
+  double max_range_m = 60.0;       // no change is placed farther from the camera than this [m]
+};
+
 struct ChangeOptions {
   AppearanceOptions appearance;
   ObjectMapOptions object_map;
@@ -267,6 +274,7 @@ struct ChangeOptions {
   GridAlignmentOptions alignment;
   RouteFrameOptions route_frames;
   RouteCompareOptions route;
+  ChangeLocationOptions location;
   // False with a message naming the first invalid option.
   bool IsValid(std::string* error) const;
 };

@@ -14,9 +14,11 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 
 #include "patrolmap/change/appearance.h"
+#include "patrolmap/change/change_location.h"
 #include "patrolmap/change/evidence_grid.h"
 #include "patrolmap/change/geo_reference.h"
 #include "patrolmap/change/object_diff.h"
@@ -29,6 +31,7 @@ namespace patrolmap::change {
 struct PlaceChange {
   int prior_node = -1, current_node = -1;  // map nodes (a loop closure between the two flights)
   AppearanceChange appearance;
+  ChangeLocation location;  // of its largest region: on the current evidence grid, else a bearing (change_location.h)
 };
 
 struct ChangeReport {
@@ -65,8 +68,22 @@ struct ChangeView {
   cv::Mat image;                  // BGR, the change outlined in red
 };
 
+// Which finding of a report an item shows: its list ("objects", "geometry", "places", "route") and its index there.
+struct ReportSource {
+  std::string list;
+  int index = -1;
+};
+
+// What one channel found of a change that another channel's entry leads (ChangeItem::evidence).
+struct ChangeEvidence {
+  std::string id, kind, state, label, located;
+  double confidence = 0.0;
+  std::optional<Eigen::Vector3d> position;
+  ReportSource source;
+};
+
 // One change for the inspector: an object that is new, removed or moved, a changed geometry region, or a
-// place whose appearance changed.
+// place whose appearance changed; with what the other channels found of the same physical change (FuseItems).
 struct ChangeItem {
   std::string id;
   int number = 0;           // 1, 2, ... in report order: the plan's markers and the table's rows
@@ -74,19 +91,42 @@ struct ChangeItem {
   std::string state;        // objects: new, removed, moved; geometry: appeared, vanished; appearance: changed
   std::string label;        // objects: the class; geometry: "N voxels"; appearance: "N regions"
   double confidence = 0.0;  // in [0, 1]
-  std::optional<Eigen::Vector3d> position;  // world frame [m]; the camera's for appearance; none without poses
+  std::optional<Eigen::Vector3d> position;  // world frame [m]; none without poses, or for a bearing
   std::optional<Eigen::Vector3d> from;      // moved objects: the prior position
+  // Appearance: how its position was found ("depth", "grid", "triangulated", or "bearing" with no position: the
+  // ray from the camera it lies on; "none" without poses). Empty for objects and geometry, placed by 3D evidence.
+  std::string located;
+  std::optional<Bearing> bearing;
+  double bearing_range_m = 0.0;  // how far along its bearing it may lie (ReportOptions::max_view_range_m) [m]
+  // Where it is, in the world [m]: an object's boxes where it was and where it is, a region's box, an appearance
+  // change's point; empty for a bearing.
+  std::vector<Eigen::AlignedBox3d> extent;
+  // The channels that saw it ("detections", "geometry objects", "geometry", "appearance"), its own first, and the
+  // findings of the others fused into it.
+  std::vector<std::string> channels;
+  std::vector<ChangeEvidence> evidence;
+  ReportSource source;
   ChangeView before, after;
 };
 
 struct ReportOptions {
-  int crop_size_px = 240;          // the longer side of each before/after picture
+  int crop_size_px = 240;  // the longer side of each before/after picture
+  // Findings of several channels are one change where they lie within this of each other [m] (FuseItems).
+  double fuse_distance_m = 1.0;
   double crop_margin = 0.6;        // a crop extends the change's box by this share of its size on each side
   double max_view_range_m = 30.0;  // kept frames farther from the change do not show it
 };
 
-// The changes of `report`, numbered, each with its before and after pictures from the two patrols' kept
-// frames (appearance: the two key frames).
+// One entry per physical change: each item of another channel joins the first entry (objects, then geometry
+// regions, then appearance, each in report order) that it lies on. A region lies on an entry whose extent, grown by
+// fuse_distance_m, its box meets; an appearance change on one whose grown extent the line of sight from its camera to
+// its point (and fuse_distance_m beyond) crosses, the nearest to that point first: a removed object's place shows
+// the wall behind it. An entry's confidence is that of independent witnesses, 1 - the product of (1 - each one's).
+// A bearing without a point joins nothing. Items that join nothing stay entries of their own.
+std::vector<ChangeItem> FuseItems(std::vector<ChangeItem> items, double fuse_distance_m);
+
+// The changes of `report`, fused (FuseItems) and numbered, each with its before and after pictures from the two
+// patrols' kept frames (appearance: the two key frames).
 std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::TopoMap& map,
                                     const ReportOptions& options = ReportOptions());
 
@@ -100,6 +140,12 @@ std::string ToGeoJson(const ChangeReport& report, const graph::TopoMap& map, con
                       const GeoReference& geo);
 std::string ToKml(const ChangeReport& report, const graph::TopoMap& map, const std::vector<ChangeItem>& items,
                   const GeoReference& geo, const std::string& images);
+
+// The ids `items` (entries and their evidence) give the findings of report list `list`, by index ("" where none).
+std::vector<std::string> IdsOf(const std::vector<ChangeItem>& items, const std::string& list, std::size_t count);
+
+// The far end of a change's bearing (ChangeItem::bearing, bearing_range_m along it).
+Eigen::Vector3d BearingEnd(const ChangeItem& item);
 
 // The file name of a change's picture: "<id>-before.jpg" or "<id>-after.jpg".
 std::string ViewFileName(const ChangeItem& item, bool before);

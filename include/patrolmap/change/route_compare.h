@@ -22,6 +22,7 @@
 #include <opencv2/core/types.hpp>
 
 #include "patrolmap/change/appearance.h"
+#include "patrolmap/change/change_location.h"
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/patrol_data.h"
 
@@ -47,6 +48,10 @@ struct RouteChange {
   double score = 0.0;         // mean structure change over the views
   double marked_share = 0.0;  // mean share of the views' pixels that depth marked (AppearanceRegion::marked_share)
   double confidence = 0.0;    // RouteConfidence(score, marked_share, the pairs the views come from)
+  // Where it stands: its views' depth (the median of their points), else their rays triangulated (poses in one
+  // world frame only), else its best view's bearing (change_location.h). The change detector may place it on the
+  // current patrol's evidence grid instead of triangulating or giving a bearing.
+  ChangeLocation location;
 };
 
 struct RouteComparison {
@@ -94,6 +99,7 @@ KeyFrameView RouteFrameView(const RouteFrame& frame, int max_features);
 
 RouteComparison CompareRoutes(const std::vector<RouteFrame>& prior, const std::vector<RouteFrame>& current,
                               const std::vector<RouteAnchor>& anchors, const RouteCompareOptions& options,
-                              const AppearanceOptions& appearance, const RouteCameras& cameras = RouteCameras());
+                              const AppearanceOptions& appearance, const RouteCameras& cameras = RouteCameras(),
+                              const ChangeLocationOptions& location = ChangeLocationOptions());
 
 }  // namespace patrolmap::change

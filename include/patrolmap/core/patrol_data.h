@@ -127,4 +127,7 @@ struct PatrolRecord {
   std::string source, source_digest;
 };
 
+// The view of `record` nearest in time to `timestamp_ns`, when one lies within `tolerance_ns` of it.
+std::optional<CameraPoseSample> ViewAt(const PatrolRecord& record, TimestampNs timestamp_ns, TimestampNs tolerance_ns);
+
 }  // namespace patrolmap

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "patrolmap/change/grid_alignment.h"
+#include "patrolmap/change/change_detector.h"
 #include "patrolmap/change/report.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/graph/topo_map.h"
@@ -54,7 +54,7 @@ class ChangeMonitor {
 
   // Place stage's thread: a new node of the flight, the camera pose there and its loop closure (may be null).
   void OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose, const MapLoopClosure* closure,
-              const place::PlaceRecognizer& recognizer);
+              const place::PlaceRecognizer& recognizer, const io::LogInfo& info);
   // Change stage's thread: after each step of the patrol record.
   void OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
   // After the flight: the final report's changes that no event announced. `map` holds both flights.
@@ -70,33 +70,28 @@ class ChangeMonitor {
                 const ChangeEventOptions& options, int fd);
   void Send(const Event& event, bool final_event);
   void CheckRecord(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
-  // While the poses disagree: the whole-voxel shift of the live grid onto the prior's (change/grid_alignment.h),
-  // as `patrol` moves a finished flight onto the map. Takes the shift found when it is applied; returns the search.
-  change::GridShift Realign(const std::string& flight, const change::EvidenceGrid& grid);
-  // Whether a check must hold its geometry and object changes back: the poses disagree, or the alignment is
-  // undecided (a shift fits better than none, not yet by min_gain). Says why, once each.
-  bool HoldBack(const std::string& flight, const change::GeometryChange& geometry, const change::GridShift& search);
+  // Why a check holds its geometry and object changes back (the poses disagree, or the alignment is undecided: a
+  // shift fits better than none, not yet by min_gain), said once each.
+  void WarnHeldBack(const std::string& flight, const change::LiveFindings& found);
 
   const graph::TopoMap* prior_;
   std::string prior_flight_;
   const PatrolRecord* prior_record_;
   Config config_;
   ChangeEventOptions options_;
-  std::map<int, Eigen::Vector3d> node_positions_;  // place thread until Close()
-  TimestampNs last_ns_ = 0;                        // change thread until Close()
+  TimestampNs last_ns_ = 0;  // change thread until Close()
   int fd_;
   std::string path_;
   TimestampNs first_ns_ = 0, next_check_ns_ = 0;
   bool started_ = false;
   bool warned_poses_ = false;      // that the poses disagree (change thread)
   bool warned_undecided_ = false;  // that the alignment is undecided (change thread)
-  // The live grid's voxel i is compared at i + shift_, its objects moved with it: events are placed in the map's
-  // frame, as the report after the flight places them (change thread).
-  Eigen::Vector3i shift_ = Eigen::Vector3i::Zero();
-  std::optional<change::ShiftSearch> shift_search_;  // the prior grid's, made at the first search
-  change::GeometryDiffOptions check_geometry_;       // config.change.geometry with options.min_observations
-  std::set<std::string> seen_before_;                // ids the previous check found (change thread)
-  mutable std::mutex mutex_;                         // the file, sent_ and status_ (two stage threads write)
+  // Against the prior record, with change.geometry.min_observations set to options.min_observations; it keeps the
+  // shift taken while flying, so events are placed in the map's frame, as the report after the flight places them
+  // (change thread). None without a prior record.
+  std::optional<change::ChangeDetector> detector_;
+  std::set<std::string> seen_before_;  // ids the previous check found (change thread)
+  mutable std::mutex mutex_;           // the file, sent_ and status_ (two stage threads write)
   std::set<std::string> sent_;
   int events_ = 0;
   Status status_;

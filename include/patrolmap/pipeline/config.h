@@ -201,6 +201,9 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.depth.parallax_min_marked_share", &change.route.depth.parallax_min_marked_share);
   visitor->Field("change.route.depth.parallax_known_share", &change.route.depth.parallax_known_share);
   visitor->Field("change.route.depth.parallax_slack_px", &change.route.depth.parallax_slack_px);
+  visitor->Field("change.location.min_depth_share", &change.location.min_depth_share);
+  visitor->Field("change.location.min_ray_angle_deg", &change.location.min_ray_angle_deg);
+  visitor->Field("change.location.max_range_m", &change.location.max_range_m);
   depth::DepthOptions& depth = config->depth;
   visitor->Field("depth.source", &depth.source);
   visitor->Field("depth.stereo.num_disparities", &depth.stereo.num_disparities);
