@@ -446,5 +446,35 @@ TEST(ChangeScore, AveragePrecisionRewardsConfidencesThatPutTrueChangesFirst) {
   EXPECT_DOUBLE_EQ(AveragePrecision({}), 0.0);
 }
 
+// Crate 2 moved, 3 was removed, 5 is new, 1 stayed. An entry at the moved crate's prior place finds it, one beside
+// the new crate (within 1 m of its box) finds that; one where crate 1 stands is false, a bearing is counted apart,
+// and the removed barrel, which no patrol saw whole, is missed but not observable.
+TEST(ChangeScore, TheChangeListIsScoredPerEntryOverAllAndObservableChanges) {
+  const std::vector<TruthObject> before = {Truth(1, "crate", 0, 0, 10), Truth(2, "crate", 5, 0, 10),
+                                           Truth(3, "barrel", 11, 0, 10)};
+  const std::vector<TruthObject> after = {Truth(1, "crate", 0, 0, 10), Truth(2, "crate", 8, 0, 10),
+                                          Truth(5, "crate", 14, 0, 10)};
+  std::vector<TrueChange> truth = TrueChanges(before, after);
+  ASSERT_EQ(truth.size(), 3u);
+  EXPECT_EQ(truth[0].state, "moved");
+  EXPECT_EQ(truth[1].state, "removed");
+  EXPECT_EQ(truth[2].state, "new");
+  truth[0].observable = truth[2].observable = true;
+  const std::vector<ReportedEntry> entries = {{"object-p2-c2", Eigen::Vector3d(8, 0, 0.5), Eigen::Vector3d(5, 0, 0.5)},
+                                              {"geometry-7_0_0", Eigen::Vector3d(15.3, 0, 0.5), std::nullopt},
+                                              {"appearance-f1-1", Eigen::Vector3d(0, 0.2, 0.5), std::nullopt},
+                                              {"appearance-f2-2", std::nullopt, std::nullopt}};
+  const EntryScore score = ScoreEntries(entries, truth, ChangeScoreOptions());
+  EXPECT_EQ(score.entries, 4);
+  EXPECT_EQ(score.bearings, 1);
+  EXPECT_EQ(score.true_entries, 2);
+  EXPECT_EQ(score.false_ids, std::vector<std::string>{"appearance-f1-1"});
+  EXPECT_EQ(score.missed_ids, std::vector<int>{3});
+  EXPECT_DOUBLE_EQ(score.Precision(), 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(score.Recall(false), 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(score.Recall(true), 1.0);
+  EXPECT_DOUBLE_EQ(score.F1(true), 0.8);
+}
+
 }  // namespace
 }  // namespace patrolmap::eval

@@ -62,7 +62,15 @@ std::optional<double> Lies(const ChangeItem& item, const ChangeItem& entry, doub
 }
 
 ChangeEvidence EvidenceOf(const ChangeItem& item) {
-  return {item.id, item.kind, item.state, item.label, item.located, item.confidence, item.position, item.source};
+  return {item.channels.empty() ? item.kind : item.channels.front(),
+          item.id,
+          item.kind,
+          item.state,
+          item.label,
+          item.located,
+          item.confidence,
+          item.position,
+          item.source};
 }
 
 // `item` joins `entry`: its channel, its finding, its confidence as another witness, its pictures where the entry

@@ -40,7 +40,7 @@ text-align:left;vertical-align:top}th{background:#f5f7fa;position:sticky;top:0}
 #changes tr{cursor:pointer}#changes tr.selected{background:#fff7d6}
 .badge{display:inline-block;min-width:22px;height:22px;border-radius:11px;color:#fff;text-align:center;
 font-weight:bold;line-height:22px}
-.id{font-family:monospace;font-size:11px;color:#7b8794}
+.seen{font-size:12px;color:#52606d}
 figure{margin:0}figure img{display:block;border:1px solid #cbd2d9;max-width:240px;height:auto;background:#eee}
 figcaption{font-size:11px;color:#52606d}.none{color:#9aa5b1;font-size:12px}
 .marker{cursor:pointer}.marker.selected circle{stroke:#111;stroke-width:3}
@@ -112,15 +112,30 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   return out.str();
 }
 
-// What the other channels found of the change, each with its confidence.
+// The channels that saw the change, in one line: each with how many findings it gave and the best one's confidence
+// (the findings themselves are in the row's tooltip and in changes.json).
 std::string SeenBy(const ChangeItem& item) {
   if (item.evidence.empty()) return "";
-  std::string text = "<br>also seen as:";
-  for (const ChangeEvidence& e : item.evidence) {
-    text += "<br>&#8226; " + graph::EscapeXml(e.kind + " " + e.state) + ", " + graph::EscapeXml(e.label) + " (" +
-            Number(e.confidence) + ")";
+  std::string text = "<br><span class='seen'>seen by " + graph::EscapeXml(item.channels.front());
+  for (std::size_t c = 1; c < item.channels.size(); ++c) {
+    int count = 0;
+    double best = 0.0;
+    for (const ChangeEvidence& e : item.evidence) {
+      if (e.channel == item.channels[c]) ++count, best = std::max(best, e.confidence);
+    }
+    text += ", " + graph::EscapeXml(item.channels[c]) + (count > 1 ? " &#215;" + std::to_string(count) : "") + " (" +
+            Number(best) + ")";
   }
-  return text;
+  return text + "</span>";
+}
+
+// The row's tooltip: its id and every finding fused into it.
+std::string RowTitle(const ChangeItem& item) {
+  std::string title = item.id;
+  for (const ChangeEvidence& e : item.evidence) {
+    title += "\n" + e.id + ": " + e.kind + " " + e.state + ", " + e.label + " (" + Number(e.confidence) + ")";
+  }
+  return graph::EscapeXml(title);
 }
 
 void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoReference>& geo, const std::string& images,
@@ -132,11 +147,11 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
   *html << "<table id='changes'><tr><th>#</th><th>change</th><th>confidence</th><th>where</th><th>before</th>"
            "<th>after</th></tr>\n";
   for (const ChangeItem& item : items) {
-    *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id)
-          << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
+    *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id) << "' title='"
+          << RowTitle(item) << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
           << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
-          << "</b>: " << graph::EscapeXml(item.label) << SeenBy(item) << "<br><span class='id'>"
-          << graph::EscapeXml(item.id) << "</span></td><td>" << Number(item.confidence) << "</td><td>"
+          << "</b>: " << graph::EscapeXml(item.label) << SeenBy(item) << "</td><td>" << Number(item.confidence)
+          << "</td><td>"
           << Where(item, geo) << "</td><td>" << Figure(item, true, images) << "</td><td>" << Figure(item, false, images)
           << "</td></tr>\n";
   }

@@ -147,7 +147,8 @@ json ViewJson(const ChangeItem& item, bool before, const std::string& images) {
 json EvidenceJson(const ChangeItem& item) {
   json evidence = json::array();
   for (const ChangeEvidence& e : item.evidence) {
-    evidence.push_back({{"id", e.id},
+    evidence.push_back({{"channel", e.channel},
+                        {"id", e.id},
                         {"kind", e.kind},
                         {"state", e.state},
                         {"label", e.label},

@@ -10,9 +10,11 @@
 namespace patrolmap::change {
 namespace {
 
-constexpr double kWidth = 800.0;  // SVG user units across the plan
-constexpr double kPad = 30.0;     // around the drawing
-constexpr double kMarginM = 4.0;  // world margin around what is drawn [m]
+constexpr double kWidth = 800.0;        // SVG user units across the plan
+constexpr double kPad = 30.0;           // around the drawing
+constexpr double kMarginM = 4.0;        // world margin around what is drawn [m]
+constexpr double kMarkerRadius = 13.0;  // a numbered marker's circle
+constexpr double kMarkerGap = 3.0;      // at least this between two markers' circles
 
 std::string Number(double value, int decimals = 1) {
   char buffer[32];
@@ -93,7 +95,7 @@ void Graticule(const PlanFrame& frame, const GeoReference& geo, const std::vecto
   }
   const double step = NiceStep(std::max(high.x() - low.x(), high.y() - low.y()) / 4.0);
   const int decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step))));
-  *svg << "<g class='graticule' stroke='#d6dde6' stroke-width='1' font-size='10' fill='#7b8794'>\n";
+  *svg << "<g class='graticule' stroke='#d6dde6' stroke-width='1' font-size='17' fill='#52606d'>\n";
   for (int axis = 0; axis < 2; ++axis) {
     for (double v = std::ceil(low[axis] / step) * step; v <= high[axis]; v += step) {
       Eigen::Vector2d a = low, b = high;
@@ -125,28 +127,68 @@ void Places(const ChangeReport& report, const graph::TopoMap& map, const PlanFra
   }
 }
 
+// Where each marker goes (SVG units): at its change's place, or, where that would cover a marker placed before it,
+// at the nearest free spot on rings around the place (a leader line then joins the two).
+class MarkerLayout {
+ public:
+  Eigen::Vector2d Place(const Eigen::Vector2d& at) {
+    constexpr int kDirections = 12, kRings = 6;
+    Eigen::Vector2d spot = at;
+    for (int ring = 0; ring <= kRings && Covers(spot); ++ring) {
+      for (int k = 0; k < kDirections; ++k) {
+        const double angle = 2.0 * M_PI * k / kDirections - M_PI / 2.0;
+        spot = at + (ring + 1) * (2.0 * kMarkerRadius + kMarkerGap) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        if (!Covers(spot)) break;
+      }
+    }
+    placed_.push_back(spot);
+    return spot;
+  }
+
+ private:
+  bool Covers(const Eigen::Vector2d& spot) const {
+    return std::any_of(placed_.begin(), placed_.end(), [&](const Eigen::Vector2d& other) {
+      return (other - spot).norm() < 2.0 * kMarkerRadius + kMarkerGap;
+    });
+  }
+  std::vector<Eigen::Vector2d> placed_;
+};
+
+// A leader from a change's place to its marker, when the marker had to move.
+void Leader(const Eigen::Vector2d& at, const Eigen::Vector2d& marker, const ChangeItem& item, std::ostringstream* svg) {
+  if ((marker - at).norm() < 1e-9) return;
+  *svg << "<line x1='" << Number(at.x()) << "' y1='" << Number(at.y()) << "' x2='" << Number(marker.x()) << "' y2='"
+       << Number(marker.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='1.5'/><circle cx='"
+       << Number(at.x()) << "' cy='" << Number(at.y()) << "' r='3' fill='" << ChangeColour(item) << "'/>\n";
+}
+
 // A change placed by a bearing only: the ray from the camera it lies on, dashed, its number at the far end.
-void BearingMarker(const ChangeItem& item, const PlanFrame& frame, std::ostringstream* svg) {
-  const Eigen::Vector2d o = frame(item.bearing->origin.head<2>()), e = frame(BearingEnd(item).head<2>());
+void BearingMarker(const ChangeItem& item, const PlanFrame& frame, MarkerLayout* layout, std::ostringstream* svg) {
+  const Eigen::Vector2d o = frame(item.bearing->origin.head<2>()), end = frame(BearingEnd(item).head<2>());
+  const Eigen::Vector2d e = layout->Place(end);
   *svg << "<g class='marker bearing' data-id='" << graph::EscapeXml(item.id) << "'><line x1='" << Number(o.x())
-       << "' y1='" << Number(o.y()) << "' x2='" << Number(e.x()) << "' y2='" << Number(e.y()) << "' stroke='"
-       << ChangeColour(item) << "' stroke-width='2' stroke-dasharray='6 4'/><circle cx='" << Number(e.x()) << "' cy='"
-       << Number(e.y()) << "' r='9' fill='white' stroke='" << ChangeColour(item) << "' stroke-width='2'/><text x='"
-       << Number(e.x()) << "' y='" << Number(e.y() + 4) << "' text-anchor='middle' font-size='11' fill='"
-       << ChangeColour(item) << "' font-weight='bold'>" << item.number << "</text><title>" << item.number << ": "
+       << "' y1='" << Number(o.y()) << "' x2='" << Number(end.x()) << "' y2='" << Number(end.y()) << "' stroke='"
+       << ChangeColour(item) << "' stroke-width='2' stroke-dasharray='6 4'/>";
+  Leader(end, e, item, svg);
+  *svg << "<circle cx='" << Number(e.x()) << "' cy='" << Number(e.y()) << "' r='" << kMarkerRadius
+       << "' fill='white' stroke='" << ChangeColour(item) << "' stroke-width='2'/><text x='" << Number(e.x()) << "' y='"
+       << Number(e.y() + 5) << "' text-anchor='middle' font-size='14' fill='" << ChangeColour(item)
+       << "' font-weight='bold'>" << item.number << "</text><title>" << item.number << ": "
        << graph::EscapeXml(item.kind + " " + item.state)
        << ", somewhere along this bearing from the camera (no depth there)</title></g>\n";
 }
 
-void Marker(const ChangeItem& item, const PlanFrame& frame, std::ostringstream* svg) {
-  const Eigen::Vector2d p = frame(item.position->head<2>());
+void Marker(const ChangeItem& item, const PlanFrame& frame, MarkerLayout* layout, std::ostringstream* svg) {
+  const Eigen::Vector2d at = frame(item.position->head<2>());
   if (item.from) {
     const Eigen::Vector2d q = frame(item.from->head<2>());
-    *svg << "<line x1='" << Number(q.x()) << "' y1='" << Number(q.y()) << "' x2='" << Number(p.x()) << "' y2='"
-         << Number(p.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='2' marker-end='url(#arrow)'/>\n";
+    *svg << "<line x1='" << Number(q.x()) << "' y1='" << Number(q.y()) << "' x2='" << Number(at.x()) << "' y2='"
+         << Number(at.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='2' marker-end='url(#arrow)'/>\n";
   }
+  const Eigen::Vector2d p = layout->Place(at);
+  Leader(at, p, item, svg);
   *svg << "<g class='marker' data-id='" << graph::EscapeXml(item.id) << "' transform='translate(" << Number(p.x())
-       << " " << Number(p.y()) << ")'><circle r='13' fill='" << ChangeColour(item)
+       << " " << Number(p.y()) << ")'><circle r='" << kMarkerRadius << "' fill='" << ChangeColour(item)
        << "' stroke='white' stroke-width='2'/><text text-anchor='middle' dy='5' font-size='14' fill='white' "
           "font-weight='bold'>"
        << item.number << "</text><title>" << item.number << ": " << graph::EscapeXml(item.kind + " " + item.state)
@@ -194,9 +236,10 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
         << "' fill='#7c3aed22' stroke='#7c3aed' stroke-dasharray='4 2'/>\n";
   }
   Places(report, map, frame, &svg);
+  MarkerLayout layout;
   for (const ChangeItem& item : items) {
-    if (item.position) Marker(item, frame, &svg);
-    if (!item.position && item.bearing) BearingMarker(item, frame, &svg);
+    if (item.position) Marker(item, frame, &layout, &svg);
+    if (!item.position && item.bearing) BearingMarker(item, frame, &layout, &svg);
   }
   ScaleBar(frame, &svg);
   if (geo) NorthArrow(frame, &svg);

@@ -540,4 +540,56 @@ RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vecto
   return score;
 }
 
+std::vector<TrueChange> TrueChanges(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after) {
+  std::vector<TrueChange> changes;
+  for (const TruthObject& b : before) {
+    const TruthObject* a = FindId(after, b.id);
+    if (a == nullptr) changes.push_back({b.id, "removed", &b, nullptr});
+    if (a != nullptr && (a->centre - b.centre).norm() > kSamePlace) changes.push_back({b.id, "moved", &b, a});
+  }
+  for (const TruthObject& a : after) {
+    if (FindId(before, a.id) == nullptr) changes.push_back({a.id, "new", nullptr, &a});
+  }
+  return changes;
+}
+
+double EntryScore::Precision() const { return Ratio(true_entries, true_entries + static_cast<int>(false_ids.size())); }
+double EntryScore::Recall(bool observable_only) const { return (observable_only ? observable : all).Recall(); }
+double EntryScore::F1(bool observable_only) const {
+  const double p = Precision(), r = Recall(observable_only);
+  return p + r > 0.0 ? 2.0 * p * r / (p + r) : 0.0;
+}
+
+EntryScore ScoreEntries(const std::vector<ReportedEntry>& entries, const std::vector<TrueChange>& truth,
+                        const ChangeScoreOptions& options) {
+  EntryScore score;
+  score.entries = static_cast<int>(entries.size());
+  std::vector<bool> found(truth.size(), false);
+  for (const ReportedEntry& entry : entries) {
+    if (!entry.position) {
+      ++score.bearings;
+      continue;
+    }
+    bool on_truth = false;
+    for (std::size_t t = 0; t < truth.size(); ++t) {
+      for (const std::optional<Eigen::Vector3d>& p : {entry.position, entry.from}) {
+        if (!p) continue;
+        for (const TruthObject* end : {truth[t].before, truth[t].after}) {
+          if (end != nullptr && end->Contains(*p, options.distance_m)) on_truth = found[t] = true;
+        }
+      }
+    }
+    if (on_truth) ++score.true_entries;
+    if (!on_truth) score.false_ids.push_back(entry.id);
+  }
+  const int false_entries = static_cast<int>(score.false_ids.size());
+  score.all.false_positives = score.observable.false_positives = false_entries;
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    (found[t] ? score.all.true_positives : score.all.false_negatives) += 1;
+    if (truth[t].observable) (found[t] ? score.observable.true_positives : score.observable.false_negatives) += 1;
+    if (!found[t]) score.missed_ids.push_back(truth[t].id);
+  }
+  return score;
+}
+
 }  // namespace patrolmap::eval

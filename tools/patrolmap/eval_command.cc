@@ -149,6 +149,67 @@ Status ReadReportedObjects(const std::string& path, const nlohmann::json& object
   return Status::Ok();
 }
 
+// The fused change list's entries (changes.json "changes").
+Status ReadReportedEntries(const std::string& path, const nlohmann::json& changes,
+                           std::vector<eval::ReportedEntry>* entries) {
+  const auto point = [](const nlohmann::json& p) -> std::optional<Eigen::Vector3d> {
+    if (p.is_null()) return std::nullopt;
+    return Eigen::Vector3d(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+  };
+  try {
+    for (const nlohmann::json& c : changes) {
+      entries->push_back({c.at("id").get<std::string>(), point(c.at("position")), point(c.at("from"))});
+    }
+  } catch (const nlohmann::json::exception& e) {
+    return Status::DataLoss(path + ": malformed changes: " + e.what());
+  }
+  return Status::Ok();
+}
+
+// Whether each end of `change` that a flight of `map` could see lay whole in the image in options.min_whole_views
+// of that flight's views at the truth detector's sightings.
+bool Observable(const graph::TopoMap& map, const std::string& prior, const std::string& current,
+                const eval::TrueChange& change, const eval::ChangeScoreOptions& options) {
+  for (const bool was : {true, false}) {
+    const eval::TruthObject* object = was ? change.before : change.after;
+    const PatrolRecord* record = map.Patrol(was ? prior : current);
+    if (object == nullptr) continue;
+    if (record == nullptr || !record->camera.valid()) return false;
+    std::vector<CameraPoseSample> views;
+    for (const TimestampNs time_ns : object->seen_ns) {
+      if (const std::optional<CameraPoseSample> pose = io::PoseAt(record->views, time_ns)) views.push_back(*pose);
+    }
+    if (eval::SightingsOf(*object, views, record->camera, record->distortion).whole < options.min_whole_views) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The fused list per entry, over all true changes and over the observable ones.
+void ScoreEntriesOf(const graph::TopoMap& map, const std::string& prior, const std::string& current,
+                    const std::vector<eval::ReportedEntry>& entries, const std::vector<eval::TruthObject>& before,
+                    const std::vector<eval::TruthObject>& after, const eval::ChangeScoreOptions& options,
+                    nlohmann::json* result) {
+  std::vector<eval::TrueChange> truth = eval::TrueChanges(before, after);
+  for (eval::TrueChange& change : truth) change.observable = Observable(map, prior, current, change, options);
+  const eval::EntryScore score = eval::ScoreEntries(entries, truth, options);
+  (*result)["entries"] = {{"entries", score.entries},
+                          {"bearings", score.bearings},
+                          {"true_entries", score.true_entries},
+                          {"false_ids", score.false_ids},
+                          {"true_changes", score.all.true_positives + score.all.false_negatives},
+                          {"found", score.all.true_positives},
+                          {"observable", score.observable.true_positives + score.observable.false_negatives},
+                          {"observable_found", score.observable.true_positives},
+                          {"missed_ids", score.missed_ids},
+                          {"precision", score.Precision()},
+                          {"recall", score.Recall(false)},
+                          {"recall_observable", score.Recall(true)},
+                          {"f1", score.F1(false)},
+                          {"f1_observable", score.F1(true)}};
+}
+
 // Each required true change (found or missed) and each false report, with the id of the report concerned.
 nlohmann::json OutcomesJson(const std::vector<eval::ObjectOutcome>& outcomes,
                             const std::vector<eval::ReportedObject>& reported) {
@@ -413,6 +474,11 @@ Status EvaluateChanges(const EvalArguments& arguments, const std::vector<TruthLo
     PATROLMAP_RETURN_IF_ERROR(LoadCheckedConfig(arguments.config, arguments.settings, &config));
     PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(arguments.run + "/map.pmap", &map));
     if (!outcomes.empty()) AddSightings(map, prior, current, outcomes, before, after, &result["objects"]["outcomes"]);
+    if (changes.contains("changes") && changes["changes"].is_array()) {
+      std::vector<eval::ReportedEntry> entries;
+      PATROLMAP_RETURN_IF_ERROR(ReadReportedEntries(path, changes["changes"], &entries));
+      ScoreEntriesOf(map, prior, current, entries, before, after, arguments.changes, &result);
+    }
     PATROLMAP_RETURN_IF_ERROR(pipeline::CompareFlights(map, prior, current, config.change, &recomputed));
     eval::ChangeScoreOptions options = arguments.changes;
     options.min_observations = config.change.geometry.min_observations;
@@ -482,6 +548,20 @@ void PrintChangeTable(const nlohmann::json& c) {
         lost += (lost.empty() ? "" : ", ") + step + " " + std::to_string(count.get<int>());
       std::printf("route: the changes not found were lost at: %s\n", lost.c_str());
     }
+  }
+  if (c.contains("entries")) {
+    const nlohmann::json& e = c["entries"];
+    const int placed = e["entries"].get<int>() - e["bearings"].get<int>();
+    std::printf(
+        "change list: %d entries (%d by a bearing only), %d of %d placed on a true change (precision %s); found %d of "
+        "%d true changes (recall %s, F1 %s), %d of %d observable ones (recall %s, F1 %s)\n",
+        e["entries"].get<int>(), e["bearings"].get<int>(), e["true_entries"].get<int>(), placed,
+        Score(e["precision"].get<double>(), placed > 0, 0).c_str(), e["found"].get<int>(), e["true_changes"].get<int>(),
+        Score(e["recall"].get<double>(), e["true_changes"].get<int>() > 0, 0).c_str(),
+        Score(e["f1"].get<double>(), placed > 0, 0).c_str(), e["observable_found"].get<int>(),
+        e["observable"].get<int>(),
+        Score(e["recall_observable"].get<double>(), e["observable"].get<int>() > 0, 0).c_str(),
+        Score(e["f1_observable"].get<double>(), placed > 0, 0).c_str());
   }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"]);

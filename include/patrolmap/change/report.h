@@ -76,6 +76,7 @@ struct ReportSource {
 
 // What one channel found of a change that another channel's entry leads (ChangeItem::evidence).
 struct ChangeEvidence {
+  std::string channel;  // ChangeItem::channels
   std::string id, kind, state, label, located;
   double confidence = 0.0;
   std::optional<Eigen::Vector3d> position;

@@ -127,6 +127,7 @@ struct ChangeScoreOptions {
   double min_area_px = 100.0;  // thumbnail pixels
   double min_overlap = 0.3;
   double near_change_m = 0.5;  // false voxels this close to a changed object's box are counted apart [m]
+  int min_whole_views = 3;     // a true change is observable where each end lay whole in this many views
 };
 
 ObjectChangeScore ScoreObjectChanges(const std::vector<ReportedObject>& reported,
@@ -231,5 +232,41 @@ struct RouteScore {
 double AveragePrecision(std::vector<std::pair<double, bool>> ranked);
 RouteScore ScoreRoute(const std::vector<RoutePairTruth>& truth, const std::vector<ReportedRouteChange>& reported,
                       const std::vector<RouteCandidate>& candidates, const ChangeScoreOptions& options);
+
+// The fused change list (changes.json "changes": one entry per physical change, whatever channels saw it), scored
+// per entry. The true changes are every object gone, come or moved between the two flights, whatever the detector
+// saw; one is observable when each end the patrols could see (where it was, where it is) lay whole in the image in
+// at least `min_whole_views` of its flight's views (Sightings). An entry lies on a true change when its position
+// (or, moved, its prior position) lies within distance_m of the object's box where it was or where it is. A true
+// change is found when an entry lies on it; an entry with a position that lies on none is false. Entries known only
+// by a bearing are counted apart.
+struct TrueChange {
+  int id = -1;                          // groundtruth/objects.csv
+  std::string state;                    // new, removed, moved
+  const TruthObject* before = nullptr;  // where it was (removed, moved), in the prior flight's truth
+  const TruthObject* after = nullptr;   // where it is (new, moved)
+  bool observable = false;
+};
+std::vector<TrueChange> TrueChanges(const std::vector<TruthObject>& before, const std::vector<TruthObject>& after);
+
+struct ReportedEntry {
+  std::string id;
+  std::optional<Eigen::Vector3d> position, from;
+};
+
+struct EntryScore {
+  int entries = 0, bearings = 0;  // all entries; those without a position
+  int true_entries = 0;           // entries with a position on a true change (the rest are false_ids)
+  // True changes found (true positives) and missed, over all and over the observable ones; false positives: the
+  // false entries. Precision() is of true changes, so Precision() below is per entry.
+  Counts all, observable;
+  double Precision() const;  // true entries / entries with a position
+  double Recall(bool observable_only) const;
+  double F1(bool observable_only) const;
+  std::vector<std::string> false_ids;
+  std::vector<int> missed_ids;  // true changes no entry lies on (groundtruth ids)
+};
+EntryScore ScoreEntries(const std::vector<ReportedEntry>& entries, const std::vector<TrueChange>& truth,
+                        const ChangeScoreOptions& options);
 
 }  // namespace patrolmap::eval
