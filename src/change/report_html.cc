@@ -148,12 +148,11 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
            "<th>after</th></tr>\n";
   for (const ChangeItem& item : items) {
     *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id) << "' title='"
-          << RowTitle(item) << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>" << item.number
-          << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
+          << RowTitle(item) << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>"
+          << item.number << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
           << "</b>: " << graph::EscapeXml(item.label) << SeenBy(item) << "</td><td>" << Number(item.confidence)
-          << "</td><td>"
-          << Where(item, geo) << "</td><td>" << Figure(item, true, images) << "</td><td>" << Figure(item, false, images)
-          << "</td></tr>\n";
+          << "</td><td>" << Where(item, geo) << "</td><td>" << Figure(item, true, images) << "</td><td>"
+          << Figure(item, false, images) << "</td></tr>\n";
   }
   *html << "</table>\n";
 }
