@@ -86,6 +86,9 @@ ids = [e["id"] for e in events]
 report = json.load(open(sys.argv[2]))
 wanted = {o["id"] for o in report["objects"] if o["state"] in ("new", "removed", "moved")}
 ok = len(ids) == len(set(ids)) and wanted <= set(ids) and all("time_ns" in e and "confidence" in e for e in events)
+# The report's change list under the same ids: every entry is an event, and each final event names its entry.
+entries = {c["id"] for c in report["changes"]}
+ok = ok and entries <= set(ids) and all(e.get("entry") in entries for e in events if e.get("final"))
 sys.exit(0 if ok else 1)
 PY
 done

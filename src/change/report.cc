@@ -395,7 +395,8 @@ std::string ViewFileName(const ChangeItem& item, bool before) {
   return item.id + (before ? "-before.jpg" : "-after.jpg");
 }
 
-Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, const std::string& folder) {
+Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, const std::string& folder,
+                         std::vector<ChangeItem>* written) {
   constexpr char kImages[] = "changes_images";
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder));
   const std::vector<ChangeItem> items = ReportItems(report, map);
@@ -411,9 +412,12 @@ Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, 
   const std::optional<GeoReference> geo = current != nullptr ? FitGeoReference(*current) : std::nullopt;
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.json", ToJson(report, map, items, geo, kImages)));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.html", ToHtml(report, map, items, geo, kImages)));
-  if (!geo) return Status::Ok();
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.geojson", ToGeoJson(report, map, items, *geo)));
-  return WriteFileAtomically(folder + "/changes.kml", ToKml(report, map, items, *geo, kImages));
+  if (geo) {
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.geojson", ToGeoJson(report, map, items, *geo)));
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/changes.kml", ToKml(report, map, items, *geo, kImages)));
+  }
+  if (written != nullptr) *written = items;
+  return Status::Ok();
 }
 
 }  // namespace patrolmap::change

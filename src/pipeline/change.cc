@@ -80,12 +80,13 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
 }
 
 Status ReportLastFlight(const graph::TopoMap& prior, const graph::TopoMap& map, const change::ChangeOptions& options,
-                        const std::string& folder, change::ChangeReport* report, bool* compared) {
+                        const std::string& folder, change::ChangeReport* report, bool* compared,
+                        std::vector<change::ChangeItem>* entries) {
   const std::vector<std::string> before = prior.Flights(), after = map.Flights();
   if (compared != nullptr) *compared = false;
   if (before.empty() || after.size() <= before.size()) return Status::Ok();
   PATROLMAP_RETURN_IF_ERROR(CompareFlights(map, before.back(), after.back(), options, report));
-  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(*report, map, folder));
+  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(*report, map, folder, entries));
   if (compared != nullptr) *compared = true;
   return Status::Ok();
 }

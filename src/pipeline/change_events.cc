@@ -248,18 +248,38 @@ void ChangeMonitor::WarnHeldBack(const std::string& flight, const change::LiveFi
   }
 }
 
-Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map) {
+Status ChangeMonitor::Close(const change::ChangeReport& report, const graph::TopoMap& map,
+                            const std::vector<change::ChangeItem>& entries) {
+  std::map<std::string, std::string> entry_of;  // a finding's id: the entry that holds it
+  for (const change::ChangeItem& entry : entries) {
+    entry_of[entry.id] = entry.id;
+    for (const change::ChangeEvidence& e : entry.evidence) entry_of[e.id] = entry.id;
+  }
+  // The ids the report gives (a later region in the same 2 m cell, or a route change with the same best frames,
+  // has "-2" appended there).
+  const std::vector<std::string> route_ids = change::IdsOf(entries, "route", report.route.changes.size());
+  const std::vector<std::string> region_ids = change::IdsOf(entries, "geometry", report.geometry.regions.size());
+  const auto send = [&](Event event, const std::string& report_id = std::string()) {
+    if (!report_id.empty()) event.id = report_id;
+    const auto entry = entry_of.find(event.id);
+    if (entry != entry_of.end()) event.details["entry"] = entry->second;
+    Send(event, true);
+  };
   for (const change::PlaceChange& place : report.places) {
     if (place.appearance.regions.empty()) continue;
     const TimestampNs t = map.node(place.current_node).timestamp_ns;
-    Send(AppearanceEvent(place.prior_node, place.current_node, t, place.location, place.appearance), true);
+    send(AppearanceEvent(place.prior_node, place.current_node, t, place.location, place.appearance));
   }
-  for (const change::RouteChange& change : report.route.changes) Send(RouteEvent(change, report, map), true);
+  for (std::size_t i = 0; i < report.route.changes.size(); ++i) {
+    send(RouteEvent(report.route.changes[i], report, map), route_ids[i]);
+  }
   const TimestampNs end_ns = last_ns_;
   for (const change::ObjectChange& change : report.objects) {
-    if (Reported(change.state)) Send(ObjectEvent(change, end_ns), true);
+    if (Reported(change.state)) send(ObjectEvent(change, end_ns));
   }
-  for (const change::GeometryRegion& region : report.geometry.regions) Send(GeometryEvent(region, end_ns), true);
+  for (std::size_t i = 0; i < report.geometry.regions.size(); ++i) {
+    send(GeometryEvent(report.geometry.regions[i], end_ns), region_ids[i]);
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   if (status_.ok() && ::fsync(fd_) != 0) status_ = Status::IoError(path_ + ": " + std::strerror(errno));
   return status_;

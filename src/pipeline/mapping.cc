@@ -267,11 +267,14 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
     PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, prior, &recognizer, monitor.get(), outcome));
   }
   graph::TopoMap map = AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change, outcome);
+  std::vector<change::ChangeItem> entries;
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(
-        ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared));
+        ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared, &entries));
   }
-  if (monitor != nullptr && outcome->compared) PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map));
+  if (monitor != nullptr && outcome->compared) {
+    PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map, entries));
+  }
   if (monitor != nullptr) outcome->events = monitor->events();
   return SaveMapRun(&map, request.out);
 }

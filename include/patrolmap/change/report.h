@@ -152,7 +152,8 @@ Eigen::Vector3d BearingEnd(const ChangeItem& item);
 std::string ViewFileName(const ChangeItem& item, bool before);
 
 // Writes DIR/changes.json, DIR/changes.html and the pictures in DIR/changes_images/, and with GPS
-// DIR/changes.geojson and DIR/changes.kml, each file atomically.
-Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, const std::string& folder);
+// DIR/changes.geojson and DIR/changes.kml, each file atomically. `items` (may be null) receives the entries written.
+Status WriteChangeReport(const ChangeReport& report, const graph::TopoMap& map, const std::string& folder,
+                         std::vector<ChangeItem>* items = nullptr);
 
 }  // namespace patrolmap::change

@@ -57,8 +57,10 @@ class ChangeMonitor {
               const place::PlaceRecognizer& recognizer, const io::LogInfo& info);
   // Change stage's thread: after each step of the patrol record.
   void OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
-  // After the flight: the final report's changes that no event announced. `map` holds both flights.
-  Status Close(const change::ChangeReport& report, const graph::TopoMap& map);
+  // After the flight: the final report's changes that no event announced, each with the `entry` of the report's
+  // change list (`entries`) that holds it. `map` holds both flights.
+  Status Close(const change::ChangeReport& report, const graph::TopoMap& map,
+               const std::vector<change::ChangeItem>& entries);
 
   int events() const;
   const Status& status() const { return status_; }  // the first failed write, if any
