@@ -189,7 +189,7 @@ import json
 r = json.load(open('$work/changed-2/changes.json'))
 r['objects'][0]['id'] = 17
 json.dump(r, open('$work/bad-id/changes.json', 'w'))"
-expect_fail "eval: malformed object id" "bad-id/changes.json: malformed objects" -- \
+expect_fail "eval: malformed object id" "bad-id/changes.json: malformed change report: objects\\[0\\]" -- \
   "$bin" eval "$work/bad-id" --log "$work/changed/flight_2" --log "$work/changed/flight_1" --json
 
 series lighting --remove-fraction 0 --move-fraction 0 --added 0

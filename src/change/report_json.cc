@@ -1,6 +1,8 @@
 // changes.json: format "patrolmap.changes", version 2 (docs/changes.schema.json).
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -230,6 +232,80 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
       {"objects", report.objects_compared ? objects : json(nullptr)},
       {"geometry", report.geometry_compared ? GeometryJson(report.geometry, items) : json(nullptr)}};
   return document.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+namespace {
+
+// A point of changes.json: null, or three finite numbers.
+std::optional<Eigen::Vector3d> PointOf(const json& p, const char* key) {
+  if (p.is_null()) return std::nullopt;
+  if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number())
+    throw std::invalid_argument(std::string("'") + key + "' is not null or three numbers");
+  return Eigen::Vector3d(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+}
+
+// Reads item i of list `name` with `read`, naming the item in what it throws.
+template <typename Read>
+void ReadEach(const json& list, const char* name, Read read) {
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    try {
+      read(list[i]);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(std::string(name) + "[" + std::to_string(i) + "]: " + e.what());
+    }
+  }
+}
+
+void ReadObjects(const json& objects, ChangesFile* file) {
+  ReadEach(objects, "objects", [&](const json& o) {
+    ChangesFile::Object object;
+    object.id = o.value("id", "");
+    object.state = o.at("state").get<std::string>();
+    object.label = o.at("label").get<std::string>();
+    object.from_geometry = o.value("source", "detections") == "geometry";
+    object.before = PointOf(o.at("before"), "before");
+    object.after = PointOf(o.at("after"), "after");
+    file->objects.push_back(object);
+  });
+}
+
+void ReadEntries(const json& changes, ChangesFile* file) {
+  ReadEach(changes, "changes", [&](const json& c) {
+    file->entries.push_back(
+        {c.at("id").get<std::string>(), PointOf(c.at("position"), "position"), PointOf(c.at("from"), "from")});
+  });
+}
+
+}  // namespace
+
+Status ReadChangesJson(const std::string& path, ChangesFile* file) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound(path + ": cannot be read");
+  json document;
+  try {
+    document = json::parse(in);
+  } catch (const json::exception& e) {
+    return Status::DataLoss(path + ": not JSON: " + e.what());
+  }
+  if (!document.is_object() || document.value("format", "") != "patrolmap.changes")
+    return Status::DataLoss(path + ": not a patrolmap change report (\"format\": \"patrolmap.changes\")");
+  *file = ChangesFile();
+  try {
+    file->prior_flight = document.at("prior_flight").get<std::string>();
+    file->current_flight = document.at("current_flight").get<std::string>();
+    const json& summary = document.at("summary");
+    file->places_compared = summary.value("places_compared", 0);
+    file->places_changed = summary.value("places_changed", 0);
+    const json& objects = document.value("objects", json());
+    file->objects_compared = objects.is_array();
+    if (file->objects_compared) ReadObjects(objects, file);
+    const json& changes = document.value("changes", json::array());
+    if (!changes.is_array()) throw std::invalid_argument("'changes' is not an array");
+    ReadEntries(changes, file);
+  } catch (const std::exception& e) {
+    return Status::DataLoss(path + ": malformed change report: " + e.what());
+  }
+  return Status::Ok();
 }
 
 }  // namespace patrolmap::change

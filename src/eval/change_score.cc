@@ -592,4 +592,20 @@ EntryScore ScoreEntries(const std::vector<ReportedEntry>& entries, const std::ve
   return score;
 }
 
+ObjectChangeTotals TotalObjectChanges(const ObjectChangeScore& score, const std::vector<TrueChange>& truth) {
+  ObjectChangeTotals totals;
+  for (const ObjectOutcome& o : score.outcomes) {
+    if (o.outcome == "false" && o.state != "persistent") ++totals.all.false_positives;
+  }
+  totals.observable.false_positives = totals.all.false_positives;
+  for (const TrueChange& change : truth) {
+    const bool found = std::any_of(score.outcomes.begin(), score.outcomes.end(), [&](const ObjectOutcome& o) {
+      return o.outcome == "found" && o.id == change.id && o.state == change.state;
+    });
+    (found ? totals.all.true_positives : totals.all.false_negatives) += 1;
+    if (change.observable) (found ? totals.observable.true_positives : totals.observable.false_negatives) += 1;
+  }
+  return totals;
+}
+
 }  // namespace patrolmap::eval

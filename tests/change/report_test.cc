@@ -204,5 +204,56 @@ TEST(WriteChangeReport, WritesThePicturesBesideThePage) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out/changes.geojson"));  // no GPS
 }
 
+// changes.json's reader gives back what its writer wrote; a file that is not one is refused naming it and what is
+// wrong.
+TEST(ReadChangesJson, ReadsBackTheFlightsObjectsAndEntriesWritten) {
+  testing::TempDir dir;
+  const Scene scene = NewCrate();
+  std::vector<ChangeItem> items;
+  ASSERT_TRUE(WriteChangeReport(scene.report, scene.map, dir / "out", &items).ok());
+  ChangesFile file;
+  ASSERT_TRUE(ReadChangesJson(dir / "out/changes.json", &file).ok());
+  EXPECT_EQ(file.prior_flight, "a");
+  EXPECT_EQ(file.current_flight, "b");
+  ASSERT_TRUE(file.objects_compared);
+  ASSERT_EQ(file.objects.size(), 1u);
+  EXPECT_EQ(file.objects[0].state, "new");
+  EXPECT_EQ(file.objects[0].label, "crate");
+  EXPECT_FALSE(file.objects[0].before);
+  EXPECT_TRUE(file.objects[0].after->isApprox(Eigen::Vector3d(10.0, 0.0, 0.0)));
+  ASSERT_EQ(file.entries.size(), items.size());
+  EXPECT_EQ(file.entries[0].id, items[0].id);
+  EXPECT_TRUE(file.entries[0].position->isApprox(*items[0].position));
+}
+
+TEST(ReadChangesJson, RefusesAFileThatIsNotAChangeReportNamingIt) {
+  testing::TempDir dir;
+  const Scene scene = NewCrate();
+  ASSERT_TRUE(WriteChangeReport(scene.report, scene.map, dir / "out").ok());
+  const std::string path = dir / "out/changes.json";
+  nlohmann::json written = nlohmann::json::parse(testing::ReadText(path));
+  const auto refused = [&](const std::string& text, const std::string& why) {
+    testing::WriteText(path, text);
+    ChangesFile file;
+    const Status status = ReadChangesJson(path, &file);
+    EXPECT_FALSE(status.ok()) << why;
+    EXPECT_NE(status.message().find(path), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find(why), std::string::npos) << status.message();
+  };
+  refused("{\"format\": \"patrolmap.changes\", ", "not JSON");
+  refused("[1, 2]", "not a patrolmap change report");
+  nlohmann::json damaged = written;
+  damaged["changes"][0]["position"] = {1.0, 2.0};
+  refused(damaged.dump(), "'position' is not null or three numbers");
+  damaged = written;
+  damaged["objects"][0].erase("state");
+  refused(damaged.dump(), "malformed change report");
+  damaged = written;
+  damaged["changes"] = "none";
+  refused(damaged.dump(), "'changes' is not an array");
+  ChangesFile file;
+  EXPECT_EQ(ReadChangesJson(dir / "missing.json", &file).code(), StatusCode::kNotFound);
+}
+
 }  // namespace
 }  // namespace patrolmap::change

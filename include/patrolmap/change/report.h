@@ -148,6 +148,29 @@ std::vector<std::string> IdsOf(const std::vector<ChangeItem>& items, const std::
 // The far end of a change's bearing (ChangeItem::bearing, bearing_range_m along it).
 Eigen::Vector3d BearingEnd(const ChangeItem& item);
 
+// What a reader of changes.json gets back (ReadChangesJson): the flights compared, the summary, the objects as
+// reported and the change list's entries. Positions are in the map's frame [m].
+struct ChangesFile {
+  std::string prior_flight, current_flight;
+  int places_compared = 0, places_changed = 0;
+  struct Object {
+    std::string id, state, label;
+    bool from_geometry = false;  // a class-agnostic object of changed geometry ("source": "geometry")
+    std::optional<Eigen::Vector3d> before, after;
+  };
+  bool objects_compared = false;  // "objects" is an array (null when the patrols had no detections)
+  std::vector<Object> objects;
+  struct Entry {
+    std::string id;
+    std::optional<Eigen::Vector3d> position, from;  // null for a bearing; `from` where a moved object was
+  };
+  std::vector<Entry> entries;
+};
+
+// Reads a changes.json that ToJson wrote. A file that is not one, or is malformed, is DataLoss naming the file and
+// what is wrong.
+Status ReadChangesJson(const std::string& path, ChangesFile* file);
+
 // The file name of a change's picture: "<id>-before.jpg" or "<id>-after.jpg".
 std::string ViewFileName(const ChangeItem& item, bool before);
 

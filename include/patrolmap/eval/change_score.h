@@ -269,4 +269,12 @@ struct EntryScore {
 EntryScore ScoreEntries(const std::vector<ReportedEntry>& entries, const std::vector<TrueChange>& truth,
                         const ChangeScoreOptions& options);
 
+// The object channel over the true changes as a whole (new, removed, moved; TrueChanges), over all and over the
+// observable ones: a true change is found when ScoreObjectChanges found it (its id, its state); false positives are
+// the false reports of a change (persistent ones are no change).
+struct ObjectChangeTotals {
+  Counts all, observable;
+};
+ObjectChangeTotals TotalObjectChanges(const ObjectChangeScore& score, const std::vector<TrueChange>& truth);
+
 }  // namespace patrolmap::eval
