@@ -165,8 +165,8 @@ class SyntheticFrames {
 
   // A new key frame of `flight` at second `second`; with `seen` (the frame made just before this one), that
   // frame again: half its features kept and moved 6 px to the right, half new.
-  graph::NodeData Frame(const std::string& flight, int second, int features, const graph::NodeData* seen) {
-    graph::NodeData node;
+  KeyFrameNode Frame(const std::string& flight, int second, int features, const KeyFrameNode* seen) {
+    KeyFrameNode node;
     node.flight = flight;
     node.thumbnail = cv::Mat(thumbnail_width_ * 480 / 752, thumbnail_width_, CV_8UC1);
     rng_.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);
@@ -332,20 +332,15 @@ void BM_RealNodeMemory(benchmark::State& state) {
       place::KeyFrame key_frame{"real", 0, i, scaled[i % scaled.size()], false};
       place::PlaceResult result;
       if (!recognizer.AddKeyFrame(key_frame, &result).ok()) std::abort();
-      place::PlaceRecognizer::NodeFeatures features = recognizer.Features(result.node);
-      graph::NodeData data;
-      data.flight = features.flight;
+      KeyFrameNode data = std::move(result.described);  // descriptors shared with the recognizer, as in mapping
       data.frame_index = i;
       const double scale = 160.0 / key_frame.image.cols;
       cv::resize(key_frame.image, data.thumbnail, cv::Size(), scale, scale, cv::INTER_AREA);
-      data.points = std::move(features.points);
-      data.descriptors = std::move(features.descriptors);  // shared with the recognizer, as in the map command
-      data.bow = std::move(features.bow);
       map.AddNode(std::move(data));
     }
     resident_kb = (ResidentKilobytes() - start_kb) / nodes;
     for (int i = 0; i < map.node_count(); ++i) {
-      const graph::NodeData& n = map.node(i);
+      const KeyFrameNode& n = map.node(i);
       descriptors += static_cast<double>(n.descriptors.total() * n.descriptors.elemSize());
       points += 2.0 * static_cast<double>(n.points.size() * sizeof(cv::Point2f));  // the recognizer's and the map's
       words += static_cast<double>(n.bow.words.size());

@@ -17,7 +17,7 @@ graph::TopoMap TenThousandNodes() {
   graph::TopoMap map;
   cv::RNG rng(5);
   for (int i = 0; i < 10000; ++i) {
-    graph::NodeData node;
+    KeyFrameNode node;
     node.flight = "flight-" + std::to_string(i / 2500);
     node.thumbnail = cv::Mat(102, 160, CV_8UC1);
     rng.fill(node.thumbnail, cv::RNG::UNIFORM, 0, 255);

@@ -959,7 +959,7 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   FlightPassOptions every;  // every processed frame: every 5th of the 30 fps logs
   every.node_every = 5;
   for (const char* flight : {"street-1", "street-2"}) MapThroughPass(dir / flight, config, every, &recognizer, &result);
-  const graph::TopoMap map = BuildTopoMap(result, recognizer);
+  const graph::TopoMap map = BuildTopoMap(result);
   EXPECT_EQ(map.node_count(), 68);
   EXPECT_EQ(map.loop_closure_count(), static_cast<int>(result.loop_closures.size()));
   EXPECT_EQ(map.edge_count(), 66 + map.loop_closure_count());  // 33 traversals per flight
@@ -984,14 +984,14 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
   MapResult first_only;
   place::PlaceRecognizer first_recognizer(&vocabulary, config.place);
   MapThroughPass(dir / "street-1", config, every, &first_recognizer, &first_only);
-  ASSERT_TRUE(graph::SaveMap(BuildTopoMap(first_only, first_recognizer), dir / "first.pmap").ok());
+  ASSERT_TRUE(graph::SaveMap(BuildTopoMap(first_only), dir / "first.pmap").ok());
   graph::TopoMap prior;
   ASSERT_TRUE(graph::LoadMap(dir / "first.pmap", &prior).ok());
   place::PlaceRecognizer patrol_recognizer(&vocabulary, config.place);
   ASSERT_TRUE(SeedRecognizer(prior, "first.pmap", vocabulary, &patrol_recognizer).ok());
   MapResult patrol;
   MapThroughPass(dir / "street-2", config, every, &patrol_recognizer, &patrol);
-  const graph::TopoMap extended = BuildTopoMap(patrol, patrol_recognizer, &prior);
+  const graph::TopoMap extended = BuildTopoMap(patrol, &prior);
   EXPECT_EQ(extended.node_count(), map.node_count());
   EXPECT_EQ(extended.loop_closure_count(), map.loop_closure_count());
   const auto joint = map.Edges(), patrolled = extended.Edges();

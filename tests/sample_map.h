@@ -12,12 +12,11 @@ namespace patrolmap::testing {
 inline graph::TopoMap TwoFlights() {
   using graph::EdgeData;
   using graph::EdgeKind;
-  using graph::NodeData;
   using graph::TopoMap;
   TopoMap map;
   cv::RNG rng(3);
   for (int i = 0; i < 7; ++i) {
-    NodeData node;
+    KeyFrameNode node;
     node.flight = i < 4 ? "a" : "b";
     node.timestamp_ns = SecondsToNs(10.0 * i);
     node.frame_index = 30 * i;

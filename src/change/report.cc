@@ -157,7 +157,7 @@ cv::Mat OutlinedFrame(const cv::Mat& frame, int reference_width, const std::vect
 // The node's key frame with the regions outlined: the kept frame of the same frame index, else the thumbnail.
 ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<cv::Rect>& boxes,
                         const ReportOptions& options) {
-  const graph::NodeData& n = map.node(node);
+  const KeyFrameNode& n = map.node(node);
   ChangeView view{n.flight, n.timestamp_ns, n.frame_index, cv::Mat()};
   cv::Mat frame;
   const PatrolRecord* record = map.Patrol(n.flight);

@@ -230,7 +230,7 @@ void ScoreGeometryOf(const graph::TopoMap& map, const change::ChangeReport& repo
 bool KeyFrameTruth(const graph::TopoMap& map, int node, const std::vector<TruthObject>& here,
                    const std::vector<TruthObject>& other, const ChangeScoreOptions& options,
                    std::vector<cv::Rect2d>* boxes) {
-  const graph::NodeData& n = map.node(node);
+  const KeyFrameNode& n = map.node(node);
   const PatrolRecord* patrol = map.Patrol(n.flight);
   if (patrol == nullptr || !patrol->camera.valid() || n.thumbnail.empty()) return false;
   const std::optional<CameraPoseSample> pose = io::PoseAt(patrol->views, n.timestamp_ns);

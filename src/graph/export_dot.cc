@@ -22,7 +22,7 @@ std::string ToDot(const TopoMap& map) {
   std::ostringstream out;
   out << "graph patrolmap {\n  node [shape=circle, fontsize=10];\n";
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     out << "  n" << i << " [label=\"" << i << "\", flight=\"" << EscapeDot(n.flight) << "\", frame=" << n.frame_index
         << "];\n";
   }

@@ -17,7 +17,7 @@ nlohmann::json LonLat(const Eigen::Vector2d& latitude_longitude) {
 std::string ToGeoJson(const TopoMap& map) {
   nlohmann::json features = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     if (!n.gps) continue;
     features.push_back({{"type", "Feature"},
                         {"geometry", {{"type", "Point"}, {"coordinates", LonLat(*n.gps)}}},

@@ -34,7 +34,7 @@ std::string ToGraphML(const TopoMap& map) {
   GraphMLKeys(&out);
   out << "  <graph id=\"patrolmap\" edgedefault=\"undirected\">\n";
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     out << "    <node id=\"n" << i << "\"><data key=\"flight\">" << EscapeXml(n.flight) << "</data><data key=\"time\">"
         << n.timestamp_ns << "</data><data key=\"frame\">" << n.frame_index << "</data>";
     if (n.gps)

@@ -15,7 +15,7 @@ constexpr const char* kFlightColours[] = {"#374151", "#d97706", "#7c3aed", "#0f7
 nlohmann::json PageData(const TopoMap& map, const std::vector<ClosureMatches>* matches) {
   nlohmann::json nodes = nlohmann::json::array(), closures = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     nodes.push_back({{"flight", n.flight},
                      {"time_s", NsToSeconds(n.timestamp_ns)},
                      {"frame", n.frame_index},

@@ -10,7 +10,7 @@ namespace patrolmap::graph {
 std::string ToJson(const TopoMap& map) {
   nlohmann::json nodes = nlohmann::json::array(), links = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     nlohmann::json node = {{"id", i},
                            {"flight", n.flight},
                            {"timestamp_ns", n.timestamp_ns},

@@ -174,7 +174,7 @@ void NodeSection(const TopoMap& map, Writer* out) {
   Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.node_count()));
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     w.String(n.flight);
     w.Value(n.timestamp_ns);
     w.Value(n.frame_index);
@@ -204,7 +204,7 @@ void FeatureSection(const TopoMap& map, Writer* out) {
   Writer& w = *out;
   w.Value(static_cast<std::uint32_t>(map.node_count()));
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     w.Vector(n.points);
     w.Mat(n.descriptors);
     w.Vector(n.bow.words);
@@ -342,7 +342,7 @@ bool Finite(std::initializer_list<double> values) {
 
 // Node values a reader could have written: a valid time, a frame index from 0, GPS on the globe, a
 // finite layout and heading.
-bool ValidNodeValues(const NodeData& n) {
+bool ValidNodeValues(const KeyFrameNode& n) {
   const bool gps_ok = !n.gps || (std::abs((*n.gps)[0]) <= 90.0 && std::abs((*n.gps)[1]) <= 180.0);
   return ValidTimestamp(n.timestamp_ns) && n.frame_index >= 0 && gps_ok &&
          Finite({n.layout.x(), n.layout.y(), n.heading});
@@ -351,7 +351,7 @@ bool ValidNodeValues(const NodeData& n) {
 Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
   const std::uint32_t count = r->Value<std::uint32_t>();
   for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
-    NodeData n;
+    KeyFrameNode n;
     n.flight = r->String();
     n.timestamp_ns = r->Value<TimestampNs>();
     n.frame_index = r->Value<std::int64_t>();
@@ -405,7 +405,7 @@ Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, Top
 Status ParseFeatures(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
   if (r->Value<std::uint32_t>() != static_cast<std::uint32_t>(map->node_count())) return Corrupt(path, "feature count");
   for (int i = 0; i < map->node_count() && !r->failed(); ++i) {
-    NodeData& n = map->mutable_node(i);
+    KeyFrameNode& n = map->mutable_node(i);
     if (version >= 8) {
       n.points = r->Vector<cv::Point2f>();
     } else {

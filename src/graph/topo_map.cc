@@ -11,7 +11,7 @@ namespace patrolmap::graph {
 
 const char* ToString(EdgeKind kind) { return kind == EdgeKind::kTraversal ? "traversal" : "loop_closure"; }
 
-int TopoMap::AddNode(NodeData node) { return static_cast<int>(boost::add_vertex(std::move(node), graph_)); }
+int TopoMap::AddNode(KeyFrameNode node) { return static_cast<int>(boost::add_vertex(std::move(node), graph_)); }
 
 void TopoMap::AddEdge(int a, int b, const EdgeData& edge) {
   PATROLMAP_CHECK(a >= 0 && b >= 0 && a < node_count() && b < node_count());

@@ -16,7 +16,7 @@ constexpr double kNodePoseToleranceS = 1.0;
 std::vector<change::PlacePair> PlacesOf(const graph::TopoMap& map, const PatrolRecord& prior,
                                         const PatrolRecord& current) {
   const auto view = [&map](int node, const PatrolRecord& record) {
-    const graph::NodeData& n = map.node(node);
+    const KeyFrameNode& n = map.node(node);
     return change::KeyFrameOf(n.thumbnail, n.points, n.descriptors, record.feature_image_width);
   };
   std::vector<change::PlacePair> places;

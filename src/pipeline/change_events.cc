@@ -158,23 +158,20 @@ void ChangeMonitor::Send(const Event& event, bool final_event) {
   ++events_;
 }
 
-void ChangeMonitor::OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose,
-                           const MapLoopClosure* closure, const place::PlaceRecognizer& recognizer,
-                           const io::LogInfo& info) {
+void ChangeMonitor::OnNode(const KeyFrameNode& node, int feature_width, const std::optional<CameraPoseSample>& pose,
+                           const MapLoopClosure* closure, const io::LogInfo& info) {
   if (closure == nullptr || closure->matched_node >= prior_->node_count()) return;
-  const graph::NodeData& before = prior_->node(closure->matched_node);
+  const KeyFrameNode& before = prior_->node(closure->matched_node);
   if (before.flight != prior_flight_) return;
   if (!detector_) return;
-  place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
   const change::AppearanceChange appearance = detector_->ComparePlace(
       change::KeyFrameOf(before.thumbnail, before.points, before.descriptors, prior_record_->feature_image_width),
-      change::KeyFrameOf(node.thumbnail, std::move(features.points), std::move(features.descriptors),
-                         node.feature_width));
+      change::KeyFrameOf(node.thumbnail, node.points, node.descriptors, feature_width));
   if (appearance.regions.empty()) return;
   // A bearing only: the grid belongs to the change thread.
   const change::ChangeLocation location = change::BearingOfLargest(appearance, info.camera.value_or(CameraIntrinsics()),
                                                                    info.camera_distortion, node.thumbnail.cols, pose);
-  Event event = AppearanceEvent(closure->matched_node, node.node, node.timestamp_ns, location, appearance);
+  Event event = AppearanceEvent(closure->matched_node, closure->query_node, node.timestamp_ns, location, appearance);
   if (node.gps) event.details["gps"] = json::array({node.gps->x(), node.gps->y()});
   Send(event, false);
 }

@@ -130,6 +130,7 @@ Status FlightPass::HandSlot(const Slot& slot) {
   input.key_frame.timestamp_ns = slot.timestamp_ns;
   input.key_frame.frame_index = slot.frame_index;
   input.key_frame.image = slot.image.clone();  // the slot is reused; the queue keeps its own copy
+  feature_width_ = slot.image.cols;
   input.heading = slot.heading;
   input.gps = slot.gps;
   input.pose = slot.pose;
@@ -144,7 +145,7 @@ Status FlightPass::AddPlace(KeyFrameInput&& input) {
   if (monitor_ == nullptr) return Status::Ok();
   const MapResult& result = places_.result();
   const MapLoopClosure* closure = result.loop_closures.size() > closures ? &result.loop_closures.back() : nullptr;
-  monitor_->OnNode(result.nodes.back(), input.pose, closure, places_.recognizer(), info_);
+  monitor_->OnNode(result.nodes.back(), input.key_frame.image.cols, input.pose, closure, info_);
   return Status::Ok();
 }
 
@@ -171,6 +172,7 @@ Status FlightPass::Finish(FlightResult* result) {
   PATROLMAP_RETURN_IF_ERROR(place_queue_.Close());
   PATROLMAP_RETURN_IF_ERROR(change_queue_.Close());
   recorder_.Finish(&result->record, &result->record_stats);
+  result->record.feature_image_width = feature_width_;
   stats_.place_queue = place_queue_.stats();
   stats_.change_queue = change_queue_.stats();
   result->stats = stats_;
@@ -277,7 +279,6 @@ Status RunFlight(io::FrameSource* source, const Config& config, const FlightPass
   FlightResult& result = run->result;
   result.detection.skipped = source->skipped();
   result.detection.seconds = run->drive.seconds;
-  result.record.feature_image_width = FeatureWidth(*places, info.flight_id);
   const bool none = options.node_every > 0 ? places->nodes.size() == nodes_before : result.stats.processed == 0;
   if (none && !run->drive.interrupted) return Status::DataLoss(info.path + ": no frame could be read");
   run->warnings = FlightWarnings(info, config, options, result);

@@ -43,26 +43,28 @@ void YawIntegrator::Add(const std::vector<ImuSample>& samples) {
 
 PlaceStage::PlaceStage(place::PlaceRecognizer* recognizer, MapResult* result)
     : recognizer_(recognizer), result_(result) {
-  for (const MapNode& node : result->nodes) frame_of_[node.node] = node.frame_index;
+  if (result_->nodes.empty()) result_->first_node = recognizer_->node_count();
 }
 
 Status PlaceStage::Add(const KeyFrameInput& input) {
   const place::KeyFrame& key_frame = input.key_frame;
   place::PlaceResult place;
   PATROLMAP_RETURN_IF_ERROR(recognizer_->AddKeyFrame(key_frame, &place));
-  result_->nodes.push_back({place.node, key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, place.features,
-                            Thumbnail(key_frame.image), input.heading,
-                            input.gps ? std::optional<Eigen::Vector2d>(input.gps->head<2>()) : std::nullopt,
-                            key_frame.image.cols});
-  frame_of_[place.node] = key_frame.frame_index;
+  // The recognizer and the map number nodes alike: a node's id is its place in the recognizer.
+  PATROLMAP_CHECK(place.node == result_->first_node + static_cast<int>(result_->nodes.size()));
+  KeyFrameNode node = std::move(place.described);
+  node.thumbnail = Thumbnail(key_frame.image);
+  node.heading = input.heading;
+  if (input.gps) node.gps = input.gps->head<2>();
+  result_->nodes.push_back(std::move(node));
   result_->seconds_features += place.seconds_features;
   result_->seconds_query += place.seconds_query;
   result_->seconds_verify += place.seconds_verify;
   result_->seconds_add += place.seconds_add;
   if (!place.match) return Status::Ok();
-  const auto matched = frame_of_.find(place.match->node);
+  const int matched = place.match->node - result_->first_node;  // < 0: a node of the prior map
   result_->loop_closures.push_back({place.node, place.match->node, key_frame.frame_index,
-                                    matched == frame_of_.end() ? -1 : matched->second, *place.match});
+                                    matched >= 0 ? result_->nodes[matched].frame_index : -1, *place.match});
   return Status::Ok();
 }
 
@@ -80,7 +82,7 @@ graph::TopoMap::VocabularyTag TagOf(const vocab::Vocabulary& vocabulary, const s
 }
 
 Status CheckNodeFits(const graph::TopoMap& map, const std::string& path, int id, const vocab::Vocabulary& vocabulary) {
-  const graph::NodeData& node = map.node(id);
+  const KeyFrameNode& node = map.node(id);
   const bool words_fit = std::all_of(node.bow.words.begin(), node.bow.words.end(), [&](vocab::WordId word) {
     return word < static_cast<vocab::WordId>(vocabulary.word_count());
   });
@@ -95,31 +97,18 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
   PATROLMAP_CHECK(recognizer->node_count() == 0);
   for (int i = 0; i < prior.node_count(); ++i) {
     PATROLMAP_RETURN_IF_ERROR(CheckNodeFits(prior, prior_path, i, vocabulary));
-    const graph::NodeData& node = prior.node(i);
-    recognizer->AddDescribedNode(
-        {node.flight, node.timestamp_ns, node.frame_index, node.points, node.descriptors, node.bow});
+    const KeyFrameNode& node = prior.node(i);
+    recognizer->AddDescribedNode(node);
   }
   return Status::Ok();
 }
 
-graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
-                            const graph::TopoMap* prior) {
+graph::TopoMap BuildTopoMap(const MapResult& result, const graph::TopoMap* prior) {
   graph::TopoMap map;
   if (prior != nullptr) map = *prior;
-  for (const MapNode& node : result.nodes) {
-    place::PlaceRecognizer::NodeFeatures features = recognizer.Features(node.node);
-    graph::NodeData data;
-    data.flight = node.flight;
-    data.timestamp_ns = node.timestamp_ns;
-    data.frame_index = node.frame_index;
-    data.thumbnail = node.thumbnail;
-    data.heading = node.heading;
-    data.gps = node.gps;
-    data.points = std::move(features.points);
-    data.descriptors = std::move(features.descriptors);
-    data.bow = std::move(features.bow);
-    const int id = map.AddNode(std::move(data));
-    PATROLMAP_CHECK(id == node.node);  // the recognizer and the map number nodes alike
+  PATROLMAP_CHECK(result.nodes.empty() || result.first_node == map.node_count());
+  for (const KeyFrameNode& node : result.nodes) {
+    const int id = map.AddNode(node);
     if (id > 0 && map.node(id - 1).flight == node.flight) map.AddEdge(id - 1, id, graph::EdgeData{});
   }
   for (const MapLoopClosure& closure : result.loop_closures) {
@@ -135,7 +124,7 @@ Status WriteMapOutputs(const graph::TopoMap& map, const std::string& folder) {
   std::ostringstream nodes, closures;
   nodes << "node,flight,timestamp_ns,frame_index,features\n";
   for (int i = 0; i < map.node_count(); ++i) {
-    const graph::NodeData& n = map.node(i);
+    const KeyFrameNode& n = map.node(i);
     nodes << i << "," << n.flight << "," << n.timestamp_ns << "," << n.frame_index << "," << n.points.size() << "\n";
   }
   closures << "query_node,matched_node,query_frame,matched_frame,bow_score,matched_fraction,inliers,log_nfa\n";
@@ -158,13 +147,6 @@ Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary
   if (vocabulary->dimension() != 128) return Status::InvalidArgument(found + ": not a SIFT vocabulary");
   if (loaded != nullptr) *loaded = found;
   return Status::Ok();
-}
-
-int FeatureWidth(const MapResult& result, const std::string& flight) {
-  for (const MapNode& node : result.nodes) {
-    if (node.flight == flight) return node.feature_width;
-  }
-  return 0;
 }
 
 Status SaveMapRun(graph::TopoMap* map, const std::string& folder) {

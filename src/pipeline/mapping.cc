@@ -97,10 +97,11 @@ void LogRecord(const FlightResult& flight) {
 PlotTruth FlightPlotTruth(const io::LogInfo& info, const FlightResult& flight, const MapResult& places) {
   PlotTruth truth = LoadPlotTruth(info.path, flight.detection.key_locations);
   for (const KeyLocation& key_location : flight.detection.key_locations) {
-    const auto node = std::find_if(places.nodes.begin(), places.nodes.end(), [&](const MapNode& n) {
+    const auto node = std::find_if(places.nodes.begin(), places.nodes.end(), [&](const KeyFrameNode& n) {
       return n.flight == info.flight_id && n.frame_index == key_location.frame_index;
     });
-    truth.node_ids.push_back(node == places.nodes.end() ? -1 : node->node);
+    truth.node_ids.push_back(
+        node == places.nodes.end() ? -1 : places.first_node + static_cast<int>(node - places.nodes.begin()));
   }
   return truth;
 }
@@ -229,10 +230,9 @@ void AlignToMap(const graph::TopoMap& map, const change::ChangeOptions& options,
 // The map of the run: the prior's nodes, the new ones, and the patrol record of each new flight, each aligned to
 // the map's patrol before it. A flight too short for a key location keeps its record: its route frames, grid and
 // objects can still be compared.
-graph::TopoMap AssembleMap(const graph::TopoMap& prior, const place::PlaceRecognizer& recognizer,
-                           const graph::TopoMap::VocabularyTag& tag, const change::ChangeOptions& options,
-                           MappingOutcome* outcome) {
-  graph::TopoMap map = BuildTopoMap(outcome->places, recognizer, &prior);
+graph::TopoMap AssembleMap(const graph::TopoMap& prior, const graph::TopoMap::VocabularyTag& tag,
+                           const change::ChangeOptions& options, MappingOutcome* outcome) {
+  graph::TopoMap map = BuildTopoMap(outcome->places, &prior);
   map.set_vocabulary(tag);
   for (FlightRun& run : outcome->flights) {
     PatrolRecord& record = run.result.record;
@@ -266,7 +266,7 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   for (const std::string& source : request.sources) {
     PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, prior, &recognizer, monitor.get(), outcome));
   }
-  graph::TopoMap map = AssembleMap(prior, recognizer, TagOf(vocabulary, vocabulary_path), config.change, outcome);
+  graph::TopoMap map = AssembleMap(prior, TagOf(vocabulary, vocabulary_path), config.change, outcome);
   std::vector<change::ChangeItem> entries;
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(

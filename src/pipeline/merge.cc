@@ -100,11 +100,10 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
   for (const FlightPart& part : parts) {
     const bool timed = part.record == nullptr || part.record->timed;
     for (const int n : part.nodes) {
-      graph::NodeData node = maps[part.map].node(n);
+      KeyFrameNode node = maps[part.map].node(n);
       node.flight = part.id;
       place::PlaceResult result;
-      recognizer.AddDescribedKeyFrame(
-          {node.flight, node.timestamp_ns, node.frame_index, node.points, node.descriptors, node.bow}, timed, &result);
+      recognizer.AddDescribedKeyFrame(node, timed, &result);
       outcome->seconds_query += result.seconds_query;
       outcome->seconds_verify += result.seconds_verify;
       const int id = merged.AddNode(std::move(node));

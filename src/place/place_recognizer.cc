@@ -272,12 +272,6 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
   return nodes_[node].flight == nodes_[anchor].flight && std::abs(node - anchor) <= options_.max_topological_gap;
 }
 
-PlaceRecognizer::NodeFeatures PlaceRecognizer::Features(int node) const {
-  const Node& n = nodes_.at(node);
-  return {n.flight, n.timestamp_ns, n.frame_index,
-          n.points, n.descriptors,  database_.entry(static_cast<vocab::EntryId>(node))};
-}
-
 std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) const {
   // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
   cv::Mat as_float;
@@ -290,11 +284,11 @@ std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) c
   return groups;
 }
 
-int PlaceRecognizer::AddDescribedNode(NodeFeatures features) {
-  Node node{std::move(features.flight), features.timestamp_ns,           features.frame_index,
-            std::move(features.points), std::move(features.descriptors), {}};
+int PlaceRecognizer::AddDescribedNode(const KeyFrameNode& described) {
+  Node node{described.flight, described.timestamp_ns, described.frame_index,
+            described.points, described.descriptors,  {}};
   if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
-  const int id = static_cast<int>(database_.Add(features.bow));
+  const int id = static_cast<int>(database_.Add(described.bow));
   nodes_.push_back(std::move(node));
   return id;
 }
@@ -322,18 +316,18 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   return Status::Ok();
 }
 
-void PlaceRecognizer::AddDescribedKeyFrame(NodeFeatures features, bool timed, PlaceResult* result) {
+void PlaceRecognizer::AddDescribedKeyFrame(const KeyFrameNode& described, bool timed, PlaceResult* result) {
   *result = PlaceResult();
   KeyFrame key_frame;
-  key_frame.flight = features.flight;
-  key_frame.timestamp_ns = features.timestamp_ns;
-  key_frame.frame_index = features.frame_index;
+  key_frame.flight = described.flight;
+  key_frame.timestamp_ns = described.timestamp_ns;
+  key_frame.frame_index = described.frame_index;
   key_frame.timed = timed;
-  Node node{std::move(features.flight), features.timestamp_ns,           features.frame_index,
-            std::move(features.points), std::move(features.descriptors), {}};
+  Node node{described.flight, described.timestamp_ns, described.frame_index,
+            described.points, described.descriptors,  {}};
   if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
   result->features = node.descriptors.rows;
-  Recognise(key_frame, std::move(node), features.bow, result);
+  Recognise(key_frame, std::move(node), described.bow, result);
 }
 
 void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow,
@@ -363,6 +357,12 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   last_match_[key_frame.flight] = result->match ? result->match->node : -1;
   start = std::chrono::steady_clock::now();
   result->node = static_cast<int>(database_.Add(bow));
+  result->described.flight = node.flight;
+  result->described.timestamp_ns = node.timestamp_ns;
+  result->described.frame_index = node.frame_index;
+  result->described.points = node.points;
+  result->described.descriptors = node.descriptors;  // shared
+  result->described.bow = bow;
   nodes_.push_back(std::move(node));
   result->seconds_add = Since(start);
 }

@@ -55,7 +55,7 @@ TopoMap SquareLoop(LayoutInput* input) {
   TopoMap map;
   input->heading.clear();
   for (int i = 0; i <= 40; ++i) {
-    NodeData node;
+    KeyFrameNode node;
     node.flight = "a";
     node.timestamp_ns = SecondsToNs(i);
     map.AddNode(node);
@@ -105,14 +105,14 @@ TEST(Layout, AFirstNodeWithoutEdgesIsLaidOutToo) {
   TopoMap map;
   LayoutInput input;
   for (const char* flight : {"a", "b", "b"}) {
-    NodeData node;
+    KeyFrameNode node;
     node.flight = flight;
     node.timestamp_ns = 1'000'000'000LL * map.node_count();
     map.AddNode(std::move(node));
     input.heading.push_back(0.0);
   }
   TopoMap single;
-  single.AddNode(NodeData{});
+  single.AddNode(KeyFrameNode{});
   LayoutInput one;
   one.heading = {0.0};
   ASSERT_TRUE(LayoutMap(one, {}, &single).ok());

@@ -39,7 +39,7 @@ TEST(MapFile, RoundTripKeepsEverything) {
   ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
   ASSERT_EQ(loaded.node_count(), map.node_count());
   for (int i = 0; i < map.node_count(); ++i) {
-    const NodeData &a = map.node(i), &b = loaded.node(i);
+    const KeyFrameNode &a = map.node(i), &b = loaded.node(i);
     EXPECT_EQ(a.flight, b.flight);
     EXPECT_EQ(a.timestamp_ns, b.timestamp_ns);
     EXPECT_EQ(a.frame_index, b.frame_index);
@@ -498,7 +498,7 @@ TEST(MapFile, FeaturesOfAnUnknownKindAreRefused) {
   testing::TempDir dir;
   for (int damage = 0; damage < 2; ++damage) {
     TopoMap map = TwoFlights();
-    NodeData& node = map.mutable_node(1);
+    KeyFrameNode& node = map.mutable_node(1);
     if (damage == 0) node.points[0].x = std::numeric_limits<float>::quiet_NaN();
     if (damage == 1) node.descriptors = cv::Mat::zeros(static_cast<int>(node.points.size()), 100, CV_8U);
     ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
@@ -542,7 +542,7 @@ TopoMap BigMap(int nodes) {
   TopoMap map;
   cv::RNG rng(5);
   for (int i = 0; i < nodes; ++i) {
-    NodeData node;
+    KeyFrameNode node;
     node.flight = "f";
     node.thumbnail = cv::Mat(102, 160, CV_8UC1, cv::Scalar(i % 255));
     node.points.assign(200, cv::Point2f(1.0f, 2.0f));

@@ -68,7 +68,7 @@ TEST(TopoMap, AFlightWithARecordButNoNodeIsListedInTheOrderFlown) {
     record.flight = flight;
     early.SetPatrol(record);
   }
-  NodeData node;
+  KeyFrameNode node;
   node.flight = "z";
   early.AddNode(node);
   PatrolRecord z;

@@ -34,7 +34,7 @@ Status SvgTruthFromLogs(const graph::TopoMap& map, const std::vector<std::string
   std::vector<eval::NodeRecord> nodes;
   std::vector<eval::Place> node_places;
   for (int i = 0; i < map.node_count(); ++i) {
-    const graph::NodeData& node = map.node(i);
+    const KeyFrameNode& node = map.node(i);
     const auto flight = places.find(node.flight);
     if (flight == places.end() || node.frame_index < 0 ||
         node.frame_index >= static_cast<std::int64_t>(flight->second.size())) {

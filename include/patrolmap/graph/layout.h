@@ -31,7 +31,7 @@ struct LayoutOptions {
   int max_iterations = 100;
 };
 
-// Writes NodeData::layout of every node. The first node of the first flight
+// Writes KeyFrameNode::layout of every node. The first node of the first flight
 // stays at the origin facing +x; each further flight starts where its first
 // loop closure puts it (or beside the earlier flights when it has none).
 Status LayoutMap(const LayoutInput& input, const LayoutOptions& options, TopoMap* map);

@@ -1,6 +1,6 @@
-// The topological map (DESIGN.md, graph stage): nodes are key locations, edges
-// are traversals (consecutive nodes of one flight) and loop closures (the same
-// place, within or across flights), on Boost.Graph with bundled properties.
+// The topological map (DESIGN.md, graph stage): nodes are key locations (KeyFrameNode, the type place recognition
+// gives), edges are traversals (consecutive nodes of one flight) and loop closures (the same place, within or across
+// flights), on Boost.Graph with bundled properties.
 #pragma once
 
 #include <cstdint>
@@ -14,24 +14,12 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
+#include "patrolmap/core/key_frame_node.h"
 #include "patrolmap/core/patrol_data.h"
 #include "patrolmap/core/types.h"
 #include "patrolmap/vocab/bow.h"
 
 namespace patrolmap::graph {
-
-struct NodeData {
-  std::string flight;
-  TimestampNs timestamp_ns = 0;
-  std::int64_t frame_index = 0;
-  cv::Mat thumbnail;                // CV_8UC1 key frame, small (for pictures and exports)
-  std::vector<cv::Point2f> points;  // feature positions [pixels] and descriptors kept so a later flight can
-  cv::Mat descriptors;              // be matched without the original log (vocab/descriptors.h)
-  vocab::BowVector bow;
-  std::optional<Eigen::Vector2d> gps;                // latitude, longitude [deg], when the log has them
-  double heading = 0.0;                              // integrated gyro yaw at the node [rad] (0 without an IMU)
-  Eigen::Vector2d layout = Eigen::Vector2d::Zero();  // 2D position for pictures (scaleless)
-};
 
 enum class EdgeKind : std::uint8_t { kTraversal = 0, kLoopClosure = 1 };
 const char* ToString(EdgeKind kind);
@@ -46,18 +34,18 @@ struct EdgeData {
 
 class TopoMap {
  public:
-  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, NodeData, EdgeData>;
+  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, KeyFrameNode, EdgeData>;
 
   // Adds a node; ids are 0, 1, 2, ... in order.
-  int AddNode(NodeData node);
+  int AddNode(KeyFrameNode node);
   // Adds an edge between existing nodes; a loop closure needs two distinct nodes.
   void AddEdge(int a, int b, const EdgeData& edge);
 
   int node_count() const { return static_cast<int>(boost::num_vertices(graph_)); }
   int edge_count() const { return static_cast<int>(boost::num_edges(graph_)); }
   int loop_closure_count() const;
-  const NodeData& node(int id) const { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
-  NodeData& mutable_node(int id) { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
+  const KeyFrameNode& node(int id) const { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
+  KeyFrameNode& mutable_node(int id) { return graph_[static_cast<Graph::vertex_descriptor>(id)]; }
 
   struct Edge {
     int a = 0, b = 0;

@@ -52,9 +52,10 @@ class ChangeMonitor {
   ChangeMonitor(const ChangeMonitor&) = delete;
   ChangeMonitor& operator=(const ChangeMonitor&) = delete;
 
-  // Place stage's thread: a new node of the flight, the camera pose there and its loop closure (may be null).
-  void OnNode(const MapNode& node, const std::optional<CameraPoseSample>& pose, const MapLoopClosure* closure,
-              const place::PlaceRecognizer& recognizer, const io::LogInfo& info);
+  // Place stage's thread: a new node of the flight (its features found on an image `feature_width` pixels wide),
+  // the camera pose there and its loop closure (may be null).
+  void OnNode(const KeyFrameNode& node, int feature_width, const std::optional<CameraPoseSample>& pose,
+              const MapLoopClosure* closure, const io::LogInfo& info);
   // Change stage's thread: after each step of the patrol record.
   void OnChangeStep(TimestampNs timestamp_ns, const PatrolRecorder& recorder);
   // After the flight: the final report's changes that no event announced, each with the `entry` of the report's

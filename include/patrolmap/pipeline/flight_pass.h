@@ -110,6 +110,7 @@ class FlightPass {
   std::size_t next_slot_ = 0;
   std::int64_t readable_frames_ = 0;
   double scale_;
+  int feature_width_ = 0;  // of the images key frames are described in [pixels]
   FlightPassStats stats_;
   std::vector<KeyLocation> key_locations_;
   std::vector<FlowSample> samples_;

@@ -15,18 +15,6 @@
 
 namespace patrolmap::pipeline {
 
-struct MapNode {
-  int node = 0;
-  std::string flight;
-  TimestampNs timestamp_ns = 0;
-  std::int64_t frame_index = 0;
-  int features = 0;
-  cv::Mat thumbnail;                   // the key frame at kThumbnailWidth pixels wide
-  double heading = 0;                  // gyro yaw integrated since the start of the flight [rad]
-  std::optional<Eigen::Vector2d> gps;  // latitude, longitude [deg] at the key frame, when the log has GPS
-  int feature_width = 0;               // width of the image its features were found in [pixels]
-};
-
 constexpr int kThumbnailWidth = 160;
 
 struct MapLoopClosure {
@@ -38,7 +26,10 @@ struct MapLoopClosure {
 };
 
 struct MapResult {
-  std::vector<MapNode> nodes;
+  // The nodes added, each as the map keeps it (thumbnail kThumbnailWidth pixels wide); nodes[i] has id
+  // first_node + i (a prior map's nodes come first).
+  std::vector<KeyFrameNode> nodes;
+  int first_node = 0;
   std::vector<MapLoopClosure> loop_closures;
   // Summed over key frames [s] (the paper's Table IV split).
   double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
@@ -78,15 +69,13 @@ class PlaceStage {
  private:
   place::PlaceRecognizer* recognizer_;
   MapResult* result_;
-  std::map<int, std::int64_t> frame_of_;  // node -> frame index
 };
 
 // The topological map of a mapping run: the nodes with their thumbnails and
 // features, traversal edges between consecutive nodes of a flight, and the
 // verified loop closures. `prior` (may be null) holds nodes already in the
 // recognizer before this run, which come first with their edges.
-graph::TopoMap BuildTopoMap(const MapResult& result, const place::PlaceRecognizer& recognizer,
-                            const graph::TopoMap* prior = nullptr);
+graph::TopoMap BuildTopoMap(const MapResult& result, const graph::TopoMap* prior = nullptr);
 
 // Fails naming both files when `prior` records another vocabulary than `vocabulary` (maps that record
 // none pass).
@@ -108,9 +97,6 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
 // Loads the SIFT vocabulary the place stage needs (the default one, FindDefaultVocabulary, when `path` is
 // empty); fails naming the file when it is not one. `loaded` (may be null) receives the file's path.
 Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary, std::string* loaded = nullptr);
-
-// The width the key-frame features of `flight` were found at (from its first node), 0 when it has none.
-int FeatureWidth(const MapResult& result, const std::string& flight);
 
 // Lays the map out (graph::LayoutMap) and writes DIR/nodes.csv, DIR/loop_closures.csv and DIR/map.pmap.
 Status SaveMapRun(graph::TopoMap* map, const std::string& folder);

@@ -14,6 +14,7 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
+#include "patrolmap/core/key_frame_node.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/core/types.h"
 #include "patrolmap/vocab/database.h"
@@ -121,6 +122,9 @@ double LogNumberOfFalseAlarms(const cv::Matx33d& fundamental, const std::vector<
 
 struct PlaceResult {
   int node = -1;  // the node the key frame became
+  // ... as the map keeps it: flight, time, frame, features (descriptors shared with the recognizer) and BoW vector;
+  // the caller adds what the recognizer does not know (thumbnail, GPS, heading).
+  KeyFrameNode described;
   int features = 0;
   std::optional<Verification> match;     // the accepted loop closure, if any
   std::vector<Verification> candidates;  // every candidate looked at
@@ -147,25 +151,15 @@ class PlaceRecognizer {
 
   int node_count() const { return static_cast<int>(nodes_.size()); }
 
-  // What the recognizer keeps of a node: enough to match later flights without the log.
-  struct NodeFeatures {
-    std::string flight;
-    TimestampNs timestamp_ns = 0;
-    std::int64_t frame_index = 0;
-    std::vector<cv::Point2f> points;  // feature positions [pixels]
-    cv::Mat descriptors;              // vocab/descriptors.h: float, 8-bit or packed 4-bit rows
-    vocab::BowVector bow;
-  };
-  NodeFeatures Features(int node) const;
-
-  // Adds a node described earlier (a prior map's), without querying; returns its id.
-  int AddDescribedNode(NodeFeatures features);
+  // Adds a node described earlier (a prior map's), without querying; returns its id. Keeps its flight, time,
+  // frame, features and BoW vector (the descriptors shared, not copied).
+  int AddDescribedNode(const KeyFrameNode& node);
 
   // Recognises a node described earlier (a map's, when maps are merged) as AddKeyFrame recognises a key
   // frame, from its stored features and BoW vector, then adds it. `timed`: its log had timestamps. With the
   // stored features of a key frame, the result is AddKeyFrame's (with the direct index, up to the words
   // re-quantised from 8-bit descriptors).
-  void AddDescribedKeyFrame(NodeFeatures features, bool timed, PlaceResult* result);
+  void AddDescribedKeyFrame(const KeyFrameNode& node, bool timed, PlaceResult* result);
 
   // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
   // direct-index node of each feature) matching stays inside equal groups.

@@ -5,16 +5,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "patrolmap/core/key_frame_node.h"
+
 namespace patrolmap::vocab {
 
-using WordId = std::uint32_t;
-
-// A sparse, L1-normalised TF-IDF vector: words sorted ascending, weights > 0 summing to 1.
-struct BowVector {
-  std::vector<WordId> words;
-  std::vector<float> weights;
-  bool empty() const { return words.empty(); }
-};
+using WordId = patrolmap::WordId;
+using BowVector = patrolmap::BowVector;  // core/key_frame_node.h
 
 // Similarity of two L1-normalised vectors: 1 - |a - b|_1 / 2, in [0, 1]; 1 for
 // identical vectors, 0 for vectors without a common word.
