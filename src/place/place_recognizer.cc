@@ -257,7 +257,7 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point
 }
 
 bool PlaceRecognizer::Allowed(const KeyFrame& query, int node) const {
-  const Node& candidate = nodes_[node];
+  const KeyFrameNode& candidate = nodes_[node].key;
   if (!Plausible(query, node)) return false;
   if (candidate.flight != query.flight) return true;
   if (!query.timed) return query.frame_index - candidate.frame_index > options_.exclude_recent_images;
@@ -269,7 +269,8 @@ bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
   const auto last = last_match_.find(query.flight);
   if (last == last_match_.end() || last->second < 0) return true;
   const int anchor = last->second;
-  return nodes_[node].flight == nodes_[anchor].flight && std::abs(node - anchor) <= options_.max_topological_gap;
+  return nodes_[node].key.flight == nodes_[anchor].key.flight &&
+         std::abs(node - anchor) <= options_.max_topological_gap;
 }
 
 std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) const {
@@ -284,10 +285,19 @@ std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) c
   return groups;
 }
 
+PlaceRecognizer::Node PlaceRecognizer::StoredNode(const KeyFrameNode& described) const {
+  Node node;
+  node.key.flight = described.flight;
+  node.key.timestamp_ns = described.timestamp_ns;
+  node.key.frame_index = described.frame_index;
+  node.key.points = described.points;
+  node.key.descriptors = described.descriptors;  // shared
+  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.key.descriptors);
+  return node;
+}
+
 int PlaceRecognizer::AddDescribedNode(const KeyFrameNode& described) {
-  Node node{described.flight, described.timestamp_ns, described.frame_index,
-            described.points, described.descriptors,  {}};
-  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
+  Node node = StoredNode(described);
   const int id = static_cast<int>(database_.Add(described.bow));
   nodes_.push_back(std::move(node));
   return id;
@@ -299,18 +309,21 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   }
   *result = PlaceResult();
   const auto start = std::chrono::steady_clock::now();
-  Node node{key_frame.flight, key_frame.timestamp_ns, key_frame.frame_index, {}, {}, {}};
-  DescribeFeatures(key_frame.image, options_, &node.points, &node.descriptors);
+  Node node;
+  node.key.flight = key_frame.flight;
+  node.key.timestamp_ns = key_frame.timestamp_ns;
+  node.key.frame_index = key_frame.frame_index;
+  DescribeFeatures(key_frame.image, options_, &node.key.points, &node.key.descriptors);
   vocab::BowVector bow;
   std::vector<vocab::WordId> words;
-  vocabulary_->Quantize(node.descriptors, &words);
+  vocabulary_->Quantize(node.key.descriptors, &words);
   vocab::MakeBowVector(words, vocabulary_->idf().data(), &bow);
   if (options_.direct_index_levels_up > 0) {
     for (vocab::WordId word : words)
       node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
   }
-  result->features = node.descriptors.rows;
-  node.descriptors = StoredDescriptors(node.descriptors, options_);
+  result->features = node.key.descriptors.rows;
+  node.key.descriptors = StoredDescriptors(node.key.descriptors, options_);
   result->seconds_features = Since(start);
   Recognise(key_frame, std::move(node), bow, result);
   return Status::Ok();
@@ -323,10 +336,8 @@ void PlaceRecognizer::AddDescribedKeyFrame(const KeyFrameNode& described, bool t
   key_frame.timestamp_ns = described.timestamp_ns;
   key_frame.frame_index = described.frame_index;
   key_frame.timed = timed;
-  Node node{described.flight, described.timestamp_ns, described.frame_index,
-            described.points, described.descriptors,  {}};
-  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.descriptors);
-  result->features = node.descriptors.rows;
+  Node node = StoredNode(described);
+  result->features = node.key.descriptors.rows;
   Recognise(key_frame, std::move(node), described.bow, result);
 }
 
@@ -343,7 +354,7 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   for (const vocab::QueryResult& candidate : candidates) {
     const Node& other = nodes_[candidate.entry];
     const bool direct = options_.direct_index_levels_up > 0;
-    Verification verification = Verify(node.points, node.descriptors, other.points, other.descriptors,
+    Verification verification = Verify(node.key.points, node.key.descriptors, other.key.points, other.key.descriptors,
                                        direct ? &node.groups : nullptr, direct ? &other.groups : nullptr);
     verification.node = static_cast<int>(candidate.entry);
     verification.bow_score = candidate.score;
@@ -357,11 +368,7 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   last_match_[key_frame.flight] = result->match ? result->match->node : -1;
   start = std::chrono::steady_clock::now();
   result->node = static_cast<int>(database_.Add(bow));
-  result->described.flight = node.flight;
-  result->described.timestamp_ns = node.timestamp_ns;
-  result->described.frame_index = node.frame_index;
-  result->described.points = node.points;
-  result->described.descriptors = node.descriptors;  // shared
+  result->described = node.key;  // the descriptors shared
   result->described.bow = bow;
   nodes_.push_back(std::move(node));
   result->seconds_add = Since(start);

@@ -169,14 +169,13 @@ class PlaceRecognizer {
                       const std::vector<std::uint32_t>* candidate_groups = nullptr) const;
 
  private:
+  // What the recognizer keeps of a node: its flight, time, frame and features (its BoW vector is the database's),
+  // with the direct-index node of each feature (when enabled).
   struct Node {
-    std::string flight;
-    TimestampNs timestamp_ns = 0;
-    std::int64_t frame_index = 0;
-    std::vector<cv::Point2f> points;
-    cv::Mat descriptors;
-    std::vector<std::uint32_t> groups;  // direct-index node of each feature (when enabled)
+    KeyFrameNode key;
+    std::vector<std::uint32_t> groups;
   };
+  Node StoredNode(const KeyFrameNode& described) const;  // a described node's, its groups re-quantised
   bool Allowed(const KeyFrame& query, int node) const;
   // Queries the database for `node`'s place, verifies the candidates, and adds it.
   void Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow, PlaceResult* result);
