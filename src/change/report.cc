@@ -219,6 +219,7 @@ ChangeItem ObjectItem(const ChangeReport& report, const graph::TopoMap& map, con
   item.confidence = o.confidence;
   item.position = o.after ? o.after : o.before;
   if (o.state == ObjectState::kMoved) item.from = o.before;
+  item.site_object = o.site_id;
   if (o.class_agnostic) {
     item.channels = {"geometry objects"};
     for (const Eigen::AlignedBox3d& box : {o.box_before, o.box_after}) {

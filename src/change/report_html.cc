@@ -112,6 +112,11 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   return out.str();
 }
 
+// A detected object's site object: the id it keeps across the map's patrols (`patrolmap history`).
+std::string SiteObject(const ChangeItem& item) {
+  return item.site_object >= 0 ? " \u00b7 site object " + std::to_string(item.site_object) : std::string();
+}
+
 // The channels that saw the change, in one line: each with how many findings it gave and the best one's confidence
 // (the findings themselves are in the row's tooltip and in changes.json).
 std::string SeenBy(const ChangeItem& item) {
@@ -150,9 +155,9 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
     *html << "<tr id='row-" << graph::EscapeXml(item.id) << "' data-id='" << graph::EscapeXml(item.id) << "' title='"
           << RowTitle(item) << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>"
           << item.number << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
-          << "</b>: " << graph::EscapeXml(item.label) << SeenBy(item) << "</td><td>" << Number(item.confidence)
-          << "</td><td>" << Where(item, geo) << "</td><td>" << Figure(item, true, images) << "</td><td>"
-          << Figure(item, false, images) << "</td></tr>\n";
+          << "</b>: " << graph::EscapeXml(item.label) << SiteObject(item) << SeenBy(item) << "</td><td>"
+          << Number(item.confidence) << "</td><td>" << Where(item, geo) << "</td><td>" << Figure(item, true, images)
+          << "</td><td>" << Figure(item, false, images) << "</td></tr>\n";
   }
   *html << "</table>\n";
 }

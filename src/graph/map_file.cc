@@ -26,8 +26,9 @@ constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
 // 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
 // 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
 // 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit;
-// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion; 11: the patrol's log and its digest
-constexpr std::uint32_t kVersion = 11;
+// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion; 11: the patrol's log and its digest;
+// 12: each object's site id
+constexpr std::uint32_t kVersion = 12;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 2048;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
@@ -291,6 +292,9 @@ void PatrolSection(const TopoMap& map, Writer* out) {
     for (double k : p.distortion) w.Value(k);
     w.String(p.source);
     w.String(p.source_digest);
+    std::vector<std::int32_t> site_ids;
+    for (const MapObject& o : p.objects) site_ids.push_back(o.site_id);
+    w.Vector(site_ids);
   }
 }
 
@@ -491,7 +495,7 @@ bool ValidObject(const MapObject& o) {
   });
   return o.centroid.allFinite() && o.box_min.allFinite() && o.box_max.allFinite() && Finite({o.confidence, o.height}) &&
          o.detections >= 0 && finite_points && finite_descriptor && finite_labels && ValidTimestamp(o.first_seen_ns) &&
-         ValidTimestamp(o.last_seen_ns);
+         ValidTimestamp(o.last_seen_ns) && o.site_id >= -1;
 }
 
 // A grid with voxels has a voxel size the grid options allow (change.grid.voxel_size_m, with slack).
@@ -566,6 +570,11 @@ Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, T
     if (version >= 10)
       for (double& k : p.distortion) k = r->Value<double>();
     if (version >= 11) p.source = r->String(), p.source_digest = r->String();
+    if (version >= 12) {
+      const std::vector<std::int32_t> site_ids = r->Vector<std::int32_t>();
+      if (site_ids.size() != p.objects.size() && !r->failed()) return Corrupt(path, "site objects of " + p.flight);
+      for (std::size_t k = 0; k < site_ids.size(); ++k) p.objects[k].site_id = site_ids[k];
+    }
     if (r->failed()) break;
     if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
     if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);

@@ -105,6 +105,10 @@ void TopoMap::SetPatrol(PatrolRecord record) {
   patrols_.push_back(std::move(record));
 }
 
+PatrolRecord* TopoMap::MutablePatrol(const std::string& flight) {
+  return const_cast<PatrolRecord*>(static_cast<const TopoMap*>(this)->Patrol(flight));
+}
+
 const PatrolRecord* TopoMap::Patrol(const std::string& flight) const {
   for (const PatrolRecord& record : patrols_) {
     if (record.flight == flight) return &record;

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include "patrolmap/change/change_detector.h"
+#include "patrolmap/change/site_objects.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -51,6 +52,22 @@ void LogPhases(const PatrolRecord& prior, const PatrolRecord& current, const cha
   }
 }
 
+// The site objects of `map`'s flight `current` carried from the flights before it (`before`, numbered first where
+// a map written before site ids left them without), by `report`, the comparison with the last of them; then the
+// report's object changes named by them.
+void CarrySiteObjects(const std::vector<std::string>& before, const std::string& current, change::ChangeReport* report,
+                      graph::TopoMap* map) {
+  int last = change::LargestSiteId(*map);
+  for (const std::string& flight : before) {
+    if (PatrolRecord* record = map->MutablePatrol(flight)) change::NumberSiteObjects(record, &last);
+  }
+  const PatrolRecord* prior = map->Patrol(before.back());
+  PatrolRecord* now = map->MutablePatrol(current);
+  if (prior == nullptr || now == nullptr) return;
+  change::CarrySiteObjects(*prior, *report, now, &last);
+  change::NameSiteObjects(*prior, *now, report);
+}
+
 }  // namespace
 
 Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const std::string& current,
@@ -68,6 +85,7 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   LogPhases(prior_record, current_record, options);
   const change::ChangeDetector detector(prior_record, options);
   detector.Compare(current_record, PlacesOf(map, prior_record, current_record), report);
+  change::NameSiteObjects(prior_record, current_record, report);
   if (report->geometry.poses_disagree) {
     spdlog::warn(
         "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed ({} of {}; more than "
@@ -79,14 +97,15 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   return Status::Ok();
 }
 
-Status ReportLastFlight(const graph::TopoMap& prior, const graph::TopoMap& map, const change::ChangeOptions& options,
+Status ReportLastFlight(const graph::TopoMap& prior, graph::TopoMap* map, const change::ChangeOptions& options,
                         const std::string& folder, change::ChangeReport* report, bool* compared,
                         std::vector<change::ChangeItem>* entries) {
-  const std::vector<std::string> before = prior.Flights(), after = map.Flights();
+  const std::vector<std::string> before = prior.Flights(), after = map->Flights();
   if (compared != nullptr) *compared = false;
   if (before.empty() || after.size() <= before.size()) return Status::Ok();
-  PATROLMAP_RETURN_IF_ERROR(CompareFlights(map, before.back(), after.back(), options, report));
-  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(*report, map, folder, entries));
+  PATROLMAP_RETURN_IF_ERROR(CompareFlights(*map, before.back(), after.back(), options, report));
+  CarrySiteObjects(before, after.back(), report, map);
+  PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(*report, *map, folder, entries));
   if (compared != nullptr) *compared = true;
   return Status::Ok();
 }

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "patrolmap/change/change_detector.h"
+#include "patrolmap/change/site_objects.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/flight_id.h"
 #include "patrolmap/graph/map_file.h"
@@ -270,8 +271,9 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   std::vector<change::ChangeItem> entries;
   if (!request.prior_map.empty()) {
     PATROLMAP_RETURN_IF_ERROR(
-        ReportLastFlight(prior, map, config.change, request.out, &outcome->report, &outcome->compared, &entries));
+        ReportLastFlight(prior, &map, config.change, request.out, &outcome->report, &outcome->compared, &entries));
   }
+  change::NumberAllSiteObjects(&map);
   if (monitor != nullptr && outcome->compared) {
     PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map, entries));
   }

@@ -87,6 +87,17 @@ Status LoadInputs(const MergeRequest& request, const vocab::Vocabulary& vocabula
   return Status::Ok();
 }
 
+// The site ids of a record of input map `map` in the merged map: numbered 1, 2, ... as they first appear in the
+// merge order, one input map's object keeping one id (an object of a map without site ids, a new one).
+void RenumberSiteObjects(int map, std::map<std::pair<int, int>, int>* site_ids, PatrolRecord* record) {
+  for (MapObject& o : record->objects) {
+    const int next = static_cast<int>(site_ids->size()) + 1;
+    // An object without a site id is one of its own: a key no other object has.
+    const std::pair<int, int> key = o.site_id >= 0 ? std::make_pair(map, o.site_id) : std::make_pair(map, -next);
+    o.site_id = site_ids->emplace(key, next).first->second;
+  }
+}
+
 // Recognises every node again in the merge order and builds the merged map.
 graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector<FlightPart>& parts,
                       const vocab::Vocabulary& vocabulary, const place::PlaceOptions& options,
@@ -95,6 +106,7 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
   graph::TopoMap merged;
   std::vector<int> map_of;                                    // input map of each merged node
   std::vector<std::pair<int, place::Verification>> closures;  // (query node, accepted verification)
+  std::map<std::pair<int, int>, int> site_ids;                // (input map, its site id) -> the merged map's
   std::int64_t total = 0;
   for (const FlightPart& part : parts) total += static_cast<std::int64_t>(part.nodes.size());
   for (const FlightPart& part : parts) {
@@ -119,6 +131,7 @@ graph::TopoMap Replay(const std::vector<graph::TopoMap>& maps, const std::vector
     if (part.record != nullptr) {
       PatrolRecord record = *part.record;
       record.flight = part.id;
+      RenumberSiteObjects(part.map, &site_ids, &record);
       merged.SetPatrol(std::move(record));
     }
   }

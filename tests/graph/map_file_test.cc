@@ -114,9 +114,9 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   EXPECT_NE(LoadBytes(flipped).find("corrupt map (checksum of section"), std::string::npos);
   EXPECT_NE(LoadBytes("%PDF-1.4 something else").find("not a patrolmap map file"), std::string::npos);
   std::string newer = bytes_;
-  const std::uint32_t version = 12;
+  const std::uint32_t version = 13;
   std::memcpy(newer.data() + 8, &version, 4);
-  EXPECT_NE(LoadBytes(newer).find("version 12 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(newer).find("version 13 is newer"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
   // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
   TopoMap unsorted = TwoFlights();
@@ -262,11 +262,13 @@ void DowngradeFeatures(std::string* bytes) {
 }
 
 // The map file of `map` as an older version wrote it: the last `dropped` bytes of the one patrol record (its
-// newest fields up to format 10) cut off, and before format 11 also its log and digest (two empty strings: 8 bytes).
+// newest fields up to format 10) cut off, before format 11 also its log and digest (two empty strings: 8 bytes),
+// and before format 12 its objects' site ids.
 std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std::uint32_t version,
                                std::uint64_t dropped) {
   EXPECT_EQ(map.Patrol("b")->source + map.Patrol("b")->source_digest, "");
   if (version < 11) dropped += 8;
+  if (version < 12) dropped += 4 + 4 * map.Patrol("b")->objects.size();  // the objects' site ids
   EXPECT_TRUE(SaveMap(map, path).ok());
   std::string bytes = testing::ReadText(path);
   const std::size_t tag = bytes.find("PTRL", 16);
@@ -491,6 +493,27 @@ TEST(MapFile, ThePatrolsLogRoundTripsAndADamagedOneIsRefused) {
     ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
     EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("log of b"), std::string::npos);
   }
+}
+
+// Objects keep their site ids (format 12); a version-11 map's objects have none yet, and an id below -1 is refused.
+TEST(MapFile, SiteIdsRoundTripAndOlderObjectsHaveNone) {
+  testing::TempDir dir;
+  TopoMap map = TwoFlights();
+  std::ofstream(dir / "v11.pmap", std::ios::binary) << OlderPatrolSection(map, dir / "m.pmap", 11, 0);
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "v11.pmap", &loaded).ok()) << LoadMap(dir / "v11.pmap", &loaded).message();
+  ASSERT_FALSE(loaded.Patrol("b")->objects.empty());
+  EXPECT_EQ(loaded.Patrol("b")->objects[0].site_id, -1);
+  PatrolRecord record = *map.Patrol("b");
+  record.objects[0].site_id = 17;
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  EXPECT_EQ(loaded.Patrol("b")->objects[0].site_id, 17);
+  record.objects[0].site_id = -2;
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("object"), std::string::npos);
 }
 
 // Feature positions must be finite, and descriptors one of the stored kinds (vocab/descriptors.h).

@@ -21,5 +21,6 @@ Command AddInfoCommand(CLI::App* app);
 Command AddExportCommand(CLI::App* app);
 Command AddDiffCommand(CLI::App* app);
 Command AddMergeCommand(CLI::App* app);
+Command AddHistoryCommand(CLI::App* app);
 
 }  // namespace patrolmap::tools

@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
       patrolmap::tools::AddDiffCommand);
   add("export", "write a map for other tools: GraphML, DOT, JSON, SVG, an HTML viewer, GeoJSON or KML",
       patrolmap::tools::AddExportCommand);
+  add("history", "the site's objects over the map's patrols: first seen, moved, gone, back",
+      patrolmap::tools::AddHistoryCommand);
   add("vocab", "vocabulary tools: vocab build", patrolmap::tools::AddVocabCommand);
   add("eval", "score a run against a simulated log's ground truth", patrolmap::tools::AddEvalCommand);
   if (UnknownCommand(app, argc, argv) || UnknownOption(app, argc, argv)) return 2;

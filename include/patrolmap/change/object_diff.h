@@ -50,6 +50,7 @@ struct ObjectChange {
   // extent of the changed voxels where it was and where it is (empty boxes where it is not).
   bool class_agnostic = false;
   Eigen::AlignedBox3d box_before, box_after;
+  int site_id = -1;  // the site object it concerns (change/site_objects.h); -1 for none
 };
 
 // The appearance terms between two objects, each in [0, 1] and present when both have it: texture (half

@@ -94,6 +94,7 @@ struct ChangeItem {
   double confidence = 0.0;  // in [0, 1]
   std::optional<Eigen::Vector3d> position;  // world frame [m]; none without poses, or for a bearing
   std::optional<Eigen::Vector3d> from;      // moved objects: the prior position
+  int site_object = -1;                     // detected objects: the site object (change/site_objects.h); -1 for none
   // Appearance: how its position was found ("depth", "grid", "triangulated", or "bearing" with no position: the
   // ray from the camera it lies on; "none" without poses). Empty for objects and geometry, placed by 3D evidence.
   std::string located;

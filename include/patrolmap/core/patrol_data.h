@@ -47,6 +47,9 @@ struct MapObject {
   };
   std::vector<LabelEvidence> labels;
   TimestampNs first_seen_ns = 0, last_seen_ns = 0;
+  // The site object it is: one id for the same physical object across a map's patrols (change/site_objects.h);
+  // -1 until numbered.
+  int site_id = -1;
 };
 
 // Hit and pass counts of one voxel of an evidence grid (paper 004).

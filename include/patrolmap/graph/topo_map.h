@@ -65,6 +65,7 @@ class TopoMap {
   // views); at most one record per flight, replaced when set again.
   void SetPatrol(PatrolRecord record);
   const PatrolRecord* Patrol(const std::string& flight) const;  // nullptr when the flight has none
+  PatrolRecord* MutablePatrol(const std::string& flight);
   const std::vector<PatrolRecord>& patrols() const { return patrols_; }
 
   // The vocabulary the nodes' bag-of-words vectors were made with (Vocabulary::Fingerprint, and the file

@@ -20,8 +20,8 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
 // A patrol's change report: between the last flight of `prior` and the last flight of `map` (which extends
 // `prior`), written to DIR/changes.json and DIR/changes.html. `compared` (may be null) is false, and nothing
 // is written, when `map` adds no flight to a prior that has one. `entries` (may be null) receives the report's
-// change list.
-Status ReportLastFlight(const graph::TopoMap& prior, const graph::TopoMap& map, const change::ChangeOptions& options,
+// change list. The last flight's objects take their site ids (change/site_objects.h) from the comparison.
+Status ReportLastFlight(const graph::TopoMap& prior, graph::TopoMap* map, const change::ChangeOptions& options,
                         const std::string& folder, change::ChangeReport* report, bool* compared = nullptr,
                         std::vector<change::ChangeItem>* entries = nullptr);
 
