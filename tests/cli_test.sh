@@ -46,6 +46,9 @@ expect "map sample" 0 "1 log: 3 nodes" -- \
   "$bin" map "$source_dir/flight_logs/sample" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/map"
 [[ -s "$work/map/nodes.csv" && -s "$work/map/loop_closures.csv" ]] || { echo "FAIL map outputs missing"; failures=$((failures + 1)); }
 expect "info" 0 "map.pmap: .* KB, 1 flight, 3 nodes, 2 traversals" -- "$bin" info "$work/map/map.pmap"
+expect "history without objects" 0 "no site object" -- "$bin" history "$work/map/map.pmap"
+expect "history of an unknown flight" 1 "map.pmap: flight 'nope' is not in the map" -- \
+  "$bin" history "$work/map/map.pmap" --from nope
 # An image folder has no calibration of its own: --camera gives it one (a EuRoC sensor.yaml); a wrong one is named.
 printf 'intrinsics: [97.4, 97.4, 79.5, 50.6]\nresolution: [320, 204]\n' >"$work/cam_wrong.yaml"
 expect "camera file of another size" 1 "cam_wrong.yaml: resolution 320x204, but .*0.png is 160x102" -- \

@@ -478,3 +478,31 @@ TEST(ChangeScore, TheChangeListIsScoredPerEntryOverAllAndObservableChanges) {
 
 }  // namespace
 }  // namespace patrolmap::eval
+
+namespace patrolmap::eval {
+namespace {
+
+// Object 1 kept its site id over three patrols, object 2 took a new one at the third; site id 9 was given to two
+// true objects. A map object is its label's true object whose box holds it.
+TEST(SiteIds, KeptChangedAndMergedIdsAcrossPatrols) {
+  const SiteIdScore score = ScoreSiteIds({{{5, 1}, {6, 2}, {9, 3}}, {{5, 1}, {6, 2}, {9, 4}}, {{5, 1}, {7, 2}}});
+  EXPECT_EQ(score.tracked, 4);  // 1 and 2 from the first to the second, and from the second to the third
+  EXPECT_EQ(score.kept, 3);
+  EXPECT_EQ(score.changed, 1);
+  EXPECT_EQ(score.merged, 1);
+  EXPECT_DOUBLE_EQ(score.Persistence(), 0.75);
+  TruthObject crate;
+  crate.id = 4;
+  crate.label = "crate";
+  crate.centre = Eigen::Vector2d(10.0, 0.0);
+  crate.length = crate.width = crate.height = 1.0;
+  MapObject seen;
+  seen.label = "crate";
+  seen.centroid = Eigen::Vector3d(10.3, 0.2, 0.5);
+  EXPECT_EQ(TruthIdOf(seen, {crate}, ChangeScoreOptions()), 4);
+  seen.label = "barrel";
+  EXPECT_EQ(TruthIdOf(seen, {crate}, ChangeScoreOptions()), -1);
+}
+
+}  // namespace
+}  // namespace patrolmap::eval

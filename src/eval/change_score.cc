@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <unordered_map>
 
 #include "patrolmap/core/csv.h"
@@ -606,6 +607,45 @@ ObjectChangeTotals TotalObjectChanges(const ObjectChangeScore& score, const std:
     if (change.observable) (found ? totals.observable.true_positives : totals.observable.false_negatives) += 1;
   }
   return totals;
+}
+
+double SiteIdScore::Persistence() const { return tracked > 0 ? static_cast<double>(kept) / tracked : 1.0; }
+
+int TruthIdOf(const MapObject& object, const std::vector<TruthObject>& truth, const ChangeScoreOptions& options) {
+  int best = -1;
+  double nearest = 0.0;
+  for (const TruthObject& t : truth) {
+    if (t.label != object.label || !t.Contains(object.centroid, options.distance_m)) continue;
+    const double d = (object.centroid.head<2>() - t.centre).norm();
+    if (best < 0 || d < nearest) best = t.id, nearest = d;
+  }
+  return best;
+}
+
+SiteIdScore ScoreSiteIds(const std::vector<std::vector<std::pair<int, int>>>& patrols) {
+  SiteIdScore score;
+  std::map<int, std::set<int>> truths_of_site;
+  for (std::size_t p = 0; p < patrols.size(); ++p) {
+    std::map<int, int> site_of_truth;  // this patrol's
+    for (const auto& [site, truth] : patrols[p]) {
+      if (site < 0 || truth < 0) continue;
+      truths_of_site[site].insert(truth);
+      site_of_truth.emplace(truth, site);
+    }
+    if (p == 0) continue;
+    std::map<int, int> before;
+    for (const auto& [site, truth] : patrols[p - 1]) {
+      if (site >= 0 && truth >= 0) before.emplace(truth, site);
+    }
+    for (const auto& [truth, site] : site_of_truth) {
+      const auto was = before.find(truth);
+      if (was == before.end()) continue;
+      ++score.tracked;
+      (was->second == site ? score.kept : score.changed) += 1;
+    }
+  }
+  for (const auto& [site, truths] : truths_of_site) score.merged += truths.size() > 1;
+  return score;
 }
 
 }  // namespace patrolmap::eval

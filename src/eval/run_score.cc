@@ -413,6 +413,30 @@ Status ScoreRecomputed(const graph::TopoMap& map, const std::string& prior, cons
   return Status::Ok();
 }
 
+// Site ids over the patrols of `map` whose flights `logs` hold, in the order flown (ScoreSiteIds).
+Status ScoreSiteObjectsOf(const graph::TopoMap& map, const std::vector<TruthLog>& logs,
+                          const ChangeScoreOptions& options, nlohmann::json* result) {
+  std::vector<std::vector<std::pair<int, int>>> patrols;
+  for (const std::string& flight : map.Flights()) {
+    const PatrolRecord* record = map.Patrol(flight);
+    const auto log =
+        std::find_if(logs.begin(), logs.end(), [&](const TruthLog& l) { return l.info.flight_id == flight; });
+    if (record == nullptr || !record->has_objects || log == logs.end()) continue;
+    std::vector<TruthObject> truth;
+    PATROLMAP_RETURN_IF_ERROR(ReadTruthObjects(log->path, &truth));
+    patrols.emplace_back();
+    for (const MapObject& o : record->objects) {
+      if (o.confirmed) patrols.back().emplace_back(o.site_id, TruthIdOf(o, truth, options));
+    }
+  }
+  if (patrols.size() < 2) return Status::Ok();
+  const SiteIdScore score = ScoreSiteIds(patrols);
+  (*result)["site_objects"] = {{"patrols", patrols.size()}, {"tracked", score.tracked},
+                               {"kept", score.kept},        {"changed", score.changed},
+                               {"merged", score.merged},    {"persistence", score.Persistence()}};
+  return Status::Ok();
+}
+
 // Changes of RUN (changes.json, and the map.pmap beside it) against the two flights' ground truth.
 Status EvaluateChanges(const std::string& run, const RunScoreOptions& options, const std::vector<TruthLog>& logs,
                        nlohmann::json* report) {
@@ -449,6 +473,7 @@ Status EvaluateChanges(const std::string& run, const RunScoreOptions& options, c
   }
   if (has_map) {
     result["entries"] = EntriesJson(ScoreEntries(ReportedEntries(file), truth, options.changes));
+    PATROLMAP_RETURN_IF_ERROR(ScoreSiteObjectsOf(map, logs, options.changes, &result));
     PATROLMAP_RETURN_IF_ERROR(ScoreRecomputed(map, prior, current, before, after, options, &result));
   }
   (*report)["changes"] = result;

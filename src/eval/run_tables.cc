@@ -87,6 +87,14 @@ void PrintChangeTable(const nlohmann::json& c, std::string* out) {
         Score(e["recall_observable"].get<double>(), e["observable"].get<int>() > 0, 0).c_str(),
         Score(e["f1_observable"].get<double>(), placed > 0, 0).c_str());
   }
+  if (c.contains("site_objects")) {
+    const nlohmann::json& s = c["site_objects"];
+    *out += fmt::sprintf(
+        "site objects: over %d patrols, %d of %d true objects seen in consecutive patrols kept their id (%d changed); "
+        "%d ids held more than one true object\n",
+        s["patrols"].get<int>(), s["kept"].get<int>(), s["tracked"].get<int>(), s["changed"].get<int>(),
+        s["merged"].get<int>());
+  }
   if (c.contains("geometry")) {
     PrintCounts("voxels", c["geometry"], out);
     *out += fmt::sprintf("geometry: IoU %.2f over %lld voxels observed in both flights, %d regions\n",

@@ -277,4 +277,18 @@ struct ObjectChangeTotals {
 };
 ObjectChangeTotals TotalObjectChanges(const ObjectChangeScore& score, const std::vector<TrueChange>& truth);
 
+// Site objects (change/site_objects.h) against the truth: a map object is the true object of its label whose box
+// (grown by distance_m) holds its centroid, the nearest first. Over consecutive patrols that both had detections,
+// a true object both gave a map object to is tracked: kept when both carry one site id, else its id changed. A
+// site id given to two true objects in one series merged them.
+struct SiteIdScore {
+  int tracked = 0, kept = 0, changed = 0;
+  int merged = 0;              // site ids held by more than one true object
+  double Persistence() const;  // kept / tracked (1 with none tracked)
+};
+// The true object `object` is, among `truth` (its flight's); -1 for none.
+int TruthIdOf(const MapObject& object, const std::vector<TruthObject>& truth, const ChangeScoreOptions& options);
+// `patrols`: per patrol with detections, in the order flown, its objects' (site id, true id) pairs.
+SiteIdScore ScoreSiteIds(const std::vector<std::vector<std::pair<int, int>>>& patrols);
+
 }  // namespace patrolmap::eval
