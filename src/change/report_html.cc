@@ -114,7 +114,9 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
 
 // A detected object's site object: the id it keeps across the map's patrols (`patrolmap history`).
 std::string SiteObject(const ChangeItem& item) {
-  return item.site_object >= 0 ? " \u00b7 site object " + std::to_string(item.site_object) : std::string();
+  if (item.site_object < 0) return std::string();
+  const std::string id = std::to_string(item.site_object);
+  return " \u00b7 <a href='#site-" + id + "'>site object " + id + "</a>";
 }
 
 // The channels that saw the change, in one line: each with how many findings it gave and the best one's confidence
@@ -210,6 +212,29 @@ void ObjectTable(const ChangeReport& report, std::ostringstream* html) {
           << "</td><td>" << Reason(o) << "</td></tr>\n";
   }
   *html << "</table></section>\n";
+}
+
+// Each site object the report's object changes concern, with its history over the map's patrols; the rows link here.
+void SiteObjectTimelines(const ChangeReport& report, std::ostringstream* html) {
+  if (report.site_objects.empty()) return;
+  const auto where = [](const std::optional<Eigen::Vector3d>& p) {
+    return p ? "(" + Number(p->x(), 1) + ", " + Number(p->y(), 1) + ")" : std::string();
+  };
+  *html << "<section class='more'><h2>Site objects</h2><p>Each object keeps its id across the map's patrols "
+           "(<code>patrolmap history</code>).</p>\n";
+  for (const SiteObjectHistory& h : report.site_objects) {
+    *html << "<h3 id='site-" << h.id << "'>site object " << h.id << ": " << graph::EscapeXml(h.label) << "</h3><ol>";
+    for (const SiteEvent& e : h.events) {
+      *html << "<li>patrol " << e.patrol << " (" << graph::EscapeXml(e.flight) << "): " << e.what;
+      if (e.from && e.to)
+        *html << " from " << where(e.from) << " to " << where(e.to);
+      else
+        *html << " at " << where(e.to ? e.to : e.from);
+      *html << "</li>";
+    }
+    *html << "</ol>\n";
+  }
+  *html << "</section>\n";
 }
 
 const char* DepthWords(const std::string& source) {
@@ -313,6 +338,7 @@ std::string ToHtml(const ChangeReport& report, const graph::TopoMap& map, const 
     ChangeRows(items, geo, images, &html);
   html << "</section>\n</main>\n";
   if (report.objects_compared) ObjectTable(report, &html);
+  SiteObjectTimelines(report, &html);
   html << "<script>" << kScript << "</script>\n</body></html>\n";
   return html.str();
 }

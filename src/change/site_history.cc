@@ -88,4 +88,14 @@ Status SiteHistory(const graph::TopoMap& map, const ObjectDiffOptions& options, 
   return Status::Ok();
 }
 
+std::vector<SiteObjectHistory> SiteHistoriesOf(const graph::TopoMap& map, const ObjectDiffOptions& options,
+                                               const std::vector<int>& site_ids) {
+  std::vector<SiteObjectHistory> all, wanted;
+  if (!SiteHistory(map, options, {}, &all).ok()) return wanted;  // the whole map: no flight to miss
+  for (const SiteObjectHistory& h : all) {
+    if (std::find(site_ids.begin(), site_ids.end(), h.id) != site_ids.end()) wanted.push_back(h);
+  }
+  return wanted;
+}
+
 }  // namespace patrolmap::change

@@ -82,7 +82,7 @@ int RunHistory(HistoryArguments arguments) {
 Command AddHistoryCommand(CLI::App* app) {
   auto arguments = std::make_shared<HistoryArguments>();
   app->add_option("map", arguments->map, "map file (map.pmap)")->required();
-  app->add_option("--object", arguments->filter.object, "one site object, by its id");
+  app->add_option("--object", arguments->filter.object, "one site object, by its id")->check(CLI::Range(0, 1 << 30));
   app->add_option("--near", arguments->near, "objects last seen near this place: east north [m], in the map's frame")
       ->expected(2)
       ->check(FiniteRange(-1e7, 1e7));

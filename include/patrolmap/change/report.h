@@ -23,6 +23,7 @@
 #include "patrolmap/change/geo_reference.h"
 #include "patrolmap/change/object_diff.h"
 #include "patrolmap/change/route_compare.h"
+#include "patrolmap/change/site_history.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/graph/topo_map.h"
 
@@ -44,6 +45,8 @@ struct ChangeReport {
   GeometryChange geometry;
   std::string pose_prior, pose_current;  // where each patrol's camera poses came from (PatrolRecord::pose_source)
   double seconds_appearance = 0.0, seconds_objects = 0.0, seconds_geometry = 0.0;
+  // The histories of the site objects its object changes concern, over the map's patrols (SiteHistoriesOf).
+  std::vector<SiteObjectHistory> site_objects;
 
   int ChangedPlaces() const;
   int ObjectsIn(ObjectState state) const;

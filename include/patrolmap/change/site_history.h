@@ -44,4 +44,8 @@ struct SiteHistoryFilter {
 Status SiteHistory(const graph::TopoMap& map, const ObjectDiffOptions& options, const SiteHistoryFilter& filter,
                    std::vector<SiteObjectHistory>* history);
 
+// The histories (all of `map`'s patrols) of the site objects `site_ids` name, by id; ids below 0 are skipped.
+std::vector<SiteObjectHistory> SiteHistoriesOf(const graph::TopoMap& map, const ObjectDiffOptions& options,
+                                               const std::vector<int>& site_ids);
+
 }  // namespace patrolmap::change
