@@ -108,7 +108,8 @@ Command AddDiffCommand(CLI::App* app) {
   app->footer(
       "Compares the two flights: appearance at every place both saw (their loop closures), objects when both "
       "logs had detections, geometry when both had depth. Writes OUT/changes.json (format "
-      "patrolmap.changes/1, docs/changes.schema.json) and OUT/changes.html.");
+      "patrolmap.changes, version 2: docs/changes.schema.json), OUT/changes.html, and with GPS OUT/changes.geojson and "
+      "OUT/changes.kml.");
   return [arguments] { return RunDiff(*arguments); };
 }
 
