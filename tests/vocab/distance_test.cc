@@ -1,33 +1,20 @@
 #include "../src/vocab/distance.h"
 
-#include <algorithm>
-#include <cstring>
-#include <random>
-#include <vector>
-
 #include <gtest/gtest.h>
+
+#include "vocab/distance_cases.h"
 
 namespace patrolmap::vocab {
 namespace {
+
+using testing_cases::ByteDistanceMismatches;
+using testing_cases::FloatDistanceMismatches;
 
 // The AVX2 build of the quantiser's distance gives the portable build's value to the bit (so words do not
 // depend on the processor), for SIFT's 128 components and for a dimension with a tail.
 TEST(QuantiserDistance, Avx2GivesThePortableValueToTheBit) {
   if (!Avx2Available()) GTEST_SKIP() << "no AVX2 build, or no AVX2 on this processor";
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> value(0.0f, 255.0f);
-  std::uniform_int_distribution<int> byte(0, 255);
-  for (const int dimension : {128, 131, 7}) {
-    for (int trial = 0; trial < 2000; ++trial) {
-      std::vector<float> a(dimension);
-      std::vector<std::uint8_t> b(dimension);
-      for (float& x : a) x = value(rng) * (trial % 2 == 0 ? 1.0f : 1e-3f);
-      for (std::uint8_t& x : b) x = static_cast<std::uint8_t>(byte(rng));
-      const float portable = SquaredDistanceTo8Bit(a.data(), b.data(), dimension);
-      const float avx2 = kSquaredDistanceTo8BitAvx2(a.data(), b.data(), dimension);
-      ASSERT_EQ(std::memcmp(&portable, &avx2, sizeof(float)), 0) << dimension << ": " << portable << " vs " << avx2;
-    }
-  }
+  EXPECT_EQ(FloatDistanceMismatches(kSquaredDistanceTo8BitAvx2), 0);
   EXPECT_EQ(FastestDistance(), kSquaredDistanceTo8BitAvx2);
 }
 
@@ -35,19 +22,27 @@ TEST(QuantiserDistance, Avx2GivesThePortableValueToTheBit) {
 // to the largest possible distance.
 TEST(MatcherDistance, Avx2GivesThePortableSum) {
   if (!Avx2Available()) GTEST_SKIP() << "no AVX2 build, or no AVX2 on this processor";
-  std::mt19937 rng(9);
-  std::uniform_int_distribution<int> byte(0, 255);
-  std::vector<std::uint8_t> a(kDescriptorDimension), b(kDescriptorDimension);
-  for (int trial = 0; trial < 2000; ++trial) {
-    for (std::size_t k = 0; k < a.size(); ++k)
-      a[k] = static_cast<std::uint8_t>(byte(rng)), b[k] = static_cast<std::uint8_t>(byte(rng));
-    ASSERT_EQ(kSquaredByteDistanceAvx2(a.data(), b.data()), SquaredByteDistance(a.data(), b.data()));
-  }
-  std::fill(a.begin(), a.end(), 0), std::fill(b.begin(), b.end(), 255);
-  EXPECT_EQ(SquaredByteDistance(a.data(), b.data()), 128u * 255u * 255u);
-  EXPECT_EQ(kSquaredByteDistanceAvx2(a.data(), b.data()), 128u * 255u * 255u);
-  EXPECT_EQ(kSquaredByteDistanceAvx2(a.data(), a.data()), 0u);
+  EXPECT_EQ(ByteDistanceMismatches(kSquaredByteDistanceAvx2), 0);
   EXPECT_EQ(FastestByteDistance(), kSquaredByteDistanceAvx2);
+}
+
+// On arm64 the NEON builds do the same (scripts/cross_arm64.sh runs these cases under qemu from any machine).
+TEST(Distances, NeonGivesThePortableValuesOnArm64) {
+  if (kSquaredDistanceTo8BitNeon == nullptr) GTEST_SKIP() << "not an arm64 build";
+  EXPECT_EQ(FloatDistanceMismatches(kSquaredDistanceTo8BitNeon), 0);
+  EXPECT_EQ(ByteDistanceMismatches(kSquaredByteDistanceNeon), 0);
+  EXPECT_EQ(FastestDistance(), kSquaredDistanceTo8BitNeon);
+  EXPECT_EQ(FastestByteDistance(), kSquaredByteDistanceNeon);
+}
+
+// The portable loops themselves, against sums written out by hand.
+TEST(Distances, ThePortableLoopsSumTheSquaredDifferences) {
+  const float a[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9.5f};
+  const std::uint8_t b[9] = {0, 0, 0, 0, 0, 0, 0, 0, 9};
+  EXPECT_FLOAT_EQ(SquaredDistanceTo8Bit(a, b, 9), 1 + 4 + 9 + 16 + 25 + 36 + 49 + 64 + 0.25f);
+  std::uint8_t x[kDescriptorDimension] = {}, y[kDescriptorDimension] = {};
+  x[0] = 3, y[127] = 4;
+  EXPECT_EQ(SquaredByteDistance(x, y), 25u);
 }
 
 }  // namespace
