@@ -8,6 +8,20 @@
 #endif
 
 namespace patrolmap::vocab {
+namespace {
+
+// The eight lanes' partial sums added in a fixed order, then the tail from component `d` on, one at a time: every
+// build of the quantiser's distance ends so.
+float SumOfLanes(const float (&lanes)[8], const float* a, const std::uint8_t* b, int d, int dimension) {
+  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
+  for (; d < dimension; ++d) {
+    const float difference = a[d] - static_cast<float>(b[d]);
+    sum += difference * difference;
+  }
+  return sum;
+}
+
+}  // namespace
 
 // Eight independent partial sums, so the compiler keeps them in vector registers (a single running float sum
 // is a dependency chain it may not reorder); the tail, when the dimension is not a multiple of 8, runs alone.
@@ -21,12 +35,7 @@ float SquaredDistanceTo8Bit(const float* a, const std::uint8_t* b, int dimension
       lanes[l] += difference * difference;
     }
   }
-  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
-  for (; d < dimension; ++d) {
-    const float difference = a[d] - static_cast<float>(b[d]);
-    sum += difference * difference;
-  }
-  return sum;
+  return SumOfLanes(lanes, a, b, d, dimension);
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -45,12 +54,7 @@ __attribute__((target("avx2"))) float SquaredDistanceTo8BitAvx2(const float* a, 
   }
   float lanes[8];
   _mm256_storeu_ps(lanes, sums);
-  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
-  for (; d < dimension; ++d) {
-    const float difference = a[d] - static_cast<float>(b[d]);
-    sum += difference * difference;
-  }
-  return sum;
+  return SumOfLanes(lanes, a, b, d, dimension);
 }
 
 }  // namespace
@@ -82,12 +86,7 @@ float SquaredDistanceTo8BitNeon(const float* a, const std::uint8_t* b, int dimen
   float lanes[8];
   vst1q_f32(lanes, low);
   vst1q_f32(lanes + 4, high);
-  float sum = ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5])) + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]));
-  for (; d < dimension; ++d) {
-    const float difference = a[d] - static_cast<float>(b[d]);
-    sum += difference * difference;
-  }
-  return sum;
+  return SumOfLanes(lanes, a, b, d, dimension);
 }
 
 }  // namespace
