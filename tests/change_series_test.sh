@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Change detection end to end on simulated patrol series (issue 6):
+# Change detection end to end on simulated patrol series:
 #  - two L-shaped flights with objects added, removed and moved between them, object detections and depth:
 #    `map`, then `patrol` writes changes.json and changes.html; `eval` scores them against the ground truth;
 #  - `diff` on the patrol's map repeats the patrol's report;

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fleet scale (issue 17): maps built apart and merged equal one map over all the logs, whatever the grouping and
+# Fleet scale: maps built apart and merged equal one map over all the logs, whatever the grouping and
 # order of the merges; the fleet scripts run it with GNU parallel and on a real single-node Slurm cluster
 # started on localhost (each skipped with a message where it is not installed); bad merges are named.
 # Usage: fleet_test.sh PATROLMAP_BINARY SOURCE_DIR

@@ -333,7 +333,8 @@ INSTANTIATE_TEST_SUITE_P(OpencvDoc, RealUnchangedPair,
 
 // Real revisits of one unchanged room (the shared EuRoC pairs, 752x480, a MAV seen from two viewpoints), at the route
 // frames' width, each pair both ways round: with both_ways, none gives a region. (With the defaults, left_img_3
-// against left_img_2 gives two, on furniture and a wall seen with parallax: BENCHMARKS.md, session 25.)
+// against left_img_2 gives two, on furniture and a wall seen with parallax: BENCHMARKS.md, "Appearance along the
+// route".)
 TEST(RouteCompare, RealEurocRevisitsGiveNoRegionWithBothWays) {
   const std::string folder = std::string(PATROLMAP_SOURCE_DIR) + "/../shared/data/euroc_revisit_pairs/";
   if (!std::filesystem::exists(folder)) GTEST_SKIP() << "shared EuRoC pairs not present";

@@ -605,7 +605,7 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
-// A damaged map behind good checksums (paper-free rule of issue 18): truncated at 64 offsets, and 200
+// A damaged map behind good checksums (rules no paper gives): truncated at 64 offsets, and 200
 // single-bit flips with the checksums recomputed (fixed seed). Each file loads the same way twice and then
 // survives a save and every export, or fails with a message that names it.
 TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {

@@ -90,7 +90,7 @@ namespace patrolmap::vocab {
 namespace {
 
 // The words of the shipped vocabulary for 4,000 RootSIFT-like descriptors (cv::RNG, the same on every machine),
-// folded into one number: a faster Quantize must give the same words (issue 17), and a map built before it must
+// folded into one number: a faster Quantize must give the same words, and a map built before it must
 // still be matched as it was built.
 TEST(Vocabulary, ShippedVocabularyGivesTheSameWords) {
   Vocabulary vocabulary;

@@ -39,7 +39,8 @@ struct AppearanceOptions {
   int max_planes = 1;
   // Also search each pixel's prior window in the current image, and require a region's content to be found
   // shifted both ways before it counts as parallax: finds objects that left as well as objects that came. Off:
-  // a face lit in one flight and in shade in the other then gives regions too (BENCHMARKS.md, session 25).
+  // a face lit in one flight and in shade in the other then gives regions too (BENCHMARKS.md, "Appearance along the
+  // route").
   bool both_ways = false;
 };
 

@@ -1,4 +1,4 @@
-// Appearance change along the whole route (issue 15): every frame a patrol kept along its route
+// Appearance change along the whole route: every frame a patrol kept along its route
 // (PatrolRecord::route) is aligned to the frame of the prior patrol's route that shows the same place, and
 // every aligned pair is compared (DetectAppearanceChange). A region is reported when consecutive aligned
 // pairs agree on it.

@@ -1,4 +1,4 @@
-// Depth along the route (issue 15): a route frame with a pose gets depth by semi-global matching against the frames
+// Depth along the route: a route frame with a pose gets depth by semi-global matching against the frames
 // before and after it in its own patrol (motion stereo; depth::StereoDepth with the pair's relative pose as its
 // calibration). Both frames come from one flight, so they share the light, and depth tells what brightness cannot: a
 // small face lit otherwise from a small object.

@@ -1,4 +1,4 @@
-// Merging maps built apart (issue 17: a fleet's logs mapped on many machines): `patrolmap merge`.
+// Merging maps built apart (a fleet's logs mapped on many machines): `patrolmap merge`.
 //
 // The merged map is the map one `patrolmap map` over all their logs would build, with the logs in the merge
 // order: by each flight's start (its first route frame, else its first node), then by flight id (natural order). Each
