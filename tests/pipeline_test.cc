@@ -1006,3 +1006,60 @@ TEST(MapEndToEnd, SecondFlightClosesLoopsAgainstTheFirst) {
 
 }  // namespace
 }  // namespace patrolmap::pipeline
+
+#include "patrolmap/pipeline/merge.h"
+
+namespace patrolmap::pipeline {
+namespace {
+
+// A map of flights (patrol records only) whose objects carry `site_ids`, one list per flight; flight i starts at
+// time `start` + i.
+graph::TopoMap SiteMap(const std::vector<std::string>& flights, const std::vector<std::vector<int>>& site_ids,
+                       TimestampNs start) {
+  graph::TopoMap map;
+  for (std::size_t f = 0; f < flights.size(); ++f) {
+    PatrolRecord record;
+    record.flight = flights[f];
+    record.has_objects = true;
+    RouteFrame frame;
+    frame.timestamp_ns = start + static_cast<TimestampNs>(f);
+    cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC1, cv::Scalar(90)), frame.jpeg);
+    record.route.push_back(frame);
+    for (const int id : site_ids[f]) {
+      MapObject o;
+      o.id = id;
+      o.label = "crate";
+      o.site_id = id;
+      record.objects.push_back(o);
+    }
+    map.SetPatrol(record);
+  }
+  return map;
+}
+
+// Merged maps number site objects 1, 2, ... in the merge order: one input map's object (the same id in two of its
+// patrols) keeps one id, and objects of different maps never share one.
+TEST(Merge, SiteObjectsAreRenumberedInTheMergeOrderOneMapsObjectKeepingOneId) {
+  testing::TempDir dir;
+  ASSERT_TRUE(graph::SaveMap(SiteMap({"a1", "a2"}, {{1, 2}, {2, 3}}, 100), dir / "a.pmap").ok());
+  ASSERT_TRUE(graph::SaveMap(SiteMap({"b1"}, {{1}}, 50), dir / "b.pmap").ok());
+  MergeRequest request;
+  request.maps = {dir / "a.pmap", dir / "b.pmap"};
+  request.out = dir / "merged";
+  request.vocabulary_path = std::string(PATROLMAP_SOURCE_DIR) + "/vocab/default.pmvoc";
+  MergeOutcome outcome;
+  ASSERT_TRUE(RunMerge(request, &outcome).ok());
+  graph::TopoMap merged;
+  ASSERT_TRUE(graph::LoadMap(dir / "merged/map.pmap", &merged).ok());
+  const auto ids = [&](const std::string& flight) {
+    std::vector<int> sites;
+    for (const MapObject& o : merged.Patrol(flight)->objects) sites.push_back(o.site_id);
+    return sites;
+  };
+  EXPECT_EQ(ids("b1"), std::vector<int>({1}));  // b1 started first
+  EXPECT_EQ(ids("a1"), std::vector<int>({2, 3}));
+  EXPECT_EQ(ids("a2"), std::vector<int>({3, 4}));  // a's object 2 in both of its patrols
+}
+
+}  // namespace
+}  // namespace patrolmap::pipeline
