@@ -32,6 +32,7 @@ constexpr std::uint32_t kVersion = 12;
 constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
 constexpr int kMaxRouteFrameSide = 2048;  // change.route_frames.max_width's largest value
 constexpr std::uint32_t kOldestVersion = 1;
+constexpr int kMaxSiteId = 1 << 30;  // numbering on from a crafted id near INT_MAX would overflow
 
 // Where a section's bytes go: counted (its length), checksummed, or written to the file. A section is built
 // once for each, so saving never holds a section in memory: the features of an hour's map are 45 MB.
@@ -495,7 +496,7 @@ bool ValidObject(const MapObject& o) {
   });
   return o.centroid.allFinite() && o.box_min.allFinite() && o.box_max.allFinite() && Finite({o.confidence, o.height}) &&
          o.detections >= 0 && finite_points && finite_descriptor && finite_labels && ValidTimestamp(o.first_seen_ns) &&
-         ValidTimestamp(o.last_seen_ns) && o.site_id >= -1;
+         ValidTimestamp(o.last_seen_ns) && o.site_id >= -1 && o.site_id <= kMaxSiteId;
 }
 
 // A grid with voxels has a voxel size the grid options allow (change.grid.voxel_size_m, with slack).

@@ -60,9 +60,9 @@ std::vector<int> SiteIdsOf(const change::ChangeReport& report) {
 
 // The site objects of `map`'s flight `current` carried from the flights before it (`before`, numbered first where
 // a map written before site ids left them without), by `report`, the comparison with the last of them; then the
-// report's object changes named by them, with their histories.
-void CarrySiteObjects(const std::vector<std::string>& before, const std::string& current,
-                      const change::ObjectDiffOptions& options, change::ChangeReport* report, graph::TopoMap* map) {
+// report's object changes named by them.
+void CarrySiteObjects(const std::vector<std::string>& before, const std::string& current, change::ChangeReport* report,
+                      graph::TopoMap* map) {
   int last = change::LargestSiteId(*map);
   for (const std::string& flight : before) {
     if (PatrolRecord* record = map->MutablePatrol(flight)) change::NumberSiteObjects(record, &last);
@@ -72,7 +72,6 @@ void CarrySiteObjects(const std::vector<std::string>& before, const std::string&
   if (prior == nullptr || now == nullptr) return;
   change::CarrySiteObjects(*prior, *report, now, &last);
   change::NameSiteObjects(*prior, *now, report);
-  report->site_objects = change::SiteHistoriesOf(*map, options, SiteIdsOf(*report));
 }
 
 }  // namespace
@@ -93,7 +92,6 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   const change::ChangeDetector detector(prior_record, options);
   detector.Compare(current_record, PlacesOf(map, prior_record, current_record), report);
   change::NameSiteObjects(prior_record, current_record, report);
-  report->site_objects = change::SiteHistoriesOf(map, options.objects, SiteIdsOf(*report));
   if (report->geometry.poses_disagree) {
     spdlog::warn(
         "{} and {}: their surfaces differ in {:.0f} % of the voxels both observed ({} of {}; more than "
@@ -105,6 +103,11 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   return Status::Ok();
 }
 
+void AddSiteHistories(const graph::TopoMap& map, const change::ObjectDiffOptions& options,
+                      change::ChangeReport* report) {
+  report->site_objects = change::SiteHistoriesOf(map, options, SiteIdsOf(*report));
+}
+
 Status ReportLastFlight(const graph::TopoMap& prior, graph::TopoMap* map, const change::ChangeOptions& options,
                         const std::string& folder, change::ChangeReport* report, bool* compared,
                         std::vector<change::ChangeItem>* entries) {
@@ -112,7 +115,8 @@ Status ReportLastFlight(const graph::TopoMap& prior, graph::TopoMap* map, const 
   if (compared != nullptr) *compared = false;
   if (before.empty() || after.size() <= before.size()) return Status::Ok();
   PATROLMAP_RETURN_IF_ERROR(CompareFlights(*map, before.back(), after.back(), options, report));
-  CarrySiteObjects(before, after.back(), options.objects, report, map);
+  CarrySiteObjects(before, after.back(), report, map);
+  AddSiteHistories(*map, options.objects, report);
   PATROLMAP_RETURN_IF_ERROR(change::WriteChangeReport(*report, *map, folder, entries));
   if (compared != nullptr) *compared = true;
   return Status::Ok();

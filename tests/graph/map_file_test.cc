@@ -495,7 +495,8 @@ TEST(MapFile, ThePatrolsLogRoundTripsAndADamagedOneIsRefused) {
   }
 }
 
-// Objects keep their site ids (format 12); a version-11 map's objects have none yet, and an id below -1 is refused.
+// Objects keep their site ids (format 12); a version-11 map's objects have none yet, and an id below -1 or above 2^30
+// is refused.
 TEST(MapFile, SiteIdsRoundTripAndOlderObjectsHaveNone) {
   testing::TempDir dir;
   TopoMap map = TwoFlights();
@@ -511,6 +512,10 @@ TEST(MapFile, SiteIdsRoundTripAndOlderObjectsHaveNone) {
   ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
   EXPECT_EQ(loaded.Patrol("b")->objects[0].site_id, 17);
   record.objects[0].site_id = -2;
+  map.SetPatrol(record);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
+  EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("object"), std::string::npos);
+  record.objects[0].site_id = (1 << 30) + 1;  // numbering on from it could overflow
   map.SetPatrol(record);
   ASSERT_TRUE(SaveMap(map, dir / "m.pmap").ok());
   EXPECT_NE(LoadMap(dir / "m.pmap", &loaded).message().find("object"), std::string::npos);

@@ -38,6 +38,7 @@ int RunDiff(const DiffArguments& arguments) {
   change::ChangeReport report;
   status = pipeline::CompareFlights(map, from, to, config.change, &report);
   if (!status.ok()) return Fail(Status::InvalidArgument(arguments.map + ": " + status.message()));
+  pipeline::AddSiteHistories(map, config.change.objects, &report);
   status = change::WriteChangeReport(report, map, arguments.out);
   if (!status.ok()) return Fail(status);
   PrintChangeSummary(report, arguments.out);

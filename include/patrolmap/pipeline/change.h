@@ -17,6 +17,10 @@ namespace patrolmap::pipeline {
 Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const std::string& current,
                       const change::ChangeOptions& options, change::ChangeReport* report);
 
+// The histories over `map`'s patrols of the site objects `report`'s object changes concern (report.site_objects).
+void AddSiteHistories(const graph::TopoMap& map, const change::ObjectDiffOptions& options,
+                      change::ChangeReport* report);
+
 // A patrol's change report: between the last flight of `prior` and the last flight of `map` (which extends
 // `prior`), written to DIR/changes.json and DIR/changes.html. `compared` (may be null) is false, and nothing
 // is written, when `map` adds no flight to a prior that has one. `entries` (may be null) receives the report's
