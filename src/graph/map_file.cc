@@ -1,629 +1,568 @@
 #include "patrolmap/graph/map_file.h"
 
 #include <algorithm>
-#include <cctype>
-#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
-#include <sstream>
 #include <tuple>
 
-#include "patrolmap/core/checksum.h"
-#include "patrolmap/core/csv.h"
+#include "map_codec.h"
+#include "map_file_v12.h"
 #include "patrolmap/core/files.h"
-#include "patrolmap/core/flight_id.h"
-#include "patrolmap/core/image_header.h"
-#include "patrolmap/vocab/descriptors.h"
-
-#include <opencv2/core.hpp>
+#include "patrolmap/core/sqlite.h"
 
 namespace patrolmap::graph {
 namespace {
 
-constexpr char kMagic[8] = {'P', 'M', 'M', 'A', 'P', '\0', '\0', '\0'};
-// 2: PTRL section (patrol records); 3: VOCB section (vocabulary); 4: voxels the grid's memory budget dropped;
-// 5: the patrol's depth source; 6: the frames kept along the route; 7: whether the patrol's log was timed;
-// 8: features keep their positions only (no size, angle, response, octave), descriptors may be packed 4-bit;
-// 9: where the patrol's camera poses came from; 10: the patrol's lens distortion; 11: the patrol's log and its digest;
-// 12: each object's site id
-constexpr std::uint32_t kVersion = 12;
-constexpr std::size_t kMaxRouteJpegBytes = 16u << 20;
-constexpr int kMaxRouteFrameSide = 2048;  // change.route_frames.max_width's largest value
-constexpr std::uint32_t kOldestVersion = 1;
-constexpr int kMaxSiteId = 1 << 30;  // numbering on from a crafted id near INT_MAX would overflow
+constexpr std::uint32_t kVersion = 13;  // 13: the SQLite database; 1 to 12: the binary file (map_file_v12.h)
+constexpr char kFormat[] = "patrolmap.map";
+constexpr char kSqliteMagic[16] = {'S', 'Q', 'L', 'i', 't', 'e', ' ', 'f', 'o', 'r', 'm', 'a', 't', ' ', '3', '\0'};
 
-// Where a section's bytes go: counted (its length), checksummed, or written to the file. A section is built
-// once for each, so saving never holds a section in memory: the features of an hour's map are 45 MB.
-class Sink {
+constexpr char kSchema[] = R"sql(
+CREATE TABLE map_info(key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE nodes(id INTEGER PRIMARY KEY, flight TEXT NOT NULL, timestamp_ns INTEGER NOT NULL,
+  frame_index INTEGER NOT NULL, latitude REAL, longitude REAL, layout_x REAL NOT NULL, layout_y REAL NOT NULL,
+  heading REAL NOT NULL, thumbnail BLOB NOT NULL, features BLOB NOT NULL);
+CREATE TABLE edges(id INTEGER PRIMARY KEY, node_a INTEGER NOT NULL, node_b INTEGER NOT NULL, kind TEXT NOT NULL,
+  bow_score REAL NOT NULL, matched_fraction REAL NOT NULL, inliers INTEGER NOT NULL, log_nfa REAL NOT NULL);
+CREATE TABLE patrols(id INTEGER PRIMARY KEY, flight TEXT NOT NULL UNIQUE, fx REAL NOT NULL, fy REAL NOT NULL,
+  cx REAL NOT NULL, cy REAL NOT NULL, width INTEGER NOT NULL, height INTEGER NOT NULL, distortion BLOB NOT NULL,
+  feature_image_width INTEGER NOT NULL, has_objects INTEGER NOT NULL, depth_source TEXT NOT NULL,
+  pose_source TEXT NOT NULL, timed INTEGER NOT NULL, source TEXT NOT NULL, source_digest TEXT NOT NULL,
+  views BLOB NOT NULL, voxel_size REAL NOT NULL, evicted_voxels INTEGER NOT NULL);
+CREATE TABLE objects(patrol INTEGER NOT NULL, position INTEGER NOT NULL, id INTEGER NOT NULL,
+  site_object INTEGER NOT NULL, label TEXT NOT NULL, confidence REAL NOT NULL, detections INTEGER NOT NULL,
+  confirmed INTEGER NOT NULL, x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, first_seen_ns INTEGER NOT NULL,
+  last_seen_ns INTEGER NOT NULL, shape BLOB NOT NULL, PRIMARY KEY(patrol, position));
+CREATE TABLE grids(patrol INTEGER PRIMARY KEY, voxels BLOB NOT NULL);
+CREATE TABLE route_frames(patrol INTEGER NOT NULL, position INTEGER NOT NULL, timestamp_ns INTEGER NOT NULL,
+  frame_index INTEGER NOT NULL, x REAL, y REAL, z REAL, qw REAL, qx REAL, qy REAL, qz REAL, latitude REAL,
+  longitude REAL, jpeg BLOB NOT NULL, PRIMARY KEY(patrol, position));
+)sql";
+
+const char* KindName(EdgeKind kind) { return kind == EdgeKind::kLoopClosure ? "loop_closure" : "traversal"; }
+
+std::string Hex(std::uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+// The first bytes of `path`, at most `count`.
+std::string FileStart(const std::string& path, std::size_t count) {
+  std::string bytes(count, '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.read(bytes.data(), static_cast<std::streamsize>(count));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+bool IsDatabase(const std::string& path) { return FileStart(path, 16) == std::string(kSqliteMagic, 16); }
+
+template <typename T>
+std::string Bytes(const T& value, void (*write)(const T&, Writer*)) {
+  std::string bytes;
+  Writer writer(&bytes);
+  write(value, &writer);
+  return bytes;
+}
+
+// ---- Writing ----
+
+class MapWriter {
  public:
-  virtual ~Sink() = default;
-  virtual void Append(const char* data, std::size_t size) = 0;
-};
+  explicit MapWriter(SqliteDatabase* db) : db_(db) {}
 
-class Writer {
- public:
-  explicit Writer(Sink* sink) : sink_(sink) {}
-  template <typename T>
-  void Value(T value) {
-    sink_->Append(reinterpret_cast<const char*>(&value), sizeof(T));
-  }
-  void String(const std::string& text) {
-    Value(static_cast<std::uint32_t>(text.size()));
-    sink_->Append(text.data(), text.size());
-  }
-  void Mat(const cv::Mat& mat) {
-    const cv::Mat continuous = mat.isContinuous() ? mat : mat.clone();
-    Value(static_cast<std::int32_t>(mat.type()));
-    Value(static_cast<std::int32_t>(mat.rows));
-    Value(static_cast<std::int32_t>(mat.cols));
-    sink_->Append(reinterpret_cast<const char*>(continuous.data), continuous.total() * continuous.elemSize());
-  }
-  template <typename T>
-  void Vector(const std::vector<T>& values) {
-    Value(static_cast<std::uint32_t>(values.size()));
-    sink_->Append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  Status Prepare() {
+    PATROLMAP_RETURN_IF_ERROR(
+        db_->Prepare("INSERT INTO nodes VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11)", &node_));
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("INSERT INTO edges VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)", &edge_));
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "INSERT INTO patrols VALUES(NULL, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
+        "?18)",
+        &patrol_));
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "INSERT INTO objects VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)", &object_));
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("INSERT INTO grids VALUES(?1, ?2)", &grid_));
+    return db_->Prepare("INSERT INTO route_frames VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)",
+                        &frame_);
   }
 
- private:
-  Sink* sink_;
-};
-
-class CountingSink : public Sink {
- public:
-  void Append(const char*, std::size_t size) override { size_ += size; }
-  std::uint64_t size() const { return size_; }
-
- private:
-  std::uint64_t size_ = 0;
-};
-
-class ChecksumSink : public Sink {
- public:
-  explicit ChecksumSink(std::uint64_t size) : stream_(size) {}
-  void Append(const char* data, std::size_t size) override { stream_.Add(data, size); }
-  std::uint64_t checksum() const { return stream_.Finish(); }
-
- private:
-  ChecksumStream stream_;
-};
-
-// Writes to the file in pieces of about kPiece bytes; keeps the first failure.
-class FileSink : public Sink {
- public:
-  explicit FileSink(AtomicFile* file) : file_(file) {}
-  void Append(const char* data, std::size_t size) override {
-    buffer_.append(data, size);
-    if (buffer_.size() >= kPiece) Flush();
-  }
-  Status Finish() {
-    Flush();
-    return status_;
+  Status Info(const TopoMap& map) {
+    SqliteStatement info;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("INSERT OR REPLACE INTO map_info VALUES(?1, ?2)", &info));
+    const std::pair<const char*, std::string> rows[] = {{"format", kFormat},
+                                                        {"version", std::to_string(kVersion)},
+                                                        {"vocabulary_fingerprint", Hex(map.vocabulary().fingerprint)},
+                                                        {"vocabulary_name", map.vocabulary().name}};
+    for (const auto& [key, value] : rows)
+      PATROLMAP_RETURN_IF_ERROR(info.Bind(1, std::string(key)).Bind(2, value).Run());
+    return Status::Ok();
   }
 
- private:
-  static constexpr std::size_t kPiece = 1 << 20;
-  void Flush() {
-    if (status_.ok() && !buffer_.empty()) status_ = file_->Write(buffer_);
-    buffer_.clear();
-  }
-  AtomicFile* file_;
-  std::string buffer_;
-  Status status_;
-};
-
-// Reads with bounds checks; any overrun sets failed() and yields zeros.
-class Reader {
- public:
-  Reader(const char* data, std::size_t size) : data_(data), size_(size) {}
-  template <typename T>
-  T Value() {
-    T value{};
-    if (!Take(sizeof(T))) return value;
-    std::memcpy(&value, data_ + position_ - sizeof(T), sizeof(T));
-    return value;
-  }
-  std::string String() {
-    const std::uint32_t length = Value<std::uint32_t>();
-    if (!Take(length)) return {};
-    return std::string(data_ + position_ - length, length);
-  }
-  cv::Mat Mat() {
-    const int type = Value<std::int32_t>(), rows = Value<std::int32_t>(), cols = Value<std::int32_t>();
-    if (failed_ || rows < 0 || cols < 0 || (type != CV_8UC1 && type != CV_32FC1)) return Fail(), cv::Mat();
-    // The bytes must be in the file before anything is allocated (a header may claim 2^31 x 2^31).
-    const std::size_t bytes =
-        static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols) * (type == CV_8UC1 ? 1 : 4);
-    if (bytes > size_ - position_) return Fail(), cv::Mat();
-    cv::Mat mat(rows, cols, type);
-    if (!Take(bytes)) return cv::Mat();
-    if (bytes > 0) std::memcpy(mat.data, data_ + position_ - bytes, bytes);
-    return mat;
-  }
-  template <typename T>
-  std::vector<T> Vector() {
-    const std::uint32_t count = Value<std::uint32_t>();
-    if (!Take(static_cast<std::size_t>(count) * sizeof(T))) return {};
-    std::vector<T> values(count);
-    if (count > 0)
-      std::memcpy(static_cast<void*>(values.data()), data_ + position_ - count * sizeof(T), count * sizeof(T));
-    return values;
-  }
-  bool failed() const { return failed_; }
-  bool done() const { return position_ == size_; }
-
- private:
-  void Fail() { failed_ = true; }
-  bool Take(std::size_t bytes) {
-    if (failed_ || bytes > size_ - position_) return failed_ = true, false;
-    position_ += bytes;
-    return true;
-  }
-  const char* data_;
-  std::size_t size_;
-  std::size_t position_ = 0;
-  bool failed_ = false;
-};
-
-// A feature as map format 7 and older kept it; only the position is read.
-struct KeyPointRecord {
-  float x, y, size, angle, response;
-  std::int32_t octave;
-};
-
-void NodeSection(const TopoMap& map, Writer* out) {
-  Writer& w = *out;
-  w.Value(static_cast<std::uint32_t>(map.node_count()));
-  for (int i = 0; i < map.node_count(); ++i) {
-    const KeyFrameNode& n = map.node(i);
-    w.String(n.flight);
-    w.Value(n.timestamp_ns);
-    w.Value(n.frame_index);
-    w.Mat(n.thumbnail);
-    w.Value(static_cast<std::uint8_t>(n.gps.has_value()));
-    const Eigen::Vector2d gps = n.gps.value_or(Eigen::Vector2d::Zero());
-    for (double v : {gps.x(), gps.y(), n.layout.x(), n.layout.y(), n.heading}) w.Value(v);
-  }
-}
-
-void EdgeSection(const TopoMap& map, Writer* out) {
-  Writer& w = *out;
-  const std::vector<TopoMap::Edge> edges = map.Edges();
-  w.Value(static_cast<std::uint32_t>(edges.size()));
-  for (const TopoMap::Edge& e : edges) {
-    w.Value(static_cast<std::uint32_t>(e.a));
-    w.Value(static_cast<std::uint32_t>(e.b));
-    w.Value(static_cast<std::uint8_t>(e.data.kind));
-    w.Value(e.data.bow_score);
-    w.Value(e.data.matched_fraction);
-    w.Value(static_cast<std::int32_t>(e.data.inliers));
-    w.Value(e.data.log_nfa);
-  }
-}
-
-void FeatureSection(const TopoMap& map, Writer* out) {
-  Writer& w = *out;
-  w.Value(static_cast<std::uint32_t>(map.node_count()));
-  for (int i = 0; i < map.node_count(); ++i) {
-    const KeyFrameNode& n = map.node(i);
-    w.Vector(n.points);
-    w.Mat(n.descriptors);
-    w.Vector(n.bow.words);
-    w.Vector(n.bow.weights);
-  }
-}
-
-struct PoseRecord {
-  std::int64_t timestamp_ns;
-  double position[3];
-  double rotation[4];  // w, x, y, z
-};
-
-void WriteObject(const MapObject& o, Writer* w) {
-  w->Value<std::int32_t>(o.id);
-  w->String(o.label);
-  w->Value(o.confidence);
-  w->Value<std::int32_t>(o.detections);
-  w->Value<std::uint8_t>(o.confirmed ? 1 : 0);
-  for (const Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
-    for (int k = 0; k < 3; ++k) w->Value((*v)[k]);
-  }
-  w->Vector(o.points);
-  w->Vector(o.descriptor);
-  w->Value(o.height);
-  w->Value(static_cast<std::uint32_t>(o.labels.size()));
-  for (const MapObject::LabelEvidence& e : o.labels) {
-    w->String(e.label);
-    w->Value(e.confidence_sum);
-    w->Value<std::int32_t>(e.count);
-  }
-  w->Value(o.first_seen_ns);
-  w->Value(o.last_seen_ns);
-}
-
-PoseRecord ToRecord(const CameraPoseSample& v) {
-  return {v.timestamp_ns,
-          {v.position.x(), v.position.y(), v.position.z()},
-          {v.rotation.w(), v.rotation.x(), v.rotation.y(), v.rotation.z()}};
-}
-
-CameraPoseSample FromRecord(const PoseRecord& v) {
-  return {v.timestamp_ns, Eigen::Vector3d(v.position[0], v.position[1], v.position[2]),
-          Eigen::Quaterniond(v.rotation[0], v.rotation[1], v.rotation[2], v.rotation[3])};
-}
-
-// Per frame: time, frame index, flags (1: pose, 2: GPS), the pose, latitude and longitude, the JPEG bytes.
-void WriteRoute(const std::vector<RouteFrame>& route, Writer* w) {
-  w->Value(static_cast<std::uint32_t>(route.size()));
-  for (const RouteFrame& f : route) {
-    w->Value(f.timestamp_ns);
-    w->Value(f.frame_index);
-    w->Value<std::uint8_t>((f.pose ? 1 : 0) | (f.gps ? 2 : 0));
-    w->Value(ToRecord(f.pose.value_or(CameraPoseSample())));
-    const Eigen::Vector2d gps = f.gps.value_or(Eigen::Vector2d::Zero());
-    w->Value(gps.x());
-    w->Value(gps.y());
-    w->Vector(f.jpeg);
-  }
-}
-
-void PatrolSection(const TopoMap& map, Writer* out) {
-  Writer& w = *out;
-  w.Value(static_cast<std::uint32_t>(map.patrols().size()));
-  for (const PatrolRecord& p : map.patrols()) {
-    w.String(p.flight);
-    for (double v : {p.camera.fx, p.camera.fy, p.camera.cx, p.camera.cy}) w.Value(v);
-    w.Value<std::int32_t>(p.camera.width);
-    w.Value<std::int32_t>(p.camera.height);
-    w.Value<std::int32_t>(p.feature_image_width);
-    std::vector<PoseRecord> views;
-    for (const CameraPoseSample& v : p.views) views.push_back(ToRecord(v));
-    w.Vector(views);
-    w.Value<std::uint8_t>(p.has_objects ? 1 : 0);
-    w.Value(static_cast<std::uint32_t>(p.objects.size()));
-    for (const MapObject& o : p.objects) WriteObject(o, &w);
-    w.Value(p.grid.voxel_size);
-    w.Vector(p.grid.voxels);
-    w.Value<std::int64_t>(p.grid.evicted_voxels);
-    w.String(p.depth_source);
-    WriteRoute(p.route, &w);
-    w.Value<std::uint8_t>(p.timed ? 1 : 0);
-    w.String(p.pose_source);
-    for (double k : p.distortion) w.Value(k);
-    w.String(p.source);
-    w.String(p.source_digest);
-    std::vector<std::int32_t> site_ids;
-    for (const MapObject& o : p.objects) site_ids.push_back(o.site_id);
-    w.Vector(site_ids);
-  }
-}
-
-void VocabularySection(const TopoMap& map, Writer* out) {
-  Writer& w = *out;
-  w.Value(map.vocabulary().fingerprint);
-  w.String(map.vocabulary().name);
-}
-
-// Writes one section (tag, length, checksum, payload), built three times: counted, checksummed, written.
-Status WriteSection(const char (&tag)[5], const TopoMap& map, void (*build)(const TopoMap&, Writer*),
-                    AtomicFile* file) {
-  CountingSink length;
-  Writer counting(&length);
-  build(map, &counting);
-  ChecksumSink checksum(length.size());
-  Writer checksumming(&checksum);
-  build(map, &checksumming);
-  std::string header(tag, 4);
-  const std::uint64_t size = length.size(), sum = checksum.checksum();
-  header.append(reinterpret_cast<const char*>(&size), 8);
-  header.append(reinterpret_cast<const char*>(&sum), 8);
-  PATROLMAP_RETURN_IF_ERROR(file->Write(header));
-  FileSink out(file);
-  Writer writing(&out);
-  build(map, &writing);
-  return out.Finish();
-}
-
-Status Corrupt(const std::string& path, const std::string& what) {
-  return Status::DataLoss(path + ": corrupt map (" + what + ")");
-}
-
-// Flight ids as readers keep them (core/flight_id.h); maps written before ids were cut at 200 bytes hold longer ones.
-bool ValidFlightId(const std::string& id) { return IsValidFlightId(id, 1000); }
-
-// A patrol's log as the pipeline records it: printable text, and a digest of 16 hex digits (or none).
-bool ValidSource(const PatrolRecord& p) {
-  const std::string& d = p.source_digest;
-  return p.source.size() <= 4096 && PrintableText(p.source) == p.source &&
-         (d.empty() || (d.size() == 16 && std::all_of(d.begin(), d.end(), [](char c) {
-                          return std::isxdigit(static_cast<unsigned char>(c)) != 0;
-                        })));
-}
-
-bool Finite(std::initializer_list<double> values) {
-  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
-}
-
-// Node values a reader could have written: a valid time, a frame index from 0, GPS on the globe, a
-// finite layout and heading.
-bool ValidNodeValues(const KeyFrameNode& n) {
-  const bool gps_ok = !n.gps || (std::abs((*n.gps)[0]) <= 90.0 && std::abs((*n.gps)[1]) <= 180.0);
-  return ValidTimestamp(n.timestamp_ns) && n.frame_index >= 0 && gps_ok &&
-         Finite({n.layout.x(), n.layout.y(), n.heading});
-}
-
-Status ParseNodes(const std::string& path, Reader* r, TopoMap* map) {
-  const std::uint32_t count = r->Value<std::uint32_t>();
-  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
-    KeyFrameNode n;
-    n.flight = r->String();
-    n.timestamp_ns = r->Value<TimestampNs>();
-    n.frame_index = r->Value<std::int64_t>();
-    n.thumbnail = r->Mat();
-    const bool has_gps = r->Value<std::uint8_t>() != 0;
-    double v[5];
-    for (double& value : v) value = r->Value<double>();
-    if (has_gps) n.gps = Eigen::Vector2d(v[0], v[1]);
-    n.layout = Eigen::Vector2d(v[2], v[3]);
-    n.heading = v[4];
-    if (!ValidFlightId(n.flight)) return Corrupt(path, "flight id of node " + std::to_string(i));
-    if (!r->failed() && !ValidNodeValues(n))
-      return Corrupt(path, "time, frame, GPS or layout of node " + std::to_string(i));
-    if (!r->failed() &&
-        (n.thumbnail.empty() || n.thumbnail.type() != CV_8UC1 || n.thumbnail.cols > 4096 || n.thumbnail.rows > 4096)) {
-      return Corrupt(path, "thumbnail of node " + std::to_string(i));
-    }
-    map->AddNode(std::move(n));
-  }
-  return r->failed() || !r->done() ? Corrupt(path, "node section") : Status::Ok();
-}
-
-Status ParseEdges(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
-  const std::uint32_t count = r->Value<std::uint32_t>();
-  std::set<std::tuple<std::uint32_t, std::uint32_t, std::uint8_t>> seen;
-  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
-    const auto a = r->Value<std::uint32_t>(), b = r->Value<std::uint32_t>();
-    EdgeData e;
-    const auto kind = r->Value<std::uint8_t>();
-    e.bow_score = r->Value<double>();
-    e.matched_fraction = r->Value<double>();
-    e.inliers = r->Value<std::int32_t>();
-    if (version >= 3) e.log_nfa = r->Value<double>();
-    if (r->failed()) break;
-    if (kind > 1 || a >= static_cast<std::uint32_t>(map->node_count()) ||
-        b >= static_cast<std::uint32_t>(map->node_count()) || a == b ||
-        !Finite({e.bow_score, e.matched_fraction, e.log_nfa}) || e.bow_score < 0.0 || e.matched_fraction < 0.0 ||
-        e.inliers < 0) {
-      return Corrupt(path, "edge " + std::to_string(i));
-    }
-    // A map holds one edge of a kind between two nodes (a crafted one could repeat it thousands of times).
-    if (!seen.insert({std::min(a, b), std::max(a, b), kind}).second) {
-      return Corrupt(path, "edge " + std::to_string(i) + " repeats another");
-    }
-    e.kind = static_cast<EdgeKind>(kind);
-    map->AddEdge(static_cast<int>(a), static_cast<int>(b), e);
-  }
-  return r->failed() || !r->done() ? Corrupt(path, "edge section") : Status::Ok();
-}
-
-Status ParseFeatures(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
-  if (r->Value<std::uint32_t>() != static_cast<std::uint32_t>(map->node_count())) return Corrupt(path, "feature count");
-  for (int i = 0; i < map->node_count() && !r->failed(); ++i) {
-    KeyFrameNode& n = map->mutable_node(i);
-    if (version >= 8) {
-      n.points = r->Vector<cv::Point2f>();
+  Status Node(int id, const KeyFrameNode& n) {
+    node_.Bind(1, static_cast<std::int64_t>(id)).Bind(2, n.flight).Bind(3, std::int64_t{n.timestamp_ns});
+    node_.Bind(4, std::int64_t{n.frame_index});
+    if (n.gps) {
+      node_.Bind(5, n.gps->x()).Bind(6, n.gps->y());
     } else {
-      for (const KeyPointRecord& k : r->Vector<KeyPointRecord>()) n.points.emplace_back(k.x, k.y);
+      node_.BindNull(5).BindNull(6);
     }
-    n.descriptors = r->Mat();
-    n.bow.words = r->Vector<vocab::WordId>();
-    n.bow.weights = r->Vector<float>();
-    if (n.bow.words.size() != n.bow.weights.size() ||
-        (!n.descriptors.empty() && static_cast<std::size_t>(n.descriptors.rows) != n.points.size()) ||
-        !vocab::IsStoredDescriptorKind(n.descriptors) ||
-        !std::all_of(n.points.begin(), n.points.end(), [](const cv::Point2f& p) { return std::isfinite(p.x + p.y); }) ||
-        (n.descriptors.depth() == CV_32F && !cv::checkRange(n.descriptors)) ||
-        !std::all_of(n.bow.weights.begin(), n.bow.weights.end(), [](float w) { return std::isfinite(w) && w >= 0; })) {
-      return Corrupt(path, "features of node " + std::to_string(i));
+    node_.Bind(7, n.layout.x()).Bind(8, n.layout.y()).Bind(9, n.heading);
+    const std::string thumbnail = Bytes<cv::Mat>(n.thumbnail, [](const cv::Mat& m, Writer* w) { w->Mat(m); });
+    const std::string features = Bytes<KeyFrameNode>(n, WriteFeatures);
+    node_.BindBlob(10, thumbnail.data(), thumbnail.size()).BindBlob(11, features.data(), features.size());
+    return node_.Run();
+  }
+
+  Status Edge(int id, const TopoMap::Edge& e) {
+    edge_.Bind(1, static_cast<std::int64_t>(id)).Bind(2, static_cast<std::int64_t>(e.a));
+    edge_.Bind(3, static_cast<std::int64_t>(e.b)).Bind(4, std::string(KindName(e.data.kind)));
+    edge_.Bind(5, e.data.bow_score).Bind(6, e.data.matched_fraction);
+    edge_.Bind(7, static_cast<std::int64_t>(e.data.inliers)).Bind(8, e.data.log_nfa);
+    return edge_.Run();
+  }
+
+  // A whole record, with its objects, grid and route frames.
+  Status Patrol(const PatrolRecord& p) {
+    PATROLMAP_CHECK(!p.partial);
+    const CameraIntrinsics& c = p.camera;
+    patrol_.Bind(1, p.flight).Bind(2, c.fx).Bind(3, c.fy).Bind(4, c.cx).Bind(5, c.cy);
+    patrol_.Bind(6, static_cast<std::int64_t>(c.width)).Bind(7, static_cast<std::int64_t>(c.height));
+    patrol_.BindBlob(8, p.distortion.data(), sizeof(p.distortion));
+    patrol_.Bind(9, static_cast<std::int64_t>(p.feature_image_width)).Bind(10, std::int64_t{p.has_objects});
+    patrol_.Bind(11, p.depth_source).Bind(12, p.pose_source).Bind(13, std::int64_t{p.timed});
+    patrol_.Bind(14, p.source).Bind(15, p.source_digest);
+    const std::vector<PoseRecord> views = ToRecords(p.views);
+    patrol_.BindBlob(16, views.data(), views.size() * sizeof(PoseRecord));
+    patrol_.Bind(17, p.grid.voxel_size).Bind(18, static_cast<std::int64_t>(p.grid.evicted_voxels));
+    PATROLMAP_RETURN_IF_ERROR(patrol_.Run());
+    const std::int64_t row = LastRow();
+    for (std::size_t i = 0; i < p.objects.size(); ++i) PATROLMAP_RETURN_IF_ERROR(Object(row, i, p.objects[i]));
+    grid_.Bind(1, row).BindBlob(2, p.grid.voxels.data(), p.grid.voxels.size() * sizeof(VoxelEvidence));
+    PATROLMAP_RETURN_IF_ERROR(grid_.Run());
+    for (std::size_t i = 0; i < p.route.size(); ++i) PATROLMAP_RETURN_IF_ERROR(Frame(row, i, p.route[i]));
+    return Status::Ok();
+  }
+
+ private:
+  std::int64_t LastRow() {
+    SqliteStatement last;
+    Status status;
+    if (!db_->Prepare("SELECT last_insert_rowid()", &last).ok() || !last.Step(&status)) return -1;
+    return last.Int(0);
+  }
+
+  Status Object(std::int64_t patrol, std::size_t position, const MapObject& o) {
+    object_.Bind(1, patrol).Bind(2, static_cast<std::int64_t>(position)).Bind(3, static_cast<std::int64_t>(o.id));
+    object_.Bind(4, static_cast<std::int64_t>(o.site_id)).Bind(5, o.label).Bind(6, o.confidence);
+    object_.Bind(7, static_cast<std::int64_t>(o.detections)).Bind(8, std::int64_t{o.confirmed});
+    object_.Bind(9, o.centroid.x()).Bind(10, o.centroid.y()).Bind(11, o.centroid.z());
+    object_.Bind(12, std::int64_t{o.first_seen_ns}).Bind(13, std::int64_t{o.last_seen_ns});
+    const std::string shape = Bytes<MapObject>(o, WriteObjectShape);
+    object_.BindBlob(14, shape.data(), shape.size());
+    return object_.Run();
+  }
+
+  Status Frame(std::int64_t patrol, std::size_t position, const RouteFrame& f) {
+    frame_.Bind(1, patrol).Bind(2, static_cast<std::int64_t>(position)).Bind(3, std::int64_t{f.timestamp_ns});
+    frame_.Bind(4, std::int64_t{f.frame_index});
+    if (f.pose) {
+      const PoseRecord r = ToRecord(*f.pose);
+      for (int k = 0; k < 3; ++k) frame_.Bind(5 + k, r.position[k]);
+      for (int k = 0; k < 4; ++k) frame_.Bind(8 + k, r.rotation[k]);
+    } else {
+      for (int k = 5; k < 12; ++k) frame_.BindNull(k);
     }
-  }
-  return r->failed() || !r->done() ? Corrupt(path, "feature section") : Status::Ok();
-}
-
-MapObject ReadObject(Reader* r) {
-  MapObject o;
-  o.id = r->Value<std::int32_t>();
-  o.label = r->String();
-  o.confidence = r->Value<double>();
-  o.detections = r->Value<std::int32_t>();
-  o.confirmed = r->Value<std::uint8_t>() != 0;
-  for (Eigen::Vector3d* v : {&o.centroid, &o.box_min, &o.box_max}) {
-    for (int k = 0; k < 3; ++k) (*v)[k] = r->Value<double>();
-  }
-  o.points = r->Vector<Eigen::Vector3f>();
-  o.descriptor = r->Vector<float>();
-  o.height = r->Value<double>();
-  const std::uint32_t labels = r->Value<std::uint32_t>();
-  for (std::uint32_t i = 0; i < labels && !r->failed(); ++i) {
-    MapObject::LabelEvidence e;
-    e.label = r->String();
-    e.confidence_sum = r->Value<double>();
-    e.count = r->Value<std::int32_t>();
-    o.labels.push_back(e);
-  }
-  o.first_seen_ns = r->Value<TimestampNs>();
-  o.last_seen_ns = r->Value<TimestampNs>();
-  return o;
-}
-
-// Sorted voxels, each well inside the integer range, so the grid's neighbour and shift arithmetic cannot overflow
-// (2^30 voxels of 1 cm are 10,000 km).
-bool SortedVoxels(const std::vector<VoxelEvidence>& voxels) {
-  constexpr int kMaxIndex = 1 << 30;
-  const auto inside = [](const VoxelEvidence& v) {
-    return std::max({v.x, v.y, v.z}) <= kMaxIndex && std::min({v.x, v.y, v.z}) >= -kMaxIndex;
-  };
-  return std::is_sorted(voxels.begin(), voxels.end(), VoxelBefore) && std::all_of(voxels.begin(), voxels.end(), inside);
-}
-
-// A pose with a valid time, a finite position and a rotation of about unit norm.
-bool ValidPose(const CameraPoseSample& v) {
-  const double norm = v.rotation.coeffs().norm();
-  return ValidTimestamp(v.timestamp_ns) && v.position.allFinite() && std::isfinite(norm) && norm > 0.5 && norm < 2.0;
-}
-
-// A patrol's camera as the pipeline records it (valid, or all zero for a log without one), its lens distortion
-// (finite and bounded), and valid views.
-bool ValidCameraAndViews(const PatrolRecord& p) {
-  const CameraIntrinsics& c = p.camera;
-  constexpr int kMaxImageSide = 100000;
-  const bool unknown = c.fx == 0.0 && c.fy == 0.0 && c.cx == 0.0 && c.cy == 0.0 && c.width == 0 && c.height == 0;
-  const bool camera_ok = unknown || (Finite({c.fx, c.fy, c.cx, c.cy}) && c.valid() && c.width <= kMaxImageSide &&
-                                     c.height <= kMaxImageSide);
-  if (!camera_ok || p.feature_image_width < 0 || p.feature_image_width > kMaxImageSide) return false;
-  if (!PlausibleDistortion(p.distortion)) return false;
-  return std::all_of(p.views.begin(), p.views.end(), ValidPose);
-}
-
-bool ValidObject(const MapObject& o) {
-  const auto finite_points =
-      std::all_of(o.points.begin(), o.points.end(), [](const Eigen::Vector3f& x) { return x.allFinite(); });
-  const auto finite_descriptor =
-      std::all_of(o.descriptor.begin(), o.descriptor.end(), [](float x) { return std::isfinite(x); });
-  const auto finite_labels = std::all_of(o.labels.begin(), o.labels.end(), [](const MapObject::LabelEvidence& e) {
-    return std::isfinite(e.confidence_sum) && e.count >= 0;
-  });
-  return o.centroid.allFinite() && o.box_min.allFinite() && o.box_max.allFinite() && Finite({o.confidence, o.height}) &&
-         o.detections >= 0 && finite_points && finite_descriptor && finite_labels && ValidTimestamp(o.first_seen_ns) &&
-         ValidTimestamp(o.last_seen_ns) && o.site_id >= -1 && o.site_id <= kMaxSiteId;
-}
-
-// A grid with voxels has a voxel size the grid options allow (change.grid.voxel_size_m, with slack).
-bool ValidVoxelSize(const EvidenceGridData& grid) {
-  constexpr double kMinVoxelM = 1e-3, kMaxVoxelM = 1e3;
-  if (!std::isfinite(grid.voxel_size) || grid.voxel_size < 0.0) return false;
-  return grid.voxels.empty() || (grid.voxel_size >= kMinVoxelM && grid.voxel_size <= kMaxVoxelM);
-}
-
-std::vector<RouteFrame> ReadRoute(Reader* r) {
-  std::vector<RouteFrame> route;
-  const std::uint32_t count = r->Value<std::uint32_t>();
-  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
-    RouteFrame f;
-    f.timestamp_ns = r->Value<TimestampNs>();
-    f.frame_index = r->Value<std::int64_t>();
-    const auto flags = r->Value<std::uint8_t>();
-    const PoseRecord pose = r->Value<PoseRecord>();
-    const double latitude = r->Value<double>(), longitude = r->Value<double>();
-    if (flags > 3) f.frame_index = -1;  // not a flag this version writes: ValidRoute refuses the frame
-    if ((flags & 1) != 0) f.pose = FromRecord(pose);
-    if ((flags & 2) != 0) f.gps = Eigen::Vector2d(latitude, longitude);
-    f.jpeg = r->Vector<unsigned char>();
-    route.push_back(std::move(f));
-  }
-  return route;
-}
-
-// Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and
-// JPEG bytes: the start-of-image marker and a frame header stating a size no larger than the patrol's camera
-// (where it is known; key frames are kept at the feature scale, the others at max_width) and at most
-// kMaxRouteFrameSide a side (what change.route_frames.max_width allows), so no crafted map makes the report or the
-// route comparison decode and describe images larger than the flight that wrote it could have kept.
-bool ValidRoute(const std::vector<RouteFrame>& route, const CameraIntrinsics& camera) {
-  for (std::size_t i = 0; i < route.size(); ++i) {
-    const RouteFrame& f = route[i];
-    if (!ValidTimestamp(f.timestamp_ns) || f.frame_index < 0) return false;
-    if (i > 0 && f.timestamp_ns < route[i - 1].timestamp_ns) return false;
-    if (f.pose && !ValidPose(*f.pose)) return false;
-    if (f.gps && !(std::abs(f.gps->x()) <= 90.0 && std::abs(f.gps->y()) <= 180.0)) return false;
-    if (f.jpeg.size() < 4 || f.jpeg.size() > kMaxRouteJpegBytes || f.jpeg[0] != 0xFF || f.jpeg[1] != 0xD8) return false;
-    std::int64_t width = 0, height = 0;
-    if (!DeclaredImageSize(f.jpeg.data(), f.jpeg.size(), &width, &height) || width < 1 || height < 1 ||
-        width > kMaxRouteFrameSide || height > kMaxRouteFrameSide) {
-      return false;
+    if (f.gps) {
+      frame_.Bind(12, f.gps->x()).Bind(13, f.gps->y());
+    } else {
+      frame_.BindNull(12).BindNull(13);
     }
-    if (camera.width > 0 && (width > camera.width || height > camera.height)) return false;
+    frame_.BindBlob(14, f.jpeg.data(), f.jpeg.size());
+    return frame_.Run();
   }
-  return true;
+
+  SqliteDatabase* db_;
+  SqliteStatement node_, edge_, patrol_, object_, grid_, frame_;
+};
+
+// Opens the temporary of `file` as a database written in one transaction; the temporary is flushed and renamed
+// by the caller (AtomicFile::Commit), so SQLite keeps no journal of its own.
+Status OpenForWriting(const AtomicFile& file, SqliteDatabase* db) {
+  PATROLMAP_RETURN_IF_ERROR(SqliteDatabase::Open(file.temporary_path(), SqliteDatabase::Mode::kReadWrite, db));
+  PATROLMAP_RETURN_IF_ERROR(db->Execute("PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;"));
+  return db->Execute("BEGIN");
 }
 
-Status ParsePatrols(const std::string& path, std::uint32_t version, Reader* r, TopoMap* map) {
-  const std::uint32_t count = r->Value<std::uint32_t>();
-  for (std::uint32_t i = 0; i < count && !r->failed(); ++i) {
-    PatrolRecord p;
-    p.flight = r->String();
-    p.camera.fx = r->Value<double>(), p.camera.fy = r->Value<double>();
-    p.camera.cx = r->Value<double>(), p.camera.cy = r->Value<double>();
-    p.camera.width = r->Value<std::int32_t>(), p.camera.height = r->Value<std::int32_t>();
-    p.feature_image_width = r->Value<std::int32_t>();
-    for (const PoseRecord& v : r->Vector<PoseRecord>()) p.views.push_back(FromRecord(v));
-    p.has_objects = r->Value<std::uint8_t>() != 0;
-    const std::uint32_t objects = r->Value<std::uint32_t>();
-    for (std::uint32_t k = 0; k < objects && !r->failed(); ++k) p.objects.push_back(ReadObject(r));
-    p.grid.voxel_size = r->Value<double>();
-    p.grid.voxels = r->Vector<VoxelEvidence>();
-    if (version >= 4) p.grid.evicted_voxels = r->Value<std::int64_t>();
-    if (version >= 5) p.depth_source = r->String();
-    if (version >= 6) p.route = ReadRoute(r);
-    if (version >= 7) p.timed = r->Value<std::uint8_t>() != 0;
-    if (version >= 9) p.pose_source = r->String();
-    if (version >= 10)
-      for (double& k : p.distortion) k = r->Value<double>();
-    if (version >= 11) p.source = r->String(), p.source_digest = r->String();
-    if (version >= 12) {
-      const std::vector<std::int32_t> site_ids = r->Vector<std::int32_t>();
-      if (site_ids.size() != p.objects.size() && !r->failed()) return Corrupt(path, "site objects of " + p.flight);
-      for (std::size_t k = 0; k < site_ids.size(); ++k) p.objects[k].site_id = site_ids[k];
-    }
-    if (r->failed()) break;
-    if (!ValidFlightId(p.flight)) return Corrupt(path, "flight id of patrol " + std::to_string(i));
-    if (!ValidCameraAndViews(p)) return Corrupt(path, "camera or views of patrol " + p.flight);
-    for (const MapObject& object : p.objects) {
-      if (!ValidObject(object)) return Corrupt(path, "object " + std::to_string(object.id) + " of patrol " + p.flight);
-    }
-    if (!SortedVoxels(p.grid.voxels) || !ValidVoxelSize(p.grid) || p.grid.evicted_voxels < 0 ||
-        (p.depth_source != "" && p.depth_source != "images" && p.depth_source != "stereo")) {
-      return Corrupt(path, "evidence grid of " + p.flight);
-    }
-    if (!ValidRoute(p.route, p.camera)) return Corrupt(path, "route frames of " + p.flight);
-    if (!KnownPoseSource(p.pose_source)) return Corrupt(path, "pose source of " + p.flight);
-    if (!ValidSource(p)) return Corrupt(path, "log of " + p.flight);
-    // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.
-    if (map->Patrol(p.flight) != nullptr) return Corrupt(path, "second patrol record of " + p.flight);
-    map->SetPatrol(std::move(p));
-  }
-  return r->failed() || !r->done() ? Corrupt(path, "patrol section") : Status::Ok();
+Status Finish(SqliteDatabase* db, AtomicFile* file) {
+  PATROLMAP_RETURN_IF_ERROR(db->Execute("COMMIT"));
+  PATROLMAP_RETURN_IF_ERROR(db->Close());
+  return file->Commit();
 }
 
-Status ParseVocabulary(const std::string& path, Reader* r, TopoMap* map) {
-  TopoMap::VocabularyTag tag;
-  tag.fingerprint = r->Value<std::uint64_t>();
-  tag.name = r->String();
-  if (r->failed() || !r->done()) return Corrupt(path, "vocabulary section");
-  map->set_vocabulary(std::move(tag));
+// Copies `from` into `file`, in pieces.
+Status CopyInto(const std::string& from, AtomicFile* file) {
+  std::ifstream in(from, std::ios::binary);
+  if (!in) return Status::NotFound(from + ": cannot read map");
+  std::string piece(1 << 20, '\0');
+  while (in) {
+    in.read(piece.data(), static_cast<std::streamsize>(piece.size()));
+    const std::streamsize got = in.gcount();
+    if (got > 0) PATROLMAP_RETURN_IF_ERROR(file->Write(piece.data(), static_cast<std::size_t>(got)));
+  }
+  if (in.bad()) return Status::IoError(from + ": read failed");
   return Status::Ok();
 }
 
-// Which sections a file has given so far; each may appear once.
-struct SectionsSeen {
-  bool nodes = false, edges = false, features = false, patrols = false, vocabulary = false;
+std::int64_t Count(SqliteDatabase* db, const std::string& sql, Status* status) {
+  SqliteStatement statement;
+  *status = db->Prepare(sql, &statement);
+  if (!status->ok() || !statement.Step(status)) return -1;
+  return statement.Int(0);
+}
+
+// ---- Reading ----
+
+class MapReader {
+ public:
+  MapReader(SqliteDatabase* db, const std::string& path) : db_(db), path_(path) {}
+
+  Status Info(TopoMap* map) {
+    if (!db_->HasTable("map_info")) return Status::DataLoss(path_ + ": an SQLite database, but not a patrolmap map");
+    std::map<std::string, std::string> info;
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("SELECT key, value FROM map_info", &rows));
+    Status status;
+    while (rows.Step(&status)) info[rows.Text(0)] = rows.Text(1);
+    PATROLMAP_RETURN_IF_ERROR(status);
+    if (info["format"] != kFormat) return Status::DataLoss(path_ + ": an SQLite database, but not a patrolmap map");
+    const std::string& version = info["version"];
+    if (version != std::to_string(kVersion)) {
+      const bool number = !version.empty() && version.size() < 10 &&
+                          std::all_of(version.begin(), version.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (number && std::stoul(version) > kVersion) {
+        return Status::DataLoss(path_ + ": map format version " + version + " is newer than this patrolmap reads (" +
+                                std::to_string(kVersion) + ")");
+      }
+      return Corrupt(path_, "map_info: version '" + version + "'");
+    }
+    TopoMap::VocabularyTag tag;
+    const std::string& fingerprint = info["vocabulary_fingerprint"];
+    char* end = nullptr;
+    tag.fingerprint = std::strtoull(fingerprint.c_str(), &end, 16);
+    if (fingerprint.size() != 16 || end != fingerprint.c_str() + 16) {
+      return Corrupt(path_, "map_info: vocabulary_fingerprint");
+    }
+    tag.name = info["vocabulary_name"];
+    map->set_vocabulary(std::move(tag));
+    return Status::Ok();
+  }
+
+  Status Nodes(TopoMap* map) {
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "SELECT id, flight, timestamp_ns, frame_index, latitude, longitude, layout_x, layout_y, heading, thumbnail, "
+        "features FROM nodes ORDER BY id",
+        &rows));
+    Status status;
+    while (rows.Step(&status)) {
+      const std::string where = "node " + std::to_string(map->node_count());
+      if (rows.Int(0) != map->node_count()) return Corrupt(path_, "node ids: not 0, 1, 2, ... at " + where);
+      KeyFrameNode n;
+      n.flight = rows.Text(1);
+      n.timestamp_ns = rows.Int(2);
+      n.frame_index = rows.Int(3);
+      if (!rows.IsNull(4) || !rows.IsNull(5)) n.gps = Eigen::Vector2d(rows.Real(4), rows.Real(5));
+      n.layout = Eigen::Vector2d(rows.Real(6), rows.Real(7));
+      n.heading = rows.Real(8);
+      if (!ValidNodeValues(n)) return Corrupt(path_, "flight, time, frame, GPS or layout of " + where);
+      Reader thumbnail = BlobReader(rows, 9);
+      n.thumbnail = thumbnail.Mat();
+      if (thumbnail.failed() || !thumbnail.done() || !ValidThumbnail(n.thumbnail)) {
+        return Corrupt(path_, "thumbnail of " + where);
+      }
+      Reader features = BlobReader(rows, 10);
+      ReadFeatures(&features, &n);
+      if (features.failed() || !features.done() || !ValidFeatures(n)) return Corrupt(path_, "features of " + where);
+      map->AddNode(std::move(n));
+    }
+    return status;
+  }
+
+  Status Edges(TopoMap* map) {
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "SELECT node_a, node_b, kind, bow_score, matched_fraction, inliers, log_nfa FROM edges ORDER BY id", &rows));
+    std::set<std::tuple<std::int64_t, std::int64_t, bool>> seen;
+    Status status;
+    for (int i = 0; rows.Step(&status); ++i) {
+      const std::int64_t a = rows.Int(0), b = rows.Int(1);
+      const std::string kind = rows.Text(2);
+      EdgeData e;
+      e.kind = kind == "loop_closure" ? EdgeKind::kLoopClosure : EdgeKind::kTraversal;
+      e.bow_score = rows.Real(3);
+      e.matched_fraction = rows.Real(4);
+      e.inliers = static_cast<int>(std::clamp<std::int64_t>(rows.Int(5), -1, 1 << 30));
+      e.log_nfa = rows.Real(6);
+      const int nodes = map->node_count();
+      const bool in_range = a >= 0 && b >= 0 && a < nodes && b < nodes;
+      if ((kind != "loop_closure" && kind != "traversal") || !in_range ||
+          !ValidEdge(e, static_cast<int>(a), static_cast<int>(b), nodes)) {
+        return Corrupt(path_, "edge " + std::to_string(i));
+      }
+      if (!seen.insert({std::min(a, b), std::max(a, b), e.kind == EdgeKind::kLoopClosure}).second) {
+        return Corrupt(path_, "edge " + std::to_string(i) + " repeats another");
+      }
+      map->AddEdge(static_cast<int>(a), static_cast<int>(b), e);
+    }
+    return status;
+  }
+
+  // The records with their objects; grids and route frames are read by Details. Fills ids_ (patrols.id per record).
+  Status Patrols(std::vector<PatrolRecord>* out) {
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "SELECT id, flight, fx, fy, cx, cy, width, height, distortion, feature_image_width, has_objects, depth_source, "
+        "pose_source, timed, source, source_digest, views, voxel_size, evicted_voxels FROM patrols ORDER BY id",
+        &rows));
+    Status status;
+    while (rows.Step(&status)) {
+      PatrolRecord p;
+      ids_.push_back(rows.Int(0));
+      p.flight = rows.Text(1);
+      CameraIntrinsics& c = p.camera;
+      c.fx = rows.Real(2), c.fy = rows.Real(3), c.cx = rows.Real(4), c.cy = rows.Real(5);
+      c.width = static_cast<int>(std::clamp<std::int64_t>(rows.Int(6), -1, 1 << 30));
+      c.height = static_cast<int>(std::clamp<std::int64_t>(rows.Int(7), -1, 1 << 30));
+      std::size_t size = 0;
+      const unsigned char* distortion = rows.Blob(8, &size);
+      if (size != sizeof(p.distortion)) return Corrupt(path_, "patrols: distortion of " + p.flight);
+      std::memcpy(p.distortion.data(), distortion, size);
+      p.feature_image_width = static_cast<int>(std::clamp<std::int64_t>(rows.Int(9), -1, 1 << 30));
+      p.has_objects = rows.Int(10) != 0;
+      p.depth_source = rows.Text(11);
+      p.pose_source = rows.Text(12);
+      p.timed = rows.Int(13) != 0;
+      p.source = rows.Text(14);
+      p.source_digest = rows.Text(15);
+      const unsigned char* views = rows.Blob(16, &size);
+      if (size % sizeof(PoseRecord) != 0) return Corrupt(path_, "patrols: views of " + p.flight);
+      std::vector<PoseRecord> records(size / sizeof(PoseRecord));
+      if (size > 0) std::memcpy(static_cast<void*>(records.data()), views, size);
+      p.views = FromRecords(records);
+      p.grid.voxel_size = rows.Real(17);
+      p.grid.evicted_voxels = rows.Int(18);
+      out->push_back(std::move(p));
+    }
+    PATROLMAP_RETURN_IF_ERROR(status);
+    return Objects(out);
+  }
+
+  // The grid and route frames of records[i].
+  Status Details(std::size_t i, PatrolRecord* p) {
+    SqliteStatement grid;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("SELECT voxels FROM grids WHERE patrol = ?1", &grid));
+    Status status;
+    if (grid.Bind(1, ids_[i]).Step(&status)) {
+      std::size_t size = 0;
+      const unsigned char* voxels = grid.Blob(0, &size);
+      if (size % sizeof(VoxelEvidence) != 0) return Corrupt(path_, "grids: voxels of " + p->flight);
+      p->grid.voxels.resize(size / sizeof(VoxelEvidence));
+      if (size > 0) std::memcpy(static_cast<void*>(p->grid.voxels.data()), voxels, size);
+    }
+    PATROLMAP_RETURN_IF_ERROR(status);
+    return Route(ids_[i], p);
+  }
+
+  // Whether records[i] has a grid with voxels.
+  bool HasVoxels(std::size_t i) {
+    SqliteStatement grid;
+    Status status;
+    return db_->Prepare("SELECT length(voxels) FROM grids WHERE patrol = ?1", &grid).ok() &&
+           grid.Bind(1, ids_[i]).Step(&status) && grid.Int(0) > 0;
+  }
+
+ private:
+  static Reader BlobReader(const SqliteStatement& rows, int column) {
+    std::size_t size = 0;
+    const unsigned char* data = rows.Blob(column, &size);
+    return Reader(reinterpret_cast<const char*>(data), data == nullptr ? 0 : size);
+  }
+
+  Status Objects(std::vector<PatrolRecord>* records) {
+    std::map<std::int64_t, std::size_t> index;
+    for (std::size_t i = 0; i < ids_.size(); ++i) index[ids_[i]] = i;
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "SELECT patrol, id, site_object, label, confidence, detections, confirmed, x, y, z, first_seen_ns, "
+        "last_seen_ns, shape FROM objects ORDER BY patrol, position",
+        &rows));
+    Status status;
+    while (rows.Step(&status)) {
+      const auto owner = index.find(rows.Int(0));
+      if (owner == index.end()) return Corrupt(path_, "objects: an object of no patrol");
+      PatrolRecord& p = (*records)[owner->second];
+      MapObject o;
+      o.id = static_cast<int>(std::clamp<std::int64_t>(rows.Int(1), INT32_MIN, INT32_MAX));
+      o.site_id = static_cast<int>(std::clamp<std::int64_t>(rows.Int(2), -2, kMaxSiteId + 1));
+      o.label = rows.Text(3);
+      o.confidence = rows.Real(4);
+      o.detections = static_cast<int>(std::clamp<std::int64_t>(rows.Int(5), -1, INT32_MAX));
+      o.confirmed = rows.Int(6) != 0;
+      o.centroid = Eigen::Vector3d(rows.Real(7), rows.Real(8), rows.Real(9));
+      o.first_seen_ns = rows.Int(10);
+      o.last_seen_ns = rows.Int(11);
+      Reader shape = BlobReader(rows, 12);
+      ReadObjectShape(&shape, &o);
+      if (shape.failed() || !shape.done()) {
+        return Corrupt(path_, "objects: shape of object " + std::to_string(o.id) + " of patrol " + p.flight);
+      }
+      p.objects.push_back(std::move(o));
+    }
+    return status;
+  }
+
+  Status Route(std::int64_t patrol, PatrolRecord* p) {
+    SqliteStatement rows;
+    PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
+        "SELECT timestamp_ns, frame_index, x, y, z, qw, qx, qy, qz, latitude, longitude, jpeg FROM route_frames "
+        "WHERE patrol = ?1 ORDER BY position",
+        &rows));
+    rows.Bind(1, patrol);
+    Status status;
+    while (rows.Step(&status)) {
+      RouteFrame f;
+      f.timestamp_ns = rows.Int(0);
+      f.frame_index = rows.Int(1);
+      if (!rows.IsNull(2)) {
+        PoseRecord r{f.timestamp_ns,
+                     {rows.Real(2), rows.Real(3), rows.Real(4)},
+                     {rows.Real(5), rows.Real(6), rows.Real(7), rows.Real(8)}};
+        f.pose = FromRecord(r);
+      }
+      if (!rows.IsNull(9)) f.gps = Eigen::Vector2d(rows.Real(9), rows.Real(10));
+      std::size_t size = 0;
+      const unsigned char* jpeg = rows.Blob(11, &size);
+      if (jpeg != nullptr) f.jpeg.assign(jpeg, jpeg + size);
+      p->route.push_back(std::move(f));
+    }
+    return status;
+  }
+
+  SqliteDatabase* db_;
+  const std::string& path_;
+  std::vector<std::int64_t> ids_;
 };
 
-Status ParseSection(const std::string& path, std::uint32_t version, const std::string& tag, const char* payload,
-                    std::size_t length, TopoMap* map, SectionsSeen* seen) {
-  Reader reader(payload, length);
-  const auto once = [&](bool* flag) {
-    const bool first = !*flag;
-    *flag = true;
-    return first;
+// The records whose grids and route frames a kLatest load reads: the last flight's, and the latest with voxels.
+std::vector<bool> LatestRecords(const TopoMap& map, const std::vector<PatrolRecord>& records, MapReader* reader) {
+  std::vector<bool> wanted(records.size(), false);
+  const std::vector<std::string> flights = map.Flights();
+  const auto index_of = [&](const std::string& flight) {
+    for (std::size_t i = 0; i < records.size(); ++i)
+      if (records[i].flight == flight) return static_cast<int>(i);
+    return -1;
   };
-  if (tag == "NODE" && once(&seen->nodes)) return ParseNodes(path, &reader, map);
-  if (tag == "EDGE" && seen->nodes && once(&seen->edges)) return ParseEdges(path, version, &reader, map);
-  if (tag == "FEAT" && seen->nodes && once(&seen->features)) return ParseFeatures(path, version, &reader, map);
-  if (tag == "PTRL" && once(&seen->patrols)) return ParsePatrols(path, version, &reader, map);
-  if (tag == "VOCB" && once(&seen->vocabulary)) return ParseVocabulary(path, &reader, map);
-  return Corrupt(path, "unexpected or repeated section " + tag);
+  if (!flights.empty() && index_of(flights.back()) >= 0)
+    wanted[static_cast<std::size_t>(index_of(flights.back()))] = true;
+  for (auto flight = flights.rbegin(); flight != flights.rend(); ++flight) {
+    const int i = index_of(*flight);
+    if (i >= 0 && reader->HasVoxels(static_cast<std::size_t>(i))) {
+      wanted[static_cast<std::size_t>(i)] = true;
+      break;
+    }
+  }
+  return wanted;
+}
+
+Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) {
+  SqliteDatabase db;
+  PATROLMAP_RETURN_IF_ERROR(SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadOnly, &db));
+  MapReader reader(&db, path);
+  *map = TopoMap();
+  PATROLMAP_RETURN_IF_ERROR(reader.Info(map));
+  PATROLMAP_RETURN_IF_ERROR(reader.Nodes(map));
+  PATROLMAP_RETURN_IF_ERROR(reader.Edges(map));
+  std::vector<PatrolRecord> records;
+  PATROLMAP_RETURN_IF_ERROR(reader.Patrols(&records));
+  std::set<std::string> flights;
+  for (const PatrolRecord& p : records) {
+    // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.
+    if (!flights.insert(p.flight).second) return Corrupt(path, "second patrol record of " + p.flight);
+  }
+  const std::vector<bool> wanted =
+      detail == PatrolDetail::kAll ? std::vector<bool>(records.size(), true) : LatestRecords(*map, records, &reader);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    PatrolRecord& p = records[i];
+    if (wanted[i]) {
+      PATROLMAP_RETURN_IF_ERROR(reader.Details(i, &p));
+    } else {
+      p.partial = true;
+    }
+    PATROLMAP_RETURN_IF_ERROR(CheckPatrolRecord(path, p));
+    map->SetPatrol(std::move(p));
+  }
+  return Status::Ok();
+}
+
+Status WriteWhole(const TopoMap& map, MapWriter* writer) {
+  PATROLMAP_RETURN_IF_ERROR(writer->Prepare());
+  PATROLMAP_RETURN_IF_ERROR(writer->Info(map));
+  for (int i = 0; i < map.node_count(); ++i) PATROLMAP_RETURN_IF_ERROR(writer->Node(i, map.node(i)));
+  const std::vector<TopoMap::Edge> edges = map.Edges();
+  for (std::size_t i = 0; i < edges.size(); ++i) PATROLMAP_RETURN_IF_ERROR(writer->Edge(static_cast<int>(i), edges[i]));
+  for (const PatrolRecord& p : map.patrols()) PATROLMAP_RETURN_IF_ERROR(writer->Patrol(p));
+  return Status::Ok();
+}
+
+// What `map` has that the database `db` (the map it was loaded from) does not: nodes and edges after the stored
+// ones, and records of flights it has no record of; and the nodes' layout and the objects' site ids, renewed.
+Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* db, MapWriter* writer) {
+  Status status;
+  const std::int64_t nodes = Count(db, "SELECT count(*) FROM nodes", &status);
+  PATROLMAP_RETURN_IF_ERROR(status);
+  const std::int64_t edges = Count(db, "SELECT count(*) FROM edges", &status);
+  PATROLMAP_RETURN_IF_ERROR(status);
+  const std::vector<TopoMap::Edge> all_edges = map.Edges();
+  PATROLMAP_CHECK(nodes <= map.node_count() && edges <= static_cast<std::int64_t>(all_edges.size()));
+  PATROLMAP_RETURN_IF_ERROR(writer->Prepare());
+  PATROLMAP_RETURN_IF_ERROR(writer->Info(map));
+  for (int i = static_cast<int>(nodes); i < map.node_count(); ++i)
+    PATROLMAP_RETURN_IF_ERROR(writer->Node(i, map.node(i)));
+  for (auto i = static_cast<std::size_t>(edges); i < all_edges.size(); ++i) {
+    PATROLMAP_RETURN_IF_ERROR(writer->Edge(static_cast<int>(i), all_edges[i]));
+  }
+  SqliteStatement layout, site, stored;
+  PATROLMAP_RETURN_IF_ERROR(
+      db->Prepare("UPDATE nodes SET layout_x = ?1, layout_y = ?2, heading = ?3 WHERE id = ?4", &layout));
+  for (int i = 0; i < static_cast<int>(nodes); ++i) {
+    const KeyFrameNode& n = map.node(i);
+    PATROLMAP_RETURN_IF_ERROR(
+        layout.Bind(1, n.layout.x()).Bind(2, n.layout.y()).Bind(3, n.heading).Bind(4, std::int64_t{i}).Run());
+  }
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT id FROM patrols WHERE flight = ?1", &stored));
+  PATROLMAP_RETURN_IF_ERROR(
+      db->Prepare("UPDATE objects SET site_object = ?1 WHERE patrol = ?2 AND position = ?3", &site));
+  for (const PatrolRecord& p : map.patrols()) {
+    stored.Bind(1, p.flight);
+    const bool has = stored.Step(&status);
+    const std::int64_t row = has ? stored.Int(0) : -1;
+    stored.Reset();
+    PATROLMAP_RETURN_IF_ERROR(status);
+    if (!has) {
+      if (p.partial) return Corrupt(base, "record of " + p.flight + " is gone from the file it was read from");
+      PATROLMAP_RETURN_IF_ERROR(writer->Patrol(p));
+      continue;
+    }
+    for (std::size_t k = 0; k < p.objects.size(); ++k) {
+      PATROLMAP_RETURN_IF_ERROR(
+          site.Bind(1, std::int64_t{p.objects[k].site_id}).Bind(2, row).Bind(3, static_cast<std::int64_t>(k)).Run());
+    }
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -631,56 +570,42 @@ Status ParseSection(const std::string& path, std::uint32_t version, const std::s
 Status SaveMap(const TopoMap& map, const std::string& path) {
   AtomicFile file;
   PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
-  std::string start(kMagic, 8);
-  const std::uint32_t header[2] = {kVersion, 5};
-  start.append(reinterpret_cast<const char*>(header), sizeof(header));
-  PATROLMAP_RETURN_IF_ERROR(file.Write(start));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("NODE", map, NodeSection, &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("EDGE", map, EdgeSection, &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("FEAT", map, FeatureSection, &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("PTRL", map, PatrolSection, &file));
-  PATROLMAP_RETURN_IF_ERROR(WriteSection("VOCB", map, VocabularySection, &file));
-  return file.Commit();
+  SqliteDatabase db;
+  PATROLMAP_RETURN_IF_ERROR(OpenForWriting(file, &db));
+  PATROLMAP_RETURN_IF_ERROR(db.Execute(kSchema));
+  {
+    MapWriter writer(&db);  // its statements finalized before the database closes
+    PATROLMAP_RETURN_IF_ERROR(WriteWhole(map, &writer));
+  }
+  return Finish(&db, &file);
 }
 
-Status LoadMap(const std::string& path, TopoMap* map) {
+Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path) {
+  if (base.empty() || !IsDatabase(base)) return SaveMap(map, path);
+  AtomicFile file;
+  PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
+  PATROLMAP_RETURN_IF_ERROR(CopyInto(base, &file));
+  SqliteDatabase db;
+  PATROLMAP_RETURN_IF_ERROR(OpenForWriting(file, &db));
+  {
+    MapWriter writer(&db);
+    PATROLMAP_RETURN_IF_ERROR(WriteGrowth(map, base, &db, &writer));
+  }
+  return Finish(&db, &file);
+}
+
+Status LoadMap(const std::string& path, TopoMap* map, PatrolDetail detail) {
   std::error_code error;
   const auto size = std::filesystem::file_size(path, error);
   if (error) return Status::NotFound(path + ": cannot read map: " + error.message());
+  if (IsDatabase(path)) return LoadDatabase(path, map, detail);
+  const std::string start = FileStart(path, 8);
+  if (start.size() < 8 || std::memcmp(start.data(), kLegacyMagic, 8) != 0) {
+    return Status::DataLoss(path + ": not a patrolmap map file");
+  }
   std::string bytes(size, '\0');
   std::ifstream(path, std::ios::binary).read(bytes.data(), static_cast<std::streamsize>(size));
-  if (size < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
-    return Status::DataLoss(path + ": not a patrolmap map file");
-  if (size < 16) return Status::DataLoss(path + ": truncated map (header incomplete)");
-  std::uint32_t header[2];
-  std::memcpy(header, bytes.data() + 8, sizeof(header));
-  if (header[0] < kOldestVersion) {
-    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) + " is not one patrolmap wrote");
-  }
-  if (header[0] > kVersion) {
-    return Status::DataLoss(path + ": map format version " + std::to_string(header[0]) +
-                            " is newer than this patrolmap reads (" + std::to_string(kVersion) + ")");
-  }
-  *map = TopoMap();
-  std::size_t position = 16;
-  SectionsSeen seen;
-  for (std::uint32_t s = 0; s < header[1]; ++s) {
-    if (size - position < 20)
-      return Status::DataLoss(path + ": truncated map (section " + std::to_string(s) + " header)");
-    const std::string tag(bytes.data() + position, 4);
-    std::uint64_t length, checksum;
-    std::memcpy(&length, bytes.data() + position + 4, 8);
-    std::memcpy(&checksum, bytes.data() + position + 12, 8);
-    position += 20;
-    if (length > size - position) return Status::DataLoss(path + ": truncated map (section " + tag + ")");
-    const char* payload = bytes.data() + position;
-    if (Checksum(payload, length) != checksum) return Corrupt(path, "checksum of section " + tag);
-    PATROLMAP_RETURN_IF_ERROR(ParseSection(path, header[0], tag, payload, length, map, &seen));
-    position += length;
-  }
-  if (!seen.nodes || !seen.edges) return Corrupt(path, "node or edge section missing");
-  if (position != size) return Corrupt(path, "trailing bytes");
-  return Status::Ok();
+  return ParseLegacyMap(path, bytes, map);
 }
 
 }  // namespace patrolmap::graph

@@ -149,10 +149,10 @@ Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary
   return Status::Ok();
 }
 
-Status SaveMapRun(graph::TopoMap* map, const std::string& folder) {
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base) {
   PATROLMAP_RETURN_IF_ERROR(graph::LayoutMap(graph::LayoutInputOf(*map), graph::LayoutOptions{}, map));
   PATROLMAP_RETURN_IF_ERROR(WriteMapOutputs(*map, folder));
-  return graph::SaveMap(*map, folder + "/map.pmap");
+  return graph::SaveMapOnto(*map, base, folder + "/map.pmap");
 }
 
 }  // namespace patrolmap::pipeline

@@ -249,7 +249,10 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   Config config;
   PATROLMAP_RETURN_IF_ERROR(CheckRequest(request, &config));
   graph::TopoMap prior;
-  if (!request.prior_map.empty()) PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(request.prior_map, &prior));
+  // What a new patrol is compared and aligned with is read whole; the rest of the earlier patrols stays in the file.
+  if (!request.prior_map.empty()) {
+    PATROLMAP_RETURN_IF_ERROR(graph::LoadMap(request.prior_map, &prior, graph::PatrolDetail::kLatest));
+  }
   vocab::Vocabulary vocabulary;
   std::string vocabulary_path;
   PATROLMAP_RETURN_IF_ERROR(LoadSiftVocabulary(request.vocabulary_path, &vocabulary, &vocabulary_path));
@@ -278,7 +281,7 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
     PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map, entries));
   }
   if (monitor != nullptr) outcome->events = monitor->events();
-  return SaveMapRun(&map, request.out);
+  return SaveMapRun(&map, request.out, request.prior_map);
 }
 
 }  // namespace patrolmap::pipeline

@@ -16,7 +16,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "patrolmap/core/checksum.h"
+#include "patrolmap/core/sqlite.h"
 
+#include "../src/graph/map_file_v12.h"
 #include "graph/fixtures.h"
 #include "patrolmap/graph/export.h"
 #include "patrolmap/graph/layout.h"
@@ -94,7 +96,7 @@ TEST(MapFile, RoundTripKeepsEverything) {
 class MapFileCorruptTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    ASSERT_TRUE(SaveMap(TwoFlights(), dir_ / "m.pmap").ok());
+    ASSERT_TRUE(SaveLegacyMap(TwoFlights(), dir_ / "m.pmap").ok());
     bytes_ = testing::ReadText(dir_ / "m.pmap");
   }
   std::string LoadBytes(const std::string& bytes) {
@@ -116,14 +118,14 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
   std::string newer = bytes_;
   const std::uint32_t version = 13;
   std::memcpy(newer.data() + 8, &version, 4);
-  EXPECT_NE(LoadBytes(newer).find("version 13 is newer"), std::string::npos);
+  EXPECT_NE(LoadBytes(newer).find("version 13 is not one patrolmap wrote"), std::string::npos);
   EXPECT_NE(LoadBytes(bytes_ + "xx").find("trailing bytes"), std::string::npos);
   // Voxels out of order (a grid no patrolmap wrote), with a valid checksum.
   TopoMap unsorted = TwoFlights();
   PatrolRecord record = *unsorted.Patrol("b");
   std::swap(record.grid.voxels[0], record.grid.voxels[2]);
   unsorted.SetPatrol(record);
-  ASSERT_TRUE(SaveMap(unsorted, dir_ / "unsorted.pmap").ok());
+  ASSERT_TRUE(SaveLegacyMap(unsorted, dir_ / "unsorted.pmap").ok());
   EXPECT_NE(LoadBytes(testing::ReadText(dir_ / "unsorted.pmap")).find("corrupt map (evidence grid of b)"),
             std::string::npos);
   TopoMap map;
@@ -133,7 +135,7 @@ TEST_F(MapFileCorruptTest, EveryCaseFailsWithAMessageNamingTheFile) {
 // Files with good checksums whose content no patrolmap writes: each is refused naming what is wrong.
 TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
   const auto refused = [this](const TopoMap& map, const std::string& what) {
-    EXPECT_TRUE(SaveMap(map, dir_ / "bad.pmap").ok());
+    EXPECT_TRUE(SaveLegacyMap(map, dir_ / "bad.pmap").ok());
     const std::string message = LoadBytes(testing::ReadText(dir_ / "bad.pmap"));
     EXPECT_NE(message.find("x.pmap: corrupt map (" + what), std::string::npos) << message;
   };
@@ -179,7 +181,7 @@ TEST_F(MapFileCorruptTest, ImpossibleContentBehindAGoodChecksumIsRefused) {
     record.flight = flight;
     twice.SetPatrol(record);
   }
-  ASSERT_TRUE(SaveMap(twice, dir_ / "twice.pmap").ok());
+  ASSERT_TRUE(SaveLegacyMap(twice, dir_ / "twice.pmap").ok());
   std::string doubled = testing::ReadText(dir_ / "twice.pmap");
   const std::size_t id = doubled.find("zq8");
   ASSERT_NE(id, std::string::npos);
@@ -269,7 +271,7 @@ std::string OlderPatrolSection(const TopoMap& map, const std::string& path, std:
   EXPECT_EQ(map.Patrol("b")->source + map.Patrol("b")->source_digest, "");
   if (version < 11) dropped += 8;
   if (version < 12) dropped += 4 + 4 * map.Patrol("b")->objects.size();  // the objects' site ids
-  EXPECT_TRUE(SaveMap(map, path).ok());
+  EXPECT_TRUE(SaveLegacyMap(map, path).ok());
   std::string bytes = testing::ReadText(path);
   const std::size_t tag = bytes.find("PTRL", 16);
   EXPECT_NE(tag, std::string::npos);
@@ -423,7 +425,7 @@ TEST(MapFile, VersionSevenKeypointRecordsLoadAsPositions) {
     EXPECT_EQ(map.node(i).points, original.node(i).points);
     EXPECT_EQ(cv::norm(map.node(i).descriptors, original.node(i).descriptors, cv::NORM_INF), 0.0);
   }
-  ASSERT_TRUE(SaveMap(map, dir / "again.pmap").ok());
+  ASSERT_TRUE(SaveLegacyMap(map, dir / "again.pmap").ok());
   EXPECT_EQ(testing::ReadText(dir / "again.pmap"), testing::ReadText(dir / "m.pmap"));
 }
 
@@ -537,7 +539,7 @@ TEST(MapFile, FeaturesOfAnUnknownKindAreRefused) {
 
 TEST(MapFile, VersionOneFilesStillLoad) {
   testing::TempDir dir;
-  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
+  ASSERT_TRUE(SaveLegacyMap(TwoFlights(), dir / "m.pmap").ok());
   std::string bytes = testing::ReadText(dir / "m.pmap");
   ASSERT_NO_FATAL_FAILURE(DowngradeEdges(&bytes));
   ASSERT_NO_FATAL_FAILURE(DowngradeFeatures(&bytes));
@@ -616,7 +618,7 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
 TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {
   testing::TempDir dir;
   const std::string original = dir / "m.pmap", damaged = dir / "damaged.pmap";
-  ASSERT_TRUE(SaveMap(TwoFlights(), original).ok());
+  ASSERT_TRUE(SaveLegacyMap(TwoFlights(), original).ok());
   const std::string bytes = testing::ReadText(original);
   std::vector<std::string> cases;
   for (int i = 0; i < 64; ++i) cases.push_back(bytes.substr(0, bytes.size() * i / 64));
@@ -651,6 +653,182 @@ TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {
   EXPECT_EQ(loaded + refused, 264);
   EXPECT_GE(refused, 64);  // every truncation (and the empty file) is refused
   EXPECT_GT(loaded, 100);  // most flips reach the parsers past the recomputed checksums (187 at seed 19)
+}
+
+// ---- The SQLite store (format 13) ----
+
+// The bytes of `map` as format 12 writes them: equal bytes, equal maps (every record must be whole).
+std::string Content(const TopoMap& map, const std::string& path) {
+  EXPECT_TRUE(SaveLegacyMap(map, path).ok());
+  return testing::ReadText(path);
+}
+
+// WithRoute's map with a third flight c after it: two nodes, a closure onto b, and a record with a grid.
+TopoMap ThreeFlights() {
+  TopoMap map = WithRoute();
+  for (int i = 0; i < 2; ++i) {
+    KeyFrameNode node = map.node(i);
+    node.flight = "c";
+    node.timestamp_ns = SecondsToNs(100.0 + i);
+    map.AddNode(node);
+  }
+  map.AddEdge(7, 8, EdgeData{});
+  map.AddEdge(8, 5, {EdgeKind::kLoopClosure, 0.3, 0.4, 40, -31.0});
+  PatrolRecord c = *map.Patrol("b");
+  c.flight = "c";
+  c.grid.voxels = {{1, 1, 1, 3, 0}};
+  c.objects[0].site_id = 4;
+  map.SetPatrol(c);
+  return map;
+}
+
+TEST(MapStore, AUserCanReadTheTablesWithSqlite) {
+  testing::TempDir dir;
+  ASSERT_TRUE(SaveMap(ThreeFlights(), dir / "m.pmap").ok());
+  EXPECT_EQ(testing::ReadText(dir / "m.pmap").substr(0, 15), "SQLite format 3");
+  SqliteDatabase db;
+  ASSERT_TRUE(SqliteDatabase::Open(dir / "m.pmap", SqliteDatabase::Mode::kReadOnly, &db).ok());
+  SqliteStatement count;
+  ASSERT_TRUE(db.Prepare("SELECT count(*) FROM nodes WHERE flight = 'c'", &count).ok());
+  Status status;
+  ASSERT_TRUE(count.Step(&status));
+  EXPECT_EQ(count.Int(0), 2);
+  SqliteStatement objects;
+  ASSERT_TRUE(db.Prepare("SELECT p.flight, o.label, o.site_object FROM objects o JOIN patrols p ON p.id = o.patrol "
+                         "ORDER BY p.id",
+                         &objects)
+                  .ok());
+  ASSERT_TRUE(objects.Step(&status));
+  EXPECT_EQ(objects.Text(0), "b");
+  EXPECT_EQ(objects.Text(1), "crate");
+  ASSERT_TRUE(objects.Step(&status));
+  EXPECT_EQ(objects.Text(0), "c");
+  EXPECT_EQ(objects.Int(2), 4);
+}
+
+// A map of format 12 loads and saves as the database, holding the same.
+TEST(MapStore, AFormatTwelveMapMigrates) {
+  testing::TempDir dir;
+  const TopoMap map = ThreeFlights();
+  ASSERT_TRUE(SaveLegacyMap(map, dir / "old.pmap").ok());
+  TopoMap old;
+  ASSERT_TRUE(LoadMap(dir / "old.pmap", &old).ok());
+  ASSERT_TRUE(SaveMapOnto(old, dir / "old.pmap", dir / "new.pmap").ok());
+  EXPECT_EQ(testing::ReadText(dir / "new.pmap").substr(0, 15), "SQLite format 3");
+  TopoMap migrated;
+  ASSERT_TRUE(LoadMap(dir / "new.pmap", &migrated).ok());
+  EXPECT_EQ(Content(migrated, dir / "a.bin"), Content(map, dir / "b.bin"));
+}
+
+// A patrol reads the last flight's and the latest grid's records whole and the others without grid and route; a
+// save onto the file it read keeps those, and equals a whole save of the whole map.
+TEST(MapStore, APartialLoadGrownAndSavedOntoItsFileEqualsAWholeSave) {
+  testing::TempDir dir;
+  TopoMap whole = ThreeFlights();
+  ASSERT_TRUE(SaveMap(whole, dir / "m.pmap").ok());
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &map, PatrolDetail::kLatest).ok());
+  ASSERT_TRUE(map.Patrol("b")->partial);
+  EXPECT_TRUE(map.Patrol("b")->route.empty());
+  EXPECT_TRUE(map.Patrol("b")->grid.voxels.empty());
+  EXPECT_EQ(map.Patrol("b")->objects.size(), 1u);  // objects are always read: site objects number on from them
+  ASSERT_FALSE(map.Patrol("c")->partial);
+  EXPECT_EQ(map.Patrol("c")->grid.voxels.size(), 1u);
+  EXPECT_EQ(map.Patrol("c")->route.size(), 2u);
+  // Grown as a patrol grows it: a node, an edge, a record, the layout and a site id renewed.
+  for (TopoMap* m : {&map, &whole}) {
+    KeyFrameNode node = m->node(0);
+    node.flight = "d";
+    node.timestamp_ns = SecondsToNs(200.0);
+    m->AddNode(node);
+    m->AddEdge(9, 2, {EdgeKind::kLoopClosure, 0.5, 0.6, 70, -40.0});
+    PatrolRecord d = *m->Patrol("c");
+    d.flight = "d";
+    m->SetPatrol(d);
+    m->mutable_node(3).layout = Eigen::Vector2d(7.5, 8.5);
+    m->MutablePatrol("b")->objects[0].site_id = 9;
+  }
+  ASSERT_TRUE(SaveMapOnto(map, dir / "m.pmap", dir / "grown.pmap").ok());
+  TopoMap grown;
+  ASSERT_TRUE(LoadMap(dir / "grown.pmap", &grown).ok());
+  EXPECT_EQ(Content(grown, dir / "a.bin"), Content(whole, dir / "b.bin"));
+  EXPECT_EQ(grown.Patrol("b")->route.size(), 2u);  // kept in the file though never read
+}
+
+TEST(MapStore, ForeignNewerAndDamagedDatabasesAreRefusedNamingTheFile) {
+  testing::TempDir dir;
+  const std::string path = dir / "m.pmap";
+  ASSERT_TRUE(SaveMap(ThreeFlights(), path).ok());
+  const auto change = [&](const std::string& sql) {
+    ASSERT_TRUE(SaveMap(ThreeFlights(), path).ok());
+    SqliteDatabase db;
+    ASSERT_TRUE(SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadWrite, &db).ok());
+    ASSERT_TRUE(db.Execute(sql).ok()) << sql;
+  };
+  const auto message = [&] {
+    TopoMap map;
+    return LoadMap(path, &map).message();
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {"UPDATE map_info SET value = '14' WHERE key = 'version'", "map format version 14 is newer than"},
+      {"UPDATE map_info SET value = 'x' WHERE key = 'version'", "corrupt map (map_info: version 'x')"},
+      {"DELETE FROM map_info", "not a patrolmap map"},
+      {"DROP TABLE map_info", "not a patrolmap map"},
+      {"DROP TABLE edges", "no such table: edges"},
+      {"UPDATE nodes SET id = 9 WHERE id = 6", "node ids"},
+      {"UPDATE nodes SET thumbnail = x'00' WHERE id = 1", "thumbnail of node 1"},
+      {"UPDATE nodes SET features = x'0000' WHERE id = 2", "features of node 2"},
+      {"UPDATE nodes SET latitude = 91 WHERE id = 2", "GPS or layout of node 2"},
+      {"UPDATE edges SET node_b = 99 WHERE id = 0", "edge 0"},
+      {"UPDATE edges SET kind = 'teleport' WHERE id = 1", "edge 1"},
+      {"INSERT INTO edges SELECT 100, node_a, node_b, kind, 0, 0, 0, 0 FROM edges WHERE id = 0", "repeats another"},
+      {"UPDATE patrols SET views = x'00' WHERE flight = 'b'", "views of b"},
+      {"UPDATE patrols SET depth_source = 'sonar' WHERE flight = 'c'", "evidence grid of c"},
+      {"UPDATE patrols SET flight = 'c/d' WHERE flight = 'c'", "flight id"},
+      {"UPDATE objects SET site_object = -5", "object 3 of patrol b"},
+      {"UPDATE objects SET shape = x'01'", "shape of object 3"},
+      {"UPDATE grids SET voxels = x'0102'", "voxels of b"},
+      {"UPDATE route_frames SET jpeg = x'00'", "route frames of b"},
+  };
+  for (const auto& [sql, expected] : cases) {
+    change(sql);
+    const std::string got = message();
+    EXPECT_NE(got.find(path), std::string::npos) << sql << ": " << got;
+    EXPECT_NE(got.find(expected), std::string::npos) << sql << ": " << got;
+  }
+}
+
+// Truncated at 32 lengths and with 300 single-byte changes (fixed seed), a database loads the same way twice and
+// saves, or fails naming the file.
+TEST(MapStore, ADamagedDatabaseLoadsIdenticallyOrFailsNamingTheFile) {
+  testing::TempDir dir;
+  const std::string original = dir / "m.pmap", damaged = dir / "damaged.pmap";
+  ASSERT_TRUE(SaveMap(ThreeFlights(), original).ok());
+  const std::string bytes = testing::ReadText(original);
+  std::vector<std::string> cases;
+  for (int i = 0; i < 32; ++i) cases.push_back(bytes.substr(0, bytes.size() * i / 32));
+  std::mt19937 rng(23);
+  for (int i = 0; i < 300; ++i) {
+    std::string changed = bytes;
+    changed[std::uniform_int_distribution<std::size_t>(0, bytes.size() - 1)(rng)] =
+        static_cast<char>(std::uniform_int_distribution<int>(0, 255)(rng));
+    cases.push_back(changed);
+  }
+  int refused = 0;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    std::ofstream(damaged, std::ios::binary | std::ios::trunc) << cases[i];
+    TopoMap first, second;
+    const Status a = LoadMap(damaged, &first), b = LoadMap(damaged, &second);
+    ASSERT_EQ(a.message(), b.message()) << "case " << i;
+    if (!a.ok()) {
+      EXPECT_NE(a.message().find(damaged), std::string::npos) << "case " << i << ": " << a.message();
+      ++refused;
+      continue;
+    }
+    EXPECT_EQ(ToJson(first), ToJson(second)) << "case " << i;
+    EXPECT_TRUE(SaveMap(first, dir / "again.pmap").ok()) << "case " << i;
+  }
+  EXPECT_GE(refused, 31);  // every truncation but the whole file
 }
 
 }  // namespace

@@ -23,6 +23,9 @@ class AtomicFile {
   Status Write(const char* data, std::size_t size);
   Status Write(const std::string& bytes) { return Write(bytes.data(), bytes.size()); }
   Status Commit();
+  // The temporary, for a writer that fills it by its own means (an SQLite database); Commit() then flushes and
+  // renames it as it would the pieces.
+  const std::string& temporary_path() const { return temporary_; }
 
  private:
   void Abandon();

@@ -128,6 +128,9 @@ struct PatrolRecord {
   // The log the patrol was read from, as an absolute path, and io::LogDigest of its content (map format 11 on;
   // empty before, and for a camera), so the same log is never mapped twice.
   std::string source, source_digest;
+  // Read without its evidence grid's voxels and its route frames (graph::LoadMap, PatrolDetail::kLatest), which
+  // stay in the map file: kept and carried to the next save, never compared.
+  bool partial = false;
 };
 
 // The view of `record` nearest in time to `timestamp_ns`, when one lies within `tolerance_ns` of it.

@@ -1,21 +1,25 @@
-// The map file: one versioned binary file per patrol series holding the graph,
-// the key-frame thumbnails, features and bag-of-words vectors, so a later
-// flight can be matched without the original logs.
+// The map file: one SQLite 3 database (map format 13) holding the graph, the key frames' thumbnails, features and
+// bag-of-words vectors, and what each patrol keeps for change detection, so a later flight can be matched and
+// compared without the original logs. One file a user can copy; `sqlite3 map.pmap .schema` shows the tables:
 //
-//   8 bytes  magic "PMMAP\0\0\0"
-//   u32      format version
-//   u32      section count
-//   sections tag (4 bytes), u64 payload length, u64 checksum of the payload, payload
-//            NODE: per node flight, time, frame, thumbnail, GPS, layout, heading
-//            EDGE: per edge the two nodes, kind and verification scores
-//            FEAT: per node feature positions, descriptors (float, 8-bit or packed 4-bit rows,
-//                  vocab/descriptors.h) and BoW vector (format version 8; before it, 24-byte
-//                  keypoint records, of which only the position is read)
-//            PTRL: per patrol its camera, views, object map and evidence grid
-//                  (format version 2; version 1 files have no PTRL and still load)
-// Saving is atomic (temporary file, fsync, rename): a crash never leaves a
-// half-written map. Loading a truncated, corrupt, foreign or newer file fails
-// with a message naming the file and the problem.
+//   map_info(key, value)   format "patrolmap.map", version, vocabulary_fingerprint (hex), vocabulary_name
+//   nodes                  one row per key location: id (0, 1, ...), flight, timestamp_ns, frame_index, latitude and
+//                          longitude (NULL without GPS), layout_x, layout_y, heading, thumbnail and features (blobs)
+//   edges                  one row per edge in insertion order: node_a, node_b, kind ('traversal' or
+//                          'loop_closure'), bow_score, matched_fraction, inliers, log_nfa
+//   patrols                one row per patrol record, in the map's order: flight, the camera (fx, fy, cx, cy,
+//                          width, height, distortion), depth_source, pose_source, timed, source (the log),
+//                          source_digest, views (blob of poses), voxel_size, evicted_voxels
+//   objects                the patrol's object map: patrol, position, id, site_object, label, confidence,
+//                          detections, confirmed, x, y, z (centroid), first_seen_ns, last_seen_ns, shape (blob)
+//   grids                  the patrol's evidence grid: patrol, voxels (blob of 16-byte voxels, ascending x, y, z)
+//   route_frames           the frames kept along its route: patrol, position, timestamp_ns, frame_index, pose
+//                          (x, y, z, qw, qx, qy, qz; NULL without), latitude, longitude, jpeg
+//
+// Blobs hold little-endian values (graph/map_codec.h). A save writes a temporary file beside the map and renames
+// it over the map once it is complete and on disk, so a crash or kill at any moment leaves the previous map
+// whole. Loading a truncated, corrupt, foreign or newer file fails with a message naming the file and the problem;
+// maps of formats 1 to 12 (one binary file before the database) load too, and save as the database.
 #pragma once
 
 #include <string>
@@ -25,7 +29,18 @@
 
 namespace patrolmap::graph {
 
+// How much of the patrol records a load reads. kAll: everything. kLatest: the evidence grids and route frames of
+// the map's last flight and of its latest flight with a grid only, what a new patrol is compared and aligned with;
+// the other records are read without them (PatrolRecord::partial) and SaveMapOnto keeps them in the file. So a
+// patrol's memory and load time do not grow with the patrols the map holds.
+enum class PatrolDetail { kAll, kLatest };
+
+// Writes `map` whole to `path`; every patrol record must be whole.
 Status SaveMap(const TopoMap& map, const std::string& path);
-Status LoadMap(const std::string& path, TopoMap* map);
+Status LoadMap(const std::string& path, TopoMap* map, PatrolDetail detail = PatrolDetail::kAll);
+// Writes `map`, loaded from the map file `base` and grown since (new nodes, edges and patrol records appended, the
+// layout and site objects renumbered), to `path` as a copy of `base` with the changes applied in one transaction:
+// no record already in `base` is read or rewritten. A `base` of format 12 or older is saved whole instead.
+Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path);
 
 }  // namespace patrolmap::graph

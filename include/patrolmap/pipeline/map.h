@@ -98,8 +98,9 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
 // empty); fails naming the file when it is not one. `loaded` (may be null) receives the file's path.
 Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary, std::string* loaded = nullptr);
 
-// Lays the map out (graph::LayoutMap) and writes DIR/nodes.csv, DIR/loop_closures.csv and DIR/map.pmap.
-Status SaveMapRun(graph::TopoMap* map, const std::string& folder);
+// Lays the map out (graph::LayoutMap) and writes DIR/nodes.csv, DIR/loop_closures.csv and DIR/map.pmap: a copy of
+// the map file `base` the run read and grew (graph::SaveMapOnto), or the whole map when `base` is empty.
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base);
 
 // Writes the whole map as DIR/nodes.csv (node,flight,timestamp_ns,frame_index,
 // features) and DIR/loop_closures.csv (query_node,matched_node,query_frame,
