@@ -66,6 +66,33 @@ expect "info names the camera and its lens" 0 "camera 160x102 \(fx 97.4\) throug
 expect "patrol" 0 "1 log: 3 nodes" -- "$bin" patrol "$work/second" --map "$work/map/map.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol"
 expect "patrol extends the map" 0 "2 flights, 6 nodes" -- "$bin" info "$work/patrol/map.pmap"
+expect "the map is an SQLite database" 0 "edges +map_info +objects +route_frames" -- \
+  sqlite3 "$work/patrol/map.pmap" .tables
+# kill -9 at 20 moments of a patrol (fixed seed; half of them in the last fifth, where the map is written): the
+# prior map is never touched, and the output is either absent or a whole map of both flights.
+prior_sum=$(sha1sum <"$work/map/map.pmap")
+started=$(date +%s%N)
+"$bin" patrol "$work/second" --map "$work/map/map.pmap" --vocabulary "$source_dir/vocab/default.pmvoc" \
+  --out "$work/timed" >/dev/null 2>&1
+run_ms=$((($(date +%s%N) - started) / 1000000 + 1))
+RANDOM=7
+for kill_at in $(seq 1 20); do
+  rm -rf "$work/killed"
+  delay_ms=$((kill_at % 2 == 0 ? run_ms * 4 / 5 + RANDOM % (run_ms / 5 + 1) : RANDOM % run_ms))
+  "$bin" patrol "$work/second" --map "$work/map/map.pmap" --vocabulary "$source_dir/vocab/default.pmvoc" \
+    --out "$work/killed" >/dev/null 2>&1 &
+  patrol_pid=$!
+  sleep "$((delay_ms / 1000)).$(printf '%03d' $((delay_ms % 1000)))"
+  kill -9 "$patrol_pid" 2>/dev/null
+  wait "$patrol_pid" 2>/dev/null
+  [[ $(sha1sum <"$work/map/map.pmap") == "$prior_sum" ]] ||
+    { echo "FAIL kill $kill_at (${delay_ms} ms): the prior map changed"; failures=$((failures + 1)); }
+  if [[ -e "$work/killed/map.pmap" ]]; then
+    expect "kill $kill_at (${delay_ms} ms of ${run_ms}): the output map is whole" 0 "2 flights, 6 nodes" -- \
+      "$bin" info "$work/killed/map.pmap"
+  fi
+done
+expect "the prior map after the kills" 0 "1 flight, 3 nodes" -- "$bin" info "$work/map/map.pmap"
 # A patrol too short for a key location (30 images, 1 s) is still a flight: its route frames are compared with the
 # map's and kept, so the next patrol or `diff` can compare against it.
 mkdir -p "$work/short"
@@ -82,7 +109,7 @@ expect "diff compares the flight without nodes" 0 "street-1 -> short" -- \
 expect "merge keeps the flight without nodes" 0 "1 map merged: 2 flights, 3 nodes" -- \
   "$bin" merge "$work/shortpatrol/map.pmap" --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/shortmerge"
 head -c 300 "$work/map/map.pmap" > "$work/cut.pmap"
-expect "truncated map" 1 "cut.pmap: truncated map" -- "$bin" patrol "$work/second" --map "$work/cut.pmap" \
+expect "truncated map" 1 "cut.pmap: truncated or damaged" -- "$bin" patrol "$work/second" --map "$work/cut.pmap" \
   --vocabulary "$source_dir/vocab/default.pmvoc" --out "$work/patrol2"
 # Exports, read back by real consumers.
 expect "export graphml" 0 "" -- "$bin" export "$work/patrol/map.pmap" --format graphml --out "$work/map.graphml"

@@ -24,9 +24,11 @@ Status SqliteDatabase::Open(const std::string& path, Mode mode, SqliteDatabase* 
 
 Status SqliteDatabase::Error(const std::string& doing) const {
   if (!handle_) return Status::IoError(path_ + ": " + doing + ": out of memory");
-  std::string message = sqlite3_errmsg(handle_.get());
+  const std::string message = sqlite3_errmsg(handle_.get());
   const int code = sqlite3_errcode(handle_.get());
-  if (code == SQLITE_CORRUPT || code == SQLITE_NOTADB) message += " (the file is truncated or damaged)";
+  if (code == SQLITE_CORRUPT || code == SQLITE_NOTADB) {
+    return Status::DataLoss(path_ + ": truncated or damaged database (SQLite: " + message + ")");
+  }
   if (code == SQLITE_FULL || code == SQLITE_IOERR || code == SQLITE_CANTOPEN || code == SQLITE_READONLY) {
     return Status::IoError(path_ + ": " + doing + ": " + message);
   }

@@ -4,13 +4,16 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
+#include <optional>
 #include <set>
 #include <tuple>
 
 #include "map_codec.h"
 #include "map_file_v12.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/option_check.h"
 #include "patrolmap/core/sqlite.h"
 
 namespace patrolmap::graph {
@@ -31,7 +34,7 @@ CREATE TABLE patrols(id INTEGER PRIMARY KEY, flight TEXT NOT NULL UNIQUE, fx REA
   cx REAL NOT NULL, cy REAL NOT NULL, width INTEGER NOT NULL, height INTEGER NOT NULL, distortion BLOB NOT NULL,
   feature_image_width INTEGER NOT NULL, has_objects INTEGER NOT NULL, depth_source TEXT NOT NULL,
   pose_source TEXT NOT NULL, timed INTEGER NOT NULL, source TEXT NOT NULL, source_digest TEXT NOT NULL,
-  views BLOB NOT NULL, voxel_size REAL NOT NULL, evicted_voxels INTEGER NOT NULL);
+  views BLOB NOT NULL, voxel_size REAL NOT NULL, evicted_voxels INTEGER NOT NULL, archived INTEGER NOT NULL);
 CREATE TABLE objects(patrol INTEGER NOT NULL, position INTEGER NOT NULL, id INTEGER NOT NULL,
   site_object INTEGER NOT NULL, label TEXT NOT NULL, confidence REAL NOT NULL, detections INTEGER NOT NULL,
   confirmed INTEGER NOT NULL, x REAL NOT NULL, y REAL NOT NULL, z REAL NOT NULL, first_seen_ns INTEGER NOT NULL,
@@ -81,7 +84,7 @@ class MapWriter {
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare("INSERT INTO edges VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)", &edge_));
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
         "INSERT INTO patrols VALUES(NULL, ?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16, ?17, "
-        "?18)",
+        "?18, ?19)",
         &patrol_));
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
         "INSERT INTO objects VALUES(?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14)", &object_));
@@ -138,6 +141,7 @@ class MapWriter {
     const std::vector<PoseRecord> views = ToRecords(p.views);
     patrol_.BindBlob(16, views.data(), views.size() * sizeof(PoseRecord));
     patrol_.Bind(17, p.grid.voxel_size).Bind(18, static_cast<std::int64_t>(p.grid.evicted_voxels));
+    patrol_.Bind(19, std::int64_t{p.archived});
     PATROLMAP_RETURN_IF_ERROR(patrol_.Run());
     const std::int64_t row = LastRow();
     for (std::size_t i = 0; i < p.objects.size(); ++i) PATROLMAP_RETURN_IF_ERROR(Object(row, i, p.objects[i]));
@@ -231,10 +235,13 @@ class MapReader {
   MapReader(SqliteDatabase* db, const std::string& path) : db_(db), path_(path) {}
 
   Status Info(TopoMap* map) {
-    if (!db_->HasTable("map_info")) return Status::DataLoss(path_ + ": an SQLite database, but not a patrolmap map");
     std::map<std::string, std::string> info;
     SqliteStatement rows;
-    PATROLMAP_RETURN_IF_ERROR(db_->Prepare("SELECT key, value FROM map_info", &rows));
+    const Status prepared = db_->Prepare("SELECT key, value FROM map_info", &rows);
+    if (prepared.message().find("no such table: map_info") != std::string::npos) {
+      return Status::DataLoss(path_ + ": an SQLite database, but not a patrolmap map");
+    }
+    PATROLMAP_RETURN_IF_ERROR(prepared);
     Status status;
     while (rows.Step(&status)) info[rows.Text(0)] = rows.Text(1);
     PATROLMAP_RETURN_IF_ERROR(status);
@@ -326,7 +333,8 @@ class MapReader {
     SqliteStatement rows;
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
         "SELECT id, flight, fx, fy, cx, cy, width, height, distortion, feature_image_width, has_objects, depth_source, "
-        "pose_source, timed, source, source_digest, views, voxel_size, evicted_voxels FROM patrols ORDER BY id",
+        "pose_source, timed, source, source_digest, views, voxel_size, evicted_voxels, archived FROM patrols ORDER BY "
+        "id",
         &rows));
     Status status;
     while (rows.Step(&status)) {
@@ -355,6 +363,7 @@ class MapReader {
       p.views = FromRecords(records);
       p.grid.voxel_size = rows.Real(17);
       p.grid.evicted_voxels = rows.Int(18);
+      p.archived = rows.Int(19) != 0;
       out->push_back(std::move(p));
     }
     PATROLMAP_RETURN_IF_ERROR(status);
@@ -565,9 +574,98 @@ Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* 
   return Status::Ok();
 }
 
+// The voxels of `grids`' row `patrol`.
+Status ReadVoxels(SqliteDatabase* db, std::int64_t patrol, std::vector<VoxelEvidence>* voxels) {
+  SqliteStatement grid;
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT voxels FROM grids WHERE patrol = ?1", &grid));
+  Status status;
+  voxels->clear();
+  if (!grid.Bind(1, patrol).Step(&status)) return status;
+  std::size_t size = 0;
+  const unsigned char* data = grid.Blob(0, &size);
+  voxels->resize(size / sizeof(VoxelEvidence));
+  if (!voxels->empty()) std::memcpy(static_cast<void*>(voxels->data()), data, voxels->size() * sizeof(VoxelEvidence));
+  return Status::Ok();
+}
+
+// Keeps one route frame of `patrol` every `interval_s` (the first, then each the interval after the last kept).
+Status ThinRoute(SqliteDatabase* db, std::int64_t patrol, double interval_s) {
+  if (interval_s <= 0.0) return Status::Ok();
+  SqliteStatement frames, drop;
+  PATROLMAP_RETURN_IF_ERROR(
+      db->Prepare("SELECT position, timestamp_ns FROM route_frames WHERE patrol = ?1 ORDER BY position", &frames));
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("DELETE FROM route_frames WHERE patrol = ?1 AND position = ?2", &drop));
+  std::vector<std::int64_t> dropped;
+  std::optional<TimestampNs> kept;
+  Status status;
+  frames.Bind(1, patrol);
+  while (frames.Step(&status)) {
+    const TimestampNs time = frames.Int(1);
+    if (kept && time - *kept < SecondsToNs(interval_s)) {
+      dropped.push_back(frames.Int(0));
+    } else {
+      kept = time;
+    }
+  }
+  PATROLMAP_RETURN_IF_ERROR(status);
+  for (std::int64_t position : dropped) PATROLMAP_RETURN_IF_ERROR(drop.Bind(1, patrol).Bind(2, position).Run());
+  return Status::Ok();
+}
+
+// Archives the patrols of the database older than the latest `retention.whole_patrols` (in the order `map` flew
+// them): from the newest to the oldest, each archived one loses the voxels a later patrol holds and is thinned to
+// its archive frames. Each voxel of the site is then stored once, by the latest patrol that observed it.
+Status Archive(const TopoMap& map, const MapRetention& retention, SqliteDatabase* db) {
+  std::vector<std::string> flights;
+  for (const std::string& flight : map.Flights()) {
+    if (map.Patrol(flight) != nullptr) flights.push_back(flight);
+  }
+  const auto whole = static_cast<std::size_t>(std::max(retention.whole_patrols, 1));
+  if (flights.size() <= whole) return Status::Ok();
+  SqliteStatement row, update, mark;
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT id, voxel_size FROM patrols WHERE flight = ?1", &row));
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("UPDATE grids SET voxels = ?1 WHERE patrol = ?2", &update));
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("UPDATE patrols SET archived = 1 WHERE id = ?1", &mark));
+  std::map<double, std::vector<VoxelEvidence>> later;  // per voxel size, every voxel a later patrol holds
+  std::vector<VoxelEvidence> voxels, kept, merged;
+  for (std::size_t k = flights.size(); k-- > 0;) {
+    Status status;
+    if (!row.Bind(1, flights[k]).Step(&status))
+      return status.ok() ? Corrupt(db->path(), "no record of " + flights[k]) : status;
+    const std::int64_t patrol = row.Int(0);
+    const double voxel_size = row.Real(1);
+    row.Reset();
+    PATROLMAP_RETURN_IF_ERROR(ReadVoxels(db, patrol, &voxels));
+    std::vector<VoxelEvidence>& seen = later[voxel_size];
+    if (k + whole < flights.size()) {
+      kept.clear();
+      std::set_difference(voxels.begin(), voxels.end(), seen.begin(), seen.end(), std::back_inserter(kept),
+                          VoxelBefore);
+      if (kept.size() != voxels.size()) {
+        PATROLMAP_RETURN_IF_ERROR(
+            update.BindBlob(1, kept.data(), kept.size() * sizeof(VoxelEvidence)).Bind(2, patrol).Run());
+      }
+      PATROLMAP_RETURN_IF_ERROR(ThinRoute(db, patrol, retention.archive_frame_interval_s));
+      PATROLMAP_RETURN_IF_ERROR(mark.Bind(1, patrol).Run());
+      voxels.swap(kept);
+    }
+    merged.clear();
+    std::set_union(seen.begin(), seen.end(), voxels.begin(), voxels.end(), std::back_inserter(merged), VoxelBefore);
+    seen.swap(merged);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
-Status SaveMap(const TopoMap& map, const std::string& path) {
+bool MapRetention::IsValid(std::string* error) const {
+  return OptionCheck(error)
+      .InRange("map.whole_patrols", whole_patrols, 1, 1000000)
+      .InRange("map.archive_frame_interval_s", archive_frame_interval_s, 0.0, 3600.0)
+      .ok();
+}
+
+Status SaveMap(const TopoMap& map, const std::string& path, const MapRetention& retention) {
   AtomicFile file;
   PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
   SqliteDatabase db;
@@ -577,11 +675,13 @@ Status SaveMap(const TopoMap& map, const std::string& path) {
     MapWriter writer(&db);  // its statements finalized before the database closes
     PATROLMAP_RETURN_IF_ERROR(WriteWhole(map, &writer));
   }
+  PATROLMAP_RETURN_IF_ERROR(Archive(map, retention, &db));
   return Finish(&db, &file);
 }
 
-Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path) {
-  if (base.empty() || !IsDatabase(base)) return SaveMap(map, path);
+Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path,
+                   const MapRetention& retention) {
+  if (base.empty() || !IsDatabase(base)) return SaveMap(map, path, retention);
   AtomicFile file;
   PATROLMAP_RETURN_IF_ERROR(AtomicFile::Open(path, &file));
   PATROLMAP_RETURN_IF_ERROR(CopyInto(base, &file));
@@ -591,6 +691,7 @@ Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::strin
     MapWriter writer(&db);
     PATROLMAP_RETURN_IF_ERROR(WriteGrowth(map, base, &db, &writer));
   }
+  PATROLMAP_RETURN_IF_ERROR(Archive(map, retention, &db));
   return Finish(&db, &file);
 }
 

@@ -17,6 +17,7 @@
 #include "image_list_source.h"
 #include "image_times.h"
 #include "patrolmap/core/files.h"
+#include "patrolmap/core/sqlite.h"
 #include "patrolmap/io/bag.h"
 #include "patrolmap/io/natural_sort.h"
 #include "patrolmap/io/readers.h"
@@ -245,8 +246,18 @@ Status RefuseNonVideo(const std::string& path) {
   const std::string start(head, static_cast<std::size_t>(stream.gcount()));
   const auto starts = [&](const std::string& magic) { return start.compare(0, magic.size(), magic) == 0; };
   if (start.empty()) return Status::DataLoss(path + ": an empty file, not a flight log");
-  if (starts(std::string("PMMAP\0", 6))) {
+  // A map of format 13 on is an SQLite database with a map_info table; format 12 and older began "PMMAP".
+  SqliteDatabase database;
+  const bool sqlite = starts(std::string("SQLite format 3\0", 16));
+  if (starts(std::string("PMMAP\0", 6)) ||
+      (sqlite && SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadOnly, &database).ok() &&
+       database.HasTable("map_info"))) {
     return Status::InvalidArgument(path + ": a patrolmap map, not a flight log (give a map with --map)");
+  }
+  if (sqlite) {
+    return Status::InvalidArgument(path +
+                                   ": an SQLite database, not a flight log (a ROS 2 bag is read from its "
+                                   "folder, the one that holds metadata.yaml)");
   }
   if (starts("PMVOCAB")) {
     return Status::InvalidArgument(path + ": a patrolmap vocabulary, not a flight log (give it with --vocabulary)");

@@ -88,6 +88,14 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
   PatrolRecord prior_places, current_places;
   const PatrolRecord& prior_record = RecordOf(map, prior, &prior_places);
   const PatrolRecord& current_record = RecordOf(map, current, &current_places);
+  for (const PatrolRecord* record : {&prior_record, &current_record}) {
+    if (record->archived) {
+      spdlog::warn(
+          "{}: archived by later patrols (map.whole_patrols): its evidence grid keeps only the voxels no later patrol "
+          "observed and its route frames are thinned out, so this comparison sees less of it than when it was flown",
+          record->flight);
+    }
+  }
   LogPhases(prior_record, current_record, options);
   const change::ChangeDetector detector(prior_record, options);
   detector.Compare(current_record, PlacesOf(map, prior_record, current_record), report);

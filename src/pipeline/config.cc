@@ -165,7 +165,8 @@ class YamlWriter {
 
 bool Config::IsValid(std::string* error) const {
   if (!OptionCheck(error).InRange("input.frame_rate_hz", input.frame_rate_hz, 0.0, 10000.0).ok()) return false;
-  return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error) && depth.IsValid(error);
+  return flow.IsValid(error) && place.IsValid(error) && change.IsValid(error) && depth.IsValid(error) &&
+         map.IsValid(error);
 }
 
 Status LoadConfig(const std::string& path, Config* config) {

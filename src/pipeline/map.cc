@@ -149,10 +149,11 @@ Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary
   return Status::Ok();
 }
 
-Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base) {
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base,
+                  const graph::MapRetention& retention) {
   PATROLMAP_RETURN_IF_ERROR(graph::LayoutMap(graph::LayoutInputOf(*map), graph::LayoutOptions{}, map));
   PATROLMAP_RETURN_IF_ERROR(WriteMapOutputs(*map, folder));
-  return graph::SaveMapOnto(*map, base, folder + "/map.pmap");
+  return graph::SaveMapOnto(*map, base, folder + "/map.pmap", retention);
 }
 
 }  // namespace patrolmap::pipeline

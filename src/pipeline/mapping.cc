@@ -281,7 +281,7 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
     PATROLMAP_RETURN_IF_ERROR(monitor->Close(outcome->report, map, entries));
   }
   if (monitor != nullptr) outcome->events = monitor->events();
-  return SaveMapRun(&map, request.out, request.prior_map);
+  return SaveMapRun(&map, request.out, request.prior_map, config.map);
 }
 
 }  // namespace patrolmap::pipeline

@@ -170,7 +170,7 @@ Status RunMerge(const MergeRequest& request, MergeOutcome* outcome) {
   graph::TopoMap merged = Replay(maps, parts, vocabulary, config.place, request, outcome);
   merged.set_vocabulary(TagOf(vocabulary, vocabulary_path));
   PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(request.out));
-  return SaveMapRun(&merged, request.out, "");
+  return SaveMapRun(&merged, request.out, "", config.map);
 }
 
 }  // namespace patrolmap::pipeline

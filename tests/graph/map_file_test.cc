@@ -748,11 +748,60 @@ TEST(MapStore, APartialLoadGrownAndSavedOntoItsFileEqualsAWholeSave) {
     m->mutable_node(3).layout = Eigen::Vector2d(7.5, 8.5);
     m->MutablePatrol("b")->objects[0].site_id = 9;
   }
-  ASSERT_TRUE(SaveMapOnto(map, dir / "m.pmap", dir / "grown.pmap").ok());
+  const MapRetention keep_all{1000, 10.0};
+  ASSERT_TRUE(SaveMapOnto(map, dir / "m.pmap", dir / "grown.pmap", keep_all).ok());
   TopoMap grown;
   ASSERT_TRUE(LoadMap(dir / "grown.pmap", &grown).ok());
   EXPECT_EQ(Content(grown, dir / "a.bin"), Content(whole, dir / "b.bin"));
   EXPECT_EQ(grown.Patrol("b")->route.size(), 2u);  // kept in the file though never read
+  // Archived as they are saved (b, the oldest of three), the two ways agree too.
+  ASSERT_TRUE(SaveMapOnto(map, dir / "m.pmap", dir / "grown.pmap").ok());
+  ASSERT_TRUE(SaveMap(whole, dir / "whole.pmap").ok());
+  TopoMap whole_archived;
+  ASSERT_TRUE(LoadMap(dir / "grown.pmap", &grown).ok());
+  ASSERT_TRUE(LoadMap(dir / "whole.pmap", &whole_archived).ok());
+  EXPECT_TRUE(grown.Patrol("b")->archived);
+  EXPECT_EQ(Content(grown, dir / "a.bin"), Content(whole_archived, dir / "b.bin"));
+}
+
+// Past the latest whole patrols, a patrol keeps the voxels no later patrol observed and a frame every 10 s: the
+// grids of the map hold each voxel once.
+TEST(MapStore, OlderPatrolsAreArchivedToWhatNoLaterPatrolSaw) {
+  testing::TempDir dir;
+  TopoMap map = ThreeFlights();  // records b (three voxels, frames at 5 and 9 ns) and c (voxel 1,1,1)
+  KeyFrameNode node = map.node(0);
+  node.flight = "d";
+  node.timestamp_ns = SecondsToNs(300.0);
+  map.AddNode(node);
+  PatrolRecord d = *map.Patrol("c");
+  d.flight = "d";
+  d.grid.voxels = {{-3, 0, 1, 1, 1}, {1, 1, 1, 2, 2}};  // sees one of b's voxels again, and c's
+  map.SetPatrol(d);
+  ASSERT_TRUE(SaveMap(map, dir / "m.pmap", MapRetention{2, 10.0}).ok());
+  TopoMap loaded;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &loaded).ok());
+  const PatrolRecord& b = *loaded.Patrol("b");
+  EXPECT_TRUE(b.archived);
+  ASSERT_EQ(b.grid.voxels.size(), 2u);
+  EXPECT_EQ(b.grid.voxels[0].y, 1);  // (-3, 1, 0)
+  EXPECT_EQ(b.grid.voxels[1].x, 5);  // (5, -2, 2)
+  EXPECT_EQ(b.objects.size(), 1u);
+  ASSERT_EQ(b.route.size(), 1u);  // 5 and 9 ns lie within 10 s
+  EXPECT_EQ(b.route[0].timestamp_ns, 5);
+  EXPECT_FALSE(loaded.Patrol("c")->archived);  // c and d: the latest two
+  EXPECT_EQ(loaded.Patrol("c")->grid.voxels.size(), 1u);
+  // Kept whole, nothing is archived; one whole patrol archives c to nothing (d saw its one voxel).
+  ASSERT_TRUE(SaveMap(map, dir / "all.pmap", MapRetention{3, 10.0}).ok());
+  ASSERT_TRUE(LoadMap(dir / "all.pmap", &loaded).ok());
+  EXPECT_FALSE(loaded.Patrol("b")->archived);
+  EXPECT_EQ(loaded.Patrol("b")->grid.voxels.size(), 3u);
+  ASSERT_TRUE(SaveMap(map, dir / "one.pmap", MapRetention{1, 0.0}).ok());
+  ASSERT_TRUE(LoadMap(dir / "one.pmap", &loaded).ok());
+  EXPECT_TRUE(loaded.Patrol("c")->grid.voxels.empty());
+  EXPECT_EQ(loaded.Patrol("b")->route.size(), 2u);  // interval 0 keeps every frame
+  std::string error;
+  EXPECT_FALSE((MapRetention{0, 10.0}).IsValid(&error));
+  EXPECT_EQ(error, "map.whole_patrols = 0: must be an integer in [1, 1000000]");
 }
 
 TEST(MapStore, ForeignNewerAndDamagedDatabasesAreRefusedNamingTheFile) {

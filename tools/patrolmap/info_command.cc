@@ -75,7 +75,8 @@ int RunInfo(const std::string& path, bool verbose) {
                   record->objects.size() - static_cast<std::size_t>(confirmed));
     }
     if (record != nullptr && record->grid.voxel_size > 0) {
-      std::printf(", evidence grid %zu voxels of %.2f m", record->grid.voxels.size(), record->grid.voxel_size);
+      std::printf(", evidence grid %zu voxels of %.2f m%s", record->grid.voxels.size(), record->grid.voxel_size,
+                  record->archived ? " (archived: those no later patrol observed)" : "");
     }
     if (record != nullptr && !record->route.empty()) {
       std::size_t bytes = 0;

@@ -131,6 +131,9 @@ struct PatrolRecord {
   // Read without its evidence grid's voxels and its route frames (graph::LoadMap, PatrolDetail::kLatest), which
   // stay in the map file: kept and carried to the next save, never compared.
   bool partial = false;
+  // Kept as an archive once later patrols came (graph::MapRetention): the grid holds only the voxels no later patrol
+  // observed, the route frames are thinned out. Map format 13 on.
+  bool archived = false;
 };
 
 // The view of `record` nearest in time to `timestamp_ns`, when one lies within `tolerance_ns` of it.

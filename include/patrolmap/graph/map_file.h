@@ -35,12 +35,26 @@ namespace patrolmap::graph {
 // patrol's memory and load time do not grow with the patrols the map holds.
 enum class PatrolDetail { kAll, kLatest };
 
-// Writes `map` whole to `path`; every patrol record must be whole.
-Status SaveMap(const TopoMap& map, const std::string& path);
+// How much of each patrol a map keeps, so that it grows with the area of the site rather than with the patrols
+// flown (the map.* keys of the configuration).
+struct MapRetention {
+  // The latest patrols kept whole, for comparing, aligning and diffing. Each older patrol is archived
+  // (PatrolRecord::archived): its evidence grid keeps only the voxels no later patrol observed, so the grids of
+  // the map together hold each voxel of the site once, and its route frames one every archive_frame_interval_s;
+  // its nodes, objects and views stay as they were.
+  int whole_patrols = 2;
+  double archive_frame_interval_s = 10.0;  // [s]; 0 keeps every frame of an archived patrol
+
+  bool IsValid(std::string* error) const;
+};
+
+// Writes `map` whole to `path` (then archives what `retention` says); every patrol record must be whole.
+Status SaveMap(const TopoMap& map, const std::string& path, const MapRetention& retention = MapRetention());
 Status LoadMap(const std::string& path, TopoMap* map, PatrolDetail detail = PatrolDetail::kAll);
 // Writes `map`, loaded from the map file `base` and grown since (new nodes, edges and patrol records appended, the
 // layout and site objects renumbered), to `path` as a copy of `base` with the changes applied in one transaction:
-// no record already in `base` is read or rewritten. A `base` of format 12 or older is saved whole instead.
-Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path);
+// no record already in `base` is read or rewritten but to archive it. A `base` of format 12 or older is saved whole.
+Status SaveMapOnto(const TopoMap& map, const std::string& base, const std::string& path,
+                   const MapRetention& retention = MapRetention());
 
 }  // namespace patrolmap::graph

@@ -9,6 +9,7 @@
 #include "patrolmap/core/status.h"
 #include "patrolmap/depth/options.h"
 #include "patrolmap/flow/options.h"
+#include "patrolmap/graph/map_file.h"
 #include "patrolmap/io/readers.h"
 #include "patrolmap/place/place_recognizer.h"
 
@@ -20,6 +21,7 @@ struct Config {
   place::PlaceOptions place;
   ::patrolmap::change::ChangeOptions change;
   depth::DepthOptions depth;
+  graph::MapRetention map;
 
   bool IsValid(std::string* error) const;
 };
@@ -225,6 +227,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.stereo.fuse_frames", &depth.stereo.fuse_frames);
   visitor->Field("depth.stereo.fuse_gate_sigmas", &depth.stereo.fuse_gate_sigmas);
   visitor->Field("depth.stereo.fuse_shared_variance", &depth.stereo.fuse_shared_variance);
+  visitor->Field("map.whole_patrols", &config->map.whole_patrols);
+  visitor->Field("map.archive_frame_interval_s", &config->map.archive_frame_interval_s);
 }
 
 // Loads `path` over the defaults in `config`: keys absent from the file keep

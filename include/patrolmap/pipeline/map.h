@@ -99,8 +99,10 @@ Status SeedRecognizer(const graph::TopoMap& prior, const std::string& prior_path
 Status LoadSiftVocabulary(const std::string& path, vocab::Vocabulary* vocabulary, std::string* loaded = nullptr);
 
 // Lays the map out (graph::LayoutMap) and writes DIR/nodes.csv, DIR/loop_closures.csv and DIR/map.pmap: a copy of
-// the map file `base` the run read and grew (graph::SaveMapOnto), or the whole map when `base` is empty.
-Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base);
+// the map file `base` the run read and grew (graph::SaveMapOnto), or the whole map when `base` is empty; older
+// patrols archived as `retention` says.
+Status SaveMapRun(graph::TopoMap* map, const std::string& folder, const std::string& base,
+                  const graph::MapRetention& retention);
 
 // Writes the whole map as DIR/nodes.csv (node,flight,timestamp_ns,frame_index,
 // features) and DIR/loop_closures.csv (query_node,matched_node,query_frame,
