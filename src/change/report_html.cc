@@ -6,6 +6,7 @@
 // get there.
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <sstream>
 
 #include "patrolmap/core/words.h"
@@ -19,6 +20,18 @@ std::string Number(double value, int decimals = 2) {
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
   return buffer;
+}
+
+// When a patrol was flown: a date for log times that are Unix times (after 1973), else the log's own seconds.
+std::string FlownAt(TimestampNs ns) {
+  constexpr TimestampNs kUnixTimesFrom = 100000000LL * 1000000000LL;
+  if (ns < kUnixTimesFrom) return "at " + Number(NsToSeconds(ns), 1) + " s of its log";
+  const std::time_t seconds = static_cast<std::time_t>(ns / 1000000000LL);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%d %H:%M UTC", &utc);
+  return text;
 }
 
 // "1 place", "3 places".
@@ -282,6 +295,16 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
             << static_cast<int>(std::lround(100.0 * report.geometry.DifferingShare()))
             << " % of the voxels both observed, so their camera poses disagree (GPS without RTK, or another "
                "world frame).";
+    }
+    if (report.grid_sources.size() > 1) {
+      *html << " Where " << graph::EscapeXml(report.prior_flight)
+            << " did not observe, the geometry was compared with the latest patrol that did:";
+      for (std::size_t i = 1; i < report.grid_sources.size(); ++i) {
+        const GridSource& s = report.grid_sources[i];
+        *html << (i > 1 ? "," : "") << " " << graph::EscapeXml(s.flight) << " (" << s.voxels << " voxels, flown "
+              << FlownAt(s.flown_ns) << ")";
+      }
+      *html << ".";
     }
     if (report.geometry.evicted_prior > 0 || report.geometry.evicted_current > 0) {
       *html << " The evidence grids reached their memory budget (change.grid.memory_mb) and dropped "

@@ -191,6 +191,13 @@ json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, 
   return change;
 }
 
+json GridSourcesJson(const std::vector<GridSource>& sources) {
+  json list = json::array();
+  for (const GridSource& s : sources)
+    list.push_back({{"flight", s.flight}, {"voxels", s.voxels}, {"flown_ns", s.flown_ns}});
+  return list;
+}
+
 }  // namespace
 
 std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const std::vector<ChangeItem>& items,
@@ -217,6 +224,7 @@ std::string ToJson(const ChangeReport& report, const graph::TopoMap& map, const 
       {"prior_flight", report.prior_flight},
       {"current_flight", report.current_flight},
       {"pose_source", {{"prior", report.pose_prior}, {"current", report.pose_current}}},
+      {"geometry_reference", GridSourcesJson(report.grid_sources)},
       {"summary",
        {{"changes", items.size()},
         {"places_compared", report.places.size()},

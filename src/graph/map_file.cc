@@ -370,8 +370,8 @@ class MapReader {
     return Objects(out);
   }
 
-  // The grid and route frames of records[i].
-  Status Details(std::size_t i, PatrolRecord* p) {
+  // The evidence grid of records[i].
+  Status Grid(std::size_t i, PatrolRecord* p) {
     SqliteStatement grid;
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare("SELECT voxels FROM grids WHERE patrol = ?1", &grid));
     Status status;
@@ -382,17 +382,11 @@ class MapReader {
       p->grid.voxels.resize(size / sizeof(VoxelEvidence));
       if (size > 0) std::memcpy(static_cast<void*>(p->grid.voxels.data()), voxels, size);
     }
-    PATROLMAP_RETURN_IF_ERROR(status);
-    return Route(ids_[i], p);
+    return status;
   }
 
-  // Whether records[i] has a grid with voxels.
-  bool HasVoxels(std::size_t i) {
-    SqliteStatement grid;
-    Status status;
-    return db_->Prepare("SELECT length(voxels) FROM grids WHERE patrol = ?1", &grid).ok() &&
-           grid.Bind(1, ids_[i]).Step(&status) && grid.Int(0) > 0;
-  }
+  // The route frames of records[i].
+  Status Route(std::size_t i, PatrolRecord* p) { return RouteOf(ids_[i], p); }
 
  private:
   static Reader BlobReader(const SqliteStatement& rows, int column) {
@@ -434,7 +428,7 @@ class MapReader {
     return status;
   }
 
-  Status Route(std::int64_t patrol, PatrolRecord* p) {
+  Status RouteOf(std::int64_t patrol, PatrolRecord* p) {
     SqliteStatement rows;
     PATROLMAP_RETURN_IF_ERROR(db_->Prepare(
         "SELECT timestamp_ns, frame_index, x, y, z, qw, qx, qy, qz, latitude, longitude, jpeg FROM route_frames "
@@ -466,27 +460,6 @@ class MapReader {
   std::vector<std::int64_t> ids_;
 };
 
-// The records whose grids and route frames a kLatest load reads: the last flight's, and the latest with voxels.
-std::vector<bool> LatestRecords(const TopoMap& map, const std::vector<PatrolRecord>& records, MapReader* reader) {
-  std::vector<bool> wanted(records.size(), false);
-  const std::vector<std::string> flights = map.Flights();
-  const auto index_of = [&](const std::string& flight) {
-    for (std::size_t i = 0; i < records.size(); ++i)
-      if (records[i].flight == flight) return static_cast<int>(i);
-    return -1;
-  };
-  if (!flights.empty() && index_of(flights.back()) >= 0)
-    wanted[static_cast<std::size_t>(index_of(flights.back()))] = true;
-  for (auto flight = flights.rbegin(); flight != flights.rend(); ++flight) {
-    const int i = index_of(*flight);
-    if (i >= 0 && reader->HasVoxels(static_cast<std::size_t>(i))) {
-      wanted[static_cast<std::size_t>(i)] = true;
-      break;
-    }
-  }
-  return wanted;
-}
-
 Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) {
   SqliteDatabase db;
   PATROLMAP_RETURN_IF_ERROR(SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadOnly, &db));
@@ -502,12 +475,14 @@ Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) 
     // A second record of one flight would replace the first unseen (SetPatrol); a map never holds two.
     if (!flights.insert(p.flight).second) return Corrupt(path, "second patrol record of " + p.flight);
   }
-  const std::vector<bool> wanted =
-      detail == PatrolDetail::kAll ? std::vector<bool>(records.size(), true) : LatestRecords(*map, records, &reader);
+  // kLatest: the route frames of the last flight only (what a new patrol's appearance is compared with).
+  const std::vector<std::string> flown = map->Flights();
+  const std::string last = flown.empty() ? std::string() : flown.back();
   for (std::size_t i = 0; i < records.size(); ++i) {
     PatrolRecord& p = records[i];
-    if (wanted[i]) {
-      PATROLMAP_RETURN_IF_ERROR(reader.Details(i, &p));
+    PATROLMAP_RETURN_IF_ERROR(reader.Grid(i, &p));
+    if (detail == PatrolDetail::kAll || p.flight == last) {
+      PATROLMAP_RETURN_IF_ERROR(reader.Route(i, &p));
     } else {
       p.partial = true;
     }

@@ -6,6 +6,7 @@
 
 #include "patrolmap/change/change_detector.h"
 #include "patrolmap/change/site_objects.h"
+#include "patrolmap/change/site_state.h"
 
 namespace patrolmap::pipeline {
 namespace {
@@ -49,6 +50,14 @@ void LogPhases(const PatrolRecord& prior, const PatrolRecord& current, const cha
   if (!prior.grid.voxels.empty() && !current.grid.voxels.empty()) {
     spdlog::info("{}: comparing its evidence grid ({} voxels) with {}'s ({}; geometry and objects)", current.flight,
                  current.grid.voxels.size(), prior.flight, prior.grid.voxels.size());
+  }
+}
+
+// Which earlier patrols completed the reference grid (the regions the prior flight did not observe).
+void LogSources(const std::vector<change::GridSource>& sources, const std::string& current) {
+  for (std::size_t i = 1; i < sources.size(); ++i) {
+    spdlog::info("{}: {} voxels only {} observed (the latest state there) are compared too", current, sources[i].voxels,
+                 sources[i].flight);
   }
 }
 
@@ -96,9 +105,13 @@ Status CompareFlights(const graph::TopoMap& map, const std::string& prior, const
           record->flight);
     }
   }
-  LogPhases(prior_record, current_record, options);
-  const change::ChangeDetector detector(prior_record, options);
+  std::vector<change::GridSource> sources;
+  const PatrolRecord reference = change::LatestState(map, prior_record, &sources);
+  LogPhases(reference, current_record, options);
+  LogSources(sources, current);
+  const change::ChangeDetector detector(reference, options);
   detector.Compare(current_record, PlacesOf(map, prior_record, current_record), report);
+  report->grid_sources = std::move(sources);
   change::NameSiteObjects(prior_record, current_record, report);
   if (report->geometry.poses_disagree) {
     spdlog::warn(

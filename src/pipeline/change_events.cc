@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
+#include "patrolmap/change/site_state.h"
 #include "patrolmap/core/option_check.h"
 
 namespace patrolmap::pipeline {
@@ -126,6 +127,10 @@ ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& pri
       options_(options),
       fd_(fd) {
   if (prior_record_ == nullptr) return;
+  // The same reference the final report compares with (CompareFlights): the site's latest state.
+  std::vector<change::GridSource> sources;
+  reference_ = change::LatestState(*prior, *prior_record_, &sources);
+  prior_record_ = &reference_;
   change::ChangeOptions live = config.change;
   live.geometry.min_observations = options.min_observations;
   detector_.emplace(*prior_record_, live);

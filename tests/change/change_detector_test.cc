@@ -12,44 +12,11 @@
 namespace patrolmap::change {
 namespace {
 
+using testing_fixtures::Depth;
+using testing_fixtures::GridOf;
+using testing_fixtures::kAtOrigin;
 using testing_fixtures::kCamera;
-
-const CameraPoseSample kAtOrigin{0, Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity()};
-
-// A wall `wall_m` ahead of a camera standing at the origin; with `box`, a box 4 m ahead in front of it.
-cv::Mat Depth(float wall_m, bool box) {
-  cv::Mat depth(kCamera.height, kCamera.width, CV_32FC1, cv::Scalar(wall_m));
-  if (box) depth(cv::Rect(40, 16, 16, 16)).setTo(4.0f);
-  return depth;
-}
-
-// The grid of 25 views of `depth` from the origin.
-EvidenceGrid GridOf(const cv::Mat& depth, const ChangeOptions& options) {
-  EvidenceGrid grid(options.grid);
-  for (int i = 0; i < 25; ++i) grid.Integrate(depth, kCamera, kAtOrigin);
-  return grid;
-}
-
-// A patrol of that camera: its views, its detections (a crate 4 m ahead, seen 10 times, with `crate`), and `grid`.
-PatrolRecord Patrol(const std::string& flight, const EvidenceGrid& grid, bool crate) {
-  PatrolRecord record;
-  record.flight = flight;
-  record.camera = kCamera;
-  record.grid = grid.ToData();
-  record.depth_source = "images";
-  record.has_objects = true;
-  for (int i = 0; i < 25; ++i) record.views.push_back({SecondsToNs(0.1 * i), kAtOrigin.position, kAtOrigin.rotation});
-  if (crate) {
-    MapObject object;
-    object.label = "crate";
-    object.confidence = 0.9;
-    object.detections = 10;
-    object.centroid = Eigen::Vector3d(0.6, -0.1, 4.2);
-    object.box_min = Eigen::Vector3d(0.2, -0.5, 4.0), object.box_max = Eigen::Vector3d(1.0, 0.3, 4.4);
-    record.objects = {object};
-  }
-  return record;
-}
+using testing_fixtures::Patrol;
 
 std::vector<std::string> IdsOf(const GeometryChange& geometry, const std::vector<ObjectChange>& objects) {
   std::vector<std::string> ids;

@@ -720,8 +720,8 @@ TEST(MapStore, AFormatTwelveMapMigrates) {
   EXPECT_EQ(Content(migrated, dir / "a.bin"), Content(map, dir / "b.bin"));
 }
 
-// A patrol reads the last flight's and the latest grid's records whole and the others without grid and route; a
-// save onto the file it read keeps those, and equals a whole save of the whole map.
+// A patrol reads the last flight's record whole and the others without their route frames; a save onto the file it
+// read keeps those, and equals a whole save of the whole map.
 TEST(MapStore, APartialLoadGrownAndSavedOntoItsFileEqualsAWholeSave) {
   testing::TempDir dir;
   TopoMap whole = ThreeFlights();
@@ -730,8 +730,8 @@ TEST(MapStore, APartialLoadGrownAndSavedOntoItsFileEqualsAWholeSave) {
   ASSERT_TRUE(LoadMap(dir / "m.pmap", &map, PatrolDetail::kLatest).ok());
   ASSERT_TRUE(map.Patrol("b")->partial);
   EXPECT_TRUE(map.Patrol("b")->route.empty());
-  EXPECT_TRUE(map.Patrol("b")->grid.voxels.empty());
-  EXPECT_EQ(map.Patrol("b")->objects.size(), 1u);  // objects are always read: site objects number on from them
+  EXPECT_EQ(map.Patrol("b")->grid.voxels.size(), 3u);  // grids and objects are always read
+  EXPECT_EQ(map.Patrol("b")->objects.size(), 1u);
   ASSERT_FALSE(map.Patrol("c")->partial);
   EXPECT_EQ(map.Patrol("c")->grid.voxels.size(), 1u);
   EXPECT_EQ(map.Patrol("c")->route.size(), 2u);

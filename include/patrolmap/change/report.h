@@ -35,6 +35,13 @@ struct PlaceChange {
   ChangeLocation location;  // of its largest region: on the current evidence grid, else a bearing (change_location.h)
 };
 
+// A patrol whose evidence grid the comparison's reference took voxels from (site_state.h), and when it was flown.
+struct GridSource {
+  std::string flight;
+  long long voxels = 0;
+  TimestampNs flown_ns = 0;  // its first node's or route frame's time
+};
+
 struct ChangeReport {
   std::string prior_flight, current_flight;
   std::vector<PlaceChange> places;  // every place both patrols saw (their key frames compared when the route is not)
@@ -43,6 +50,9 @@ struct ChangeReport {
   std::vector<ObjectChange> objects;
   bool geometry_compared = false;  // both patrols had depth and poses
   GeometryChange geometry;
+  // The patrols the geometry was compared with, newest first: the prior flight, then earlier ones for the regions
+  // only they observed (the latest state of the site).
+  std::vector<GridSource> grid_sources;
   std::string pose_prior, pose_current;  // where each patrol's camera poses came from (PatrolRecord::pose_source)
   double seconds_appearance = 0.0, seconds_objects = 0.0, seconds_geometry = 0.0;
   // The histories of the site objects its object changes concern, over the map's patrols (SiteHistoriesOf).

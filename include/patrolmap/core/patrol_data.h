@@ -128,8 +128,8 @@ struct PatrolRecord {
   // The log the patrol was read from, as an absolute path, and io::LogDigest of its content (map format 11 on;
   // empty before, and for a camera), so the same log is never mapped twice.
   std::string source, source_digest;
-  // Read without its evidence grid's voxels and its route frames (graph::LoadMap, PatrolDetail::kLatest), which
-  // stay in the map file: kept and carried to the next save, never compared.
+  // Read without its route frames (graph::LoadMap, PatrolDetail::kLatest), which stay in the map file: carried to the
+  // next save; its grid and objects are whole.
   bool partial = false;
   // Kept as an archive once later patrols came (graph::MapRetention): the grid holds only the voxels no later patrol
   // observed, the route frames are thinned out. Map format 13 on.

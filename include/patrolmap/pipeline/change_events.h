@@ -79,7 +79,8 @@ class ChangeMonitor {
 
   const graph::TopoMap* prior_;
   std::string prior_flight_;
-  const PatrolRecord* prior_record_;
+  const PatrolRecord* prior_record_;  // reference_, once the prior flight's record is found
+  PatrolRecord reference_;
   Config config_;
   ChangeEventOptions options_;
   TimestampNs last_ns_ = 0;  // change thread until Close()
