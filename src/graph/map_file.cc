@@ -194,10 +194,13 @@ class MapWriter {
 };
 
 // Opens the temporary of `file` as a database written in one transaction; the temporary is flushed and renamed
-// by the caller (AtomicFile::Commit), so SQLite keeps no journal of its own.
+// by the caller (AtomicFile::Commit), so SQLite keeps no journal of its own. A new database gives the pages an
+// archived patrol's grid and frames free back at each save (auto_vacuum, set before its first table), so the file
+// holds what the map holds.
 Status OpenForWriting(const AtomicFile& file, SqliteDatabase* db) {
   PATROLMAP_RETURN_IF_ERROR(SqliteDatabase::Open(file.temporary_path(), SqliteDatabase::Mode::kReadWrite, db));
-  PATROLMAP_RETURN_IF_ERROR(db->Execute("PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;"));
+  PATROLMAP_RETURN_IF_ERROR(
+      db->Execute("PRAGMA auto_vacuum = FULL; PRAGMA journal_mode = OFF; PRAGMA synchronous = OFF;"));
   return db->Execute("BEGIN");
 }
 
@@ -460,6 +463,41 @@ class MapReader {
   std::vector<std::int64_t> ids_;
 };
 
+// The patrol records of `map` in the order flown.
+std::vector<const PatrolRecord*> RecordsInFlightOrder(const TopoMap& map) {
+  std::vector<const PatrolRecord*> records;
+  for (const std::string& flight : map.Flights()) {
+    if (const PatrolRecord* record = map.Patrol(flight)) records.push_back(record);
+  }
+  return records;
+}
+
+// The voxels of records[k]'s grid that no later record's grid of the same voxel size holds (each a sorted list).
+std::vector<VoxelEvidence> UnseenLater(const std::vector<const PatrolRecord*>& records, std::size_t k) {
+  const EvidenceGridData& grid = records[k]->grid;
+  std::vector<VoxelEvidence> kept;
+  for (const VoxelEvidence& v : grid.voxels) {
+    bool seen = false;
+    for (std::size_t j = k + 1; j < records.size() && !seen; ++j) {
+      const EvidenceGridData& later = records[j]->grid;
+      seen = later.voxel_size == grid.voxel_size &&
+             std::binary_search(later.voxels.begin(), later.voxels.end(), v, VoxelBefore);
+    }
+    if (!seen) kept.push_back(v);
+  }
+  return kept;
+}
+
+// Keeps in memory of each record but the last only the voxels no later record observed: the grids then hold the
+// site's latest state once (change::LatestState), not every whole patrol the map keeps.
+void ThinEarlierGrids(TopoMap* map) {
+  const std::vector<const PatrolRecord*> records = RecordsInFlightOrder(*map);
+  for (std::size_t k = 0; k + 1 < records.size(); ++k) {
+    std::vector<VoxelEvidence> kept = UnseenLater(records, k);
+    map->MutablePatrol(records[k]->flight)->grid.voxels = std::move(kept);
+  }
+}
+
 Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) {
   SqliteDatabase db;
   PATROLMAP_RETURN_IF_ERROR(SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadOnly, &db));
@@ -489,6 +527,7 @@ Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) 
     PATROLMAP_RETURN_IF_ERROR(CheckPatrolRecord(path, p));
     map->SetPatrol(std::move(p));
   }
+  if (detail == PatrolDetail::kLatest) ThinEarlierGrids(map);
   return Status::Ok();
 }
 
@@ -549,20 +588,6 @@ Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* 
   return Status::Ok();
 }
 
-// The voxels of `grids`' row `patrol`.
-Status ReadVoxels(SqliteDatabase* db, std::int64_t patrol, std::vector<VoxelEvidence>* voxels) {
-  SqliteStatement grid;
-  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT voxels FROM grids WHERE patrol = ?1", &grid));
-  Status status;
-  voxels->clear();
-  if (!grid.Bind(1, patrol).Step(&status)) return status;
-  std::size_t size = 0;
-  const unsigned char* data = grid.Blob(0, &size);
-  voxels->resize(size / sizeof(VoxelEvidence));
-  if (!voxels->empty()) std::memcpy(static_cast<void*>(voxels->data()), data, voxels->size() * sizeof(VoxelEvidence));
-  return Status::Ok();
-}
-
 // Keeps one route frame of `patrol` every `interval_s` (the first, then each the interval after the last kept).
 Status ThinRoute(SqliteDatabase* db, std::int64_t patrol, double interval_s) {
   if (interval_s <= 0.0) return Status::Ok();
@@ -587,50 +612,37 @@ Status ThinRoute(SqliteDatabase* db, std::int64_t patrol, double interval_s) {
   return Status::Ok();
 }
 
-// Archives the patrols of the database older than the latest `retention.whole_patrols` (in the order `map` flew
-// them): from the newest to the oldest, each archived one loses the voxels a later patrol holds and is thinned to
-// its archive frames. Each voxel of the site is then stored once, by the latest patrol that observed it.
+// Archives the patrols older than the latest `retention.whole_patrols` (in the order `map` flew them): each keeps
+// of its grid the voxels no later patrol observed (UnseenLater) and is thinned to its archive frames, in the
+// database `db` holds `map` in. Each voxel of the site is then stored once, by the latest patrol that observed it.
 Status Archive(const TopoMap& map, const MapRetention& retention, SqliteDatabase* db) {
-  std::vector<std::string> flights;
-  for (const std::string& flight : map.Flights()) {
-    if (map.Patrol(flight) != nullptr) flights.push_back(flight);
-  }
+  const std::vector<const PatrolRecord*> records = RecordsInFlightOrder(map);
   const auto whole = static_cast<std::size_t>(std::max(retention.whole_patrols, 1));
-  if (flights.size() <= whole) return Status::Ok();
+  if (records.size() <= whole) return Status::Ok();
   SqliteStatement row, update, mark;
-  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT id, voxel_size FROM patrols WHERE flight = ?1", &row));
+  PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT id FROM patrols WHERE flight = ?1", &row));
   PATROLMAP_RETURN_IF_ERROR(db->Prepare("UPDATE grids SET voxels = ?1 WHERE patrol = ?2", &update));
   PATROLMAP_RETURN_IF_ERROR(db->Prepare("UPDATE patrols SET archived = 1 WHERE id = ?1", &mark));
-  std::map<double, std::vector<VoxelEvidence>> later;  // per voxel size, every voxel a later patrol holds
-  std::vector<VoxelEvidence> voxels, kept, merged;
-  for (std::size_t k = flights.size(); k-- > 0;) {
+  for (std::size_t k = 0; k + whole < records.size(); ++k) {
+    const PatrolRecord& p = *records[k];
     Status status;
-    if (!row.Bind(1, flights[k]).Step(&status))
-      return status.ok() ? Corrupt(db->path(), "no record of " + flights[k]) : status;
+    if (!row.Bind(1, p.flight).Step(&status))
+      return status.ok() ? Corrupt(db->path(), "no record of " + p.flight) : status;
     const std::int64_t patrol = row.Int(0);
-    const double voxel_size = row.Real(1);
     row.Reset();
-    PATROLMAP_RETURN_IF_ERROR(ReadVoxels(db, patrol, &voxels));
-    std::vector<VoxelEvidence>& seen = later[voxel_size];
-    if (k + whole < flights.size()) {
-      kept.clear();
-      std::set_difference(voxels.begin(), voxels.end(), seen.begin(), seen.end(), std::back_inserter(kept),
-                          VoxelBefore);
-      if (kept.size() != voxels.size()) {
-        PATROLMAP_RETURN_IF_ERROR(
-            update.BindBlob(1, kept.data(), kept.size() * sizeof(VoxelEvidence)).Bind(2, patrol).Run());
-      }
+    const std::vector<VoxelEvidence> kept = UnseenLater(records, k);
+    // An archived record holds in memory what the file holds; a whole one read by a patrol is thinned in memory.
+    if (!p.archived || kept.size() != p.grid.voxels.size()) {
+      PATROLMAP_RETURN_IF_ERROR(
+          update.BindBlob(1, kept.data(), kept.size() * sizeof(VoxelEvidence)).Bind(2, patrol).Run());
+    }
+    if (!p.archived) {
       PATROLMAP_RETURN_IF_ERROR(ThinRoute(db, patrol, retention.archive_frame_interval_s));
       PATROLMAP_RETURN_IF_ERROR(mark.Bind(1, patrol).Run());
-      voxels.swap(kept);
     }
-    merged.clear();
-    std::set_union(seen.begin(), seen.end(), voxels.begin(), voxels.end(), std::back_inserter(merged), VoxelBefore);
-    seen.swap(merged);
   }
   return Status::Ok();
 }
-
 }  // namespace
 
 bool MapRetention::IsValid(std::string* error) const {

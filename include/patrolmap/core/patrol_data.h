@@ -128,8 +128,8 @@ struct PatrolRecord {
   // The log the patrol was read from, as an absolute path, and io::LogDigest of its content (map format 11 on;
   // empty before, and for a camera), so the same log is never mapped twice.
   std::string source, source_digest;
-  // Read without its route frames (graph::LoadMap, PatrolDetail::kLatest), which stay in the map file: carried to the
-  // next save; its grid and objects are whole.
+  // Read for a patrol (graph::LoadMap, PatrolDetail::kLatest): without its route frames, and with only the voxels of
+  // its grid no later patrol observed; the file keeps the rest, and the next save carries it over.
   bool partial = false;
   // Kept as an archive once later patrols came (graph::MapRetention): the grid holds only the voxels no later patrol
   // observed, the route frames are thinned out. Map format 13 on.

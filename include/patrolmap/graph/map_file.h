@@ -29,11 +29,10 @@
 
 namespace patrolmap::graph {
 
-// How much of the patrol records a load reads. kAll: everything. kLatest: the route frames of the map's last flight
-// only, what a new patrol's appearance is compared with; the other records are read without them
-// (PatrolRecord::partial) and SaveMapOnto keeps them in the file. Grids are read whole (archived ones hold what no
-// later patrol observed: together at most the site's area), so a patrol's memory and load time grow with the site,
-// not with the patrols the map holds.
+// How much of the patrol records a load reads. kAll: everything. kLatest: what a new patrol is compared with, the
+// latest state of the site: the last flight's record whole, and of each earlier record its nodes, objects, views
+// and the voxels of its grid no later patrol observed, without route frames (PatrolRecord::partial); SaveMapOnto
+// keeps the rest in the file. So a patrol's memory and load time grow with the site, not with the patrols flown.
 enum class PatrolDetail { kAll, kLatest };
 
 // How much of each patrol a map keeps, so that it grows with the area of the site rather than with the patrols
