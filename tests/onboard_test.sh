@@ -122,6 +122,6 @@ check "bad camera" grep -q "expected camera:N" <<<"$output"
 check "queue 0 refused" test $? -eq 2
 head -c 300 "$work/fast/map.pmap" > "$work/cut.pmap"
 output=$("$onboard" "$sample" --map "$work/cut.pmap" --vocabulary "$vocabulary" --out "$work/o" 2>&1)
-check "truncated prior map named" grep -q "cut.pmap: truncated map" <<<"$output"
+check "truncated prior map named" grep -q "cut.pmap: truncated or damaged" <<<"$output"
 
 finish onboard

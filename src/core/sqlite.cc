@@ -40,12 +40,13 @@ Status SqliteDatabase::Execute(const std::string& sql) {
   return Status::Ok();
 }
 
-Status SqliteDatabase::Prepare(const std::string& sql, SqliteStatement* statement) {
+Status SqliteDatabase::Prepare(const std::string& sql, SqliteStatement* statement, const std::string& doing) {
+  const std::string& what = doing.empty() ? sql : doing;
   sqlite3_stmt* raw = nullptr;
-  if (sqlite3_prepare_v2(handle_.get(), sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) return Error(sql);
+  if (sqlite3_prepare_v2(handle_.get(), sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) return Error(what);
   statement->handle_.reset(raw);
   statement->database_ = this;
-  statement->sql_ = sql;
+  statement->doing_ = what;
   return Status::Ok();
 }
 
@@ -92,7 +93,7 @@ SqliteStatement& SqliteStatement::BindNull(int index) {
 bool SqliteStatement::Step(Status* status) {
   const int code = sqlite3_step(handle_.get());
   if (code == SQLITE_ROW) return true;
-  if (code != SQLITE_DONE) *status = database_->Error(sql_);
+  if (code != SQLITE_DONE) *status = database_->Error(doing_);
   return false;
 }
 

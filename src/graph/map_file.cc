@@ -531,13 +531,56 @@ Status LoadDatabase(const std::string& path, TopoMap* map, PatrolDetail detail) 
   return Status::Ok();
 }
 
-Status WriteWhole(const TopoMap& map, MapWriter* writer) {
+// Which of a route's frames (their times, in order) an archive keeps: the first, then each one at least
+// `interval_s` after the last kept; every frame when the interval is 0.
+std::vector<bool> ArchiveFramesKept(const std::vector<TimestampNs>& times, double interval_s) {
+  std::vector<bool> kept(times.size(), true);
+  std::optional<TimestampNs> last;
+  for (std::size_t i = 0; i < times.size() && interval_s > 0.0; ++i) {
+    if (last && times[i] - *last < SecondsToNs(interval_s)) {
+      kept[i] = false;
+    } else {
+      last = times[i];
+    }
+  }
+  return kept;
+}
+
+// records[k] as an archive keeps it: the voxels no later record observed, its archive frames, marked archived.
+PatrolRecord ArchivedRecord(const std::vector<const PatrolRecord*>& records, std::size_t k, double interval_s) {
+  PatrolRecord archived = *records[k];
+  archived.grid.voxels = UnseenLater(records, k);
+  std::vector<TimestampNs> times;
+  for (const RouteFrame& f : archived.route) times.push_back(f.timestamp_ns);
+  const std::vector<bool> kept = ArchiveFramesKept(times, interval_s);
+  std::vector<RouteFrame> route;
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (kept[i]) route.push_back(std::move(archived.route[i]));
+  }
+  archived.route = std::move(route);
+  archived.archived = true;
+  return archived;
+}
+
+// Writes `map` whole, each patrol older than the latest `retention.whole_patrols` written as its archive (so a map
+// saved whole holds what the same map grown patrol by patrol holds, in the same rows).
+Status WriteWhole(const TopoMap& map, const MapRetention& retention, MapWriter* writer) {
   PATROLMAP_RETURN_IF_ERROR(writer->Prepare());
   PATROLMAP_RETURN_IF_ERROR(writer->Info(map));
   for (int i = 0; i < map.node_count(); ++i) PATROLMAP_RETURN_IF_ERROR(writer->Node(i, map.node(i)));
   const std::vector<TopoMap::Edge> edges = map.Edges();
   for (std::size_t i = 0; i < edges.size(); ++i) PATROLMAP_RETURN_IF_ERROR(writer->Edge(static_cast<int>(i), edges[i]));
-  for (const PatrolRecord& p : map.patrols()) PATROLMAP_RETURN_IF_ERROR(writer->Patrol(p));
+  const std::vector<const PatrolRecord*> records = RecordsInFlightOrder(map);
+  const auto whole = static_cast<std::size_t>(std::max(retention.whole_patrols, 1));
+  for (const PatrolRecord& p : map.patrols()) {
+    const auto at = std::find(records.begin(), records.end(), &p);
+    const auto k = static_cast<std::size_t>(at - records.begin());
+    if (at != records.end() && k + whole < records.size()) {
+      PATROLMAP_RETURN_IF_ERROR(writer->Patrol(ArchivedRecord(records, k, retention.archive_frame_interval_s)));
+    } else {
+      PATROLMAP_RETURN_IF_ERROR(writer->Patrol(p));
+    }
+  }
   return Status::Ok();
 }
 
@@ -588,27 +631,26 @@ Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* 
   return Status::Ok();
 }
 
-// Keeps one route frame of `patrol` every `interval_s` (the first, then each the interval after the last kept).
+// Keeps the archive frames of `patrol` (ArchiveFramesKept) in the database.
 Status ThinRoute(SqliteDatabase* db, std::int64_t patrol, double interval_s) {
   if (interval_s <= 0.0) return Status::Ok();
   SqliteStatement frames, drop;
   PATROLMAP_RETURN_IF_ERROR(
       db->Prepare("SELECT position, timestamp_ns FROM route_frames WHERE patrol = ?1 ORDER BY position", &frames));
   PATROLMAP_RETURN_IF_ERROR(db->Prepare("DELETE FROM route_frames WHERE patrol = ?1 AND position = ?2", &drop));
-  std::vector<std::int64_t> dropped;
-  std::optional<TimestampNs> kept;
+  std::vector<std::int64_t> positions;
+  std::vector<TimestampNs> times;
   Status status;
   frames.Bind(1, patrol);
   while (frames.Step(&status)) {
-    const TimestampNs time = frames.Int(1);
-    if (kept && time - *kept < SecondsToNs(interval_s)) {
-      dropped.push_back(frames.Int(0));
-    } else {
-      kept = time;
-    }
+    positions.push_back(frames.Int(0));
+    times.push_back(frames.Int(1));
   }
   PATROLMAP_RETURN_IF_ERROR(status);
-  for (std::int64_t position : dropped) PATROLMAP_RETURN_IF_ERROR(drop.Bind(1, patrol).Bind(2, position).Run());
+  const std::vector<bool> kept = ArchiveFramesKept(times, interval_s);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    if (!kept[i]) PATROLMAP_RETURN_IF_ERROR(drop.Bind(1, patrol).Bind(2, positions[i]).Run());
+  }
   return Status::Ok();
 }
 
@@ -660,9 +702,8 @@ Status SaveMap(const TopoMap& map, const std::string& path, const MapRetention& 
   PATROLMAP_RETURN_IF_ERROR(db.Execute(kSchema));
   {
     MapWriter writer(&db);  // its statements finalized before the database closes
-    PATROLMAP_RETURN_IF_ERROR(WriteWhole(map, &writer));
+    PATROLMAP_RETURN_IF_ERROR(WriteWhole(map, retention, &writer));
   }
-  PATROLMAP_RETURN_IF_ERROR(Archive(map, retention, &db));
   return Finish(&db, &file);
 }
 

@@ -2,14 +2,13 @@
 // files, each with the tables topics(id, name, type, serialization_format) and messages(id, topic_id,
 // timestamp, data). Messages are stepped through with one query per file, ordered by timestamp, so a
 // bag of any size is read a message at a time.
-#include <sqlite3.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <map>
 
 #include "bag_file.h"
 #include "image_times.h"
+#include "patrolmap/core/sqlite.h"
 #include "patrolmap/io/yaml_file.h"
 
 namespace fs = std::filesystem;
@@ -17,49 +16,15 @@ namespace fs = std::filesystem;
 namespace patrolmap::io {
 namespace {
 
-struct DatabaseCloser {
-  void operator()(sqlite3* database) const { sqlite3_close(database); }
-};
-struct StatementFinalizer {
-  void operator()(sqlite3_stmt* statement) const { sqlite3_finalize(statement); }
-};
-using Database = std::unique_ptr<sqlite3, DatabaseCloser>;
-using Statement = std::unique_ptr<sqlite3_stmt, StatementFinalizer>;
-
-Status SqlError(const std::string& path, sqlite3* database, const std::string& doing) {
-  std::string message = sqlite3_errmsg(database);
-  const int code = sqlite3_errcode(database);
-  if (code == SQLITE_CORRUPT || code == SQLITE_NOTADB) message += " (the file is truncated or damaged)";
-  return Status::DataLoss(path + ": " + doing + ": " + message);
-}
-
-Status OpenDatabase(const std::string& path, Database* database) {
+Status OpenDatabase(const std::string& path, SqliteDatabase* database) {
   if (!fs::is_regular_file(path)) return Status::NotFound(path + ": no such file (listed in metadata.yaml)");
-  sqlite3* raw = nullptr;
-  const int code = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
-  database->reset(raw);
-  if (code != SQLITE_OK) return SqlError(path, raw, "cannot open");
-  return Status::Ok();
-}
-
-Status Prepare(const std::string& path, sqlite3* database, const std::string& sql, Statement* statement) {
-  sqlite3_stmt* raw = nullptr;
-  if (sqlite3_prepare_v2(database, sql.c_str(), -1, &raw, nullptr) != SQLITE_OK) {
-    return SqlError(path, database, "not a ROS 2 bag database");
-  }
-  statement->reset(raw);
-  return Status::Ok();
-}
-
-std::string Text(sqlite3_stmt* statement, int column) {
-  const unsigned char* text = sqlite3_column_text(statement, column);
-  return text == nullptr ? std::string() : reinterpret_cast<const char*>(text);
+  return SqliteDatabase::Open(path, SqliteDatabase::Mode::kReadOnly, database);
 }
 
 // One .db3 file: its topic ids mapped to the bag's topic indices.
 struct BagDatabase {
   std::string path;
-  Database database;
+  SqliteDatabase database;
   std::map<int, int> topic_of_id;  // topics.id -> index into the bag's topics
 };
 
@@ -75,18 +40,20 @@ class Ros2Stream : public BagStream {
         PATROLMAP_RETURN_IF_ERROR(StartFile((*files_)[next_file_++]));
       }
       const BagDatabase& file = (*files_)[next_file_ - 1];
-      const int code = sqlite3_step(statement_.get());
-      if (code == SQLITE_DONE) {
+      Status status;
+      if (!statement_->Step(&status)) {
+        PATROLMAP_RETURN_IF_ERROR(status);
         statement_.reset();
         continue;
       }
-      if (code != SQLITE_ROW) return SqlError(file.path, file.database.get(), "reading messages");
-      const auto topic = file.topic_of_id.find(sqlite3_column_int(statement_.get(), 0));
+      const auto topic = file.topic_of_id.find(static_cast<int>(statement_->Int(0)));
       if (topic == file.topic_of_id.end()) continue;
       message->topic = topic->second;
-      message->record_ns = sqlite3_column_int64(statement_.get(), 1);
-      const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_.get(), 2));
-      message->bytes.assign(data, data + sqlite3_column_bytes(statement_.get(), 2));
+      message->record_ns = statement_->Int(1);
+      std::size_t size = 0;
+      const unsigned char* data = statement_->Blob(2, &size);
+      if (data == nullptr) size = 0;
+      message->bytes.assign(data, data + size);
       ++read_;
       return Status::Ok();
     }
@@ -94,17 +61,17 @@ class Ros2Stream : public BagStream {
   }
 
  private:
-  Status StartFile(const BagDatabase& file) {
+  Status StartFile(BagDatabase& file) {
     std::string ids;
     for (const auto& [id, index] : file.topic_of_id) {
       if (std::find(topics_.begin(), topics_.end(), index) == topics_.end()) continue;
       ids += (ids.empty() ? "" : ",") + std::to_string(id);
     }
     if (ids.empty()) ids = "-1";
-    return Prepare(
-        file.path, file.database.get(),
+    statement_ = std::make_unique<SqliteStatement>();
+    return file.database.Prepare(
         "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids + ") ORDER BY timestamp, id",
-        &statement_);
+        statement_.get(), "reading messages");
   }
 
   std::vector<BagDatabase>* files_;
@@ -112,7 +79,7 @@ class Ros2Stream : public BagStream {
   std::size_t limit_;
   std::size_t read_ = 0;
   std::size_t next_file_ = 0;
-  Statement statement_;
+  std::unique_ptr<SqliteStatement> statement_;
 };
 
 class Ros2Bag : public BagFile {
@@ -140,16 +107,13 @@ class Ros2Bag : public BagFile {
     for (BagDatabase& file : files_) {
       for (const auto& [id, index] : file.topic_of_id) {
         if (index != topic) continue;
-        Statement statement;
-        PATROLMAP_RETURN_IF_ERROR(
-            Prepare(file.path, file.database.get(),
-                    "SELECT timestamp FROM messages WHERE topic_id = " + std::to_string(id) + " ORDER BY timestamp",
-                    &statement));
-        int code = SQLITE_ROW;
-        while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
-          times->push_back(sqlite3_column_int64(statement.get(), 0));
-        }
-        if (code != SQLITE_DONE) return SqlError(file.path, file.database.get(), "reading message times");
+        SqliteStatement statement;
+        PATROLMAP_RETURN_IF_ERROR(file.database.Prepare(
+            "SELECT timestamp FROM messages WHERE topic_id = " + std::to_string(id) + " ORDER BY timestamp", &statement,
+            "reading message times"));
+        Status status;
+        while (statement.Step(&status)) times->push_back(statement.Int(0));
+        PATROLMAP_RETURN_IF_ERROR(status);
       }
     }
     return Status::Ok();
@@ -197,36 +161,35 @@ class Ros2Bag : public BagFile {
   }
 
   Status ReadTopics(BagDatabase* file) {
-    Statement statement;
-    PATROLMAP_RETURN_IF_ERROR(Prepare(file->path, file->database.get(),
-                                      "SELECT id, name, type, serialization_format FROM topics", &statement));
-    int code = SQLITE_ROW;
-    while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
-      const std::string name = Text(statement.get(), 1);
-      const std::string format = Text(statement.get(), 3);
+    SqliteStatement statement;
+    PATROLMAP_RETURN_IF_ERROR(file->database.Prepare("SELECT id, name, type, serialization_format FROM topics",
+                                                     &statement, "not a ROS 2 bag database"));
+    Status status;
+    while (statement.Step(&status)) {
+      const std::string name = statement.Text(1);
+      const std::string format = statement.Text(3);
       if (format != "cdr") {
         return Status::InvalidArgument(file->path + ", topic " + name + ": serialization format '" + format +
                                        "' is not cdr, the only one read");
       }
       auto known = std::find_if(topics_.begin(), topics_.end(), [&](const BagTopic& t) { return t.name == name; });
-      if (known == topics_.end()) known = topics_.insert(topics_.end(), {name, Text(statement.get(), 2), 0, 0.0});
-      file->topic_of_id[sqlite3_column_int(statement.get(), 0)] = static_cast<int>(known - topics_.begin());
+      if (known == topics_.end()) known = topics_.insert(topics_.end(), {name, statement.Text(2), 0, 0.0});
+      file->topic_of_id[static_cast<int>(statement.Int(0))] = static_cast<int>(known - topics_.begin());
     }
-    if (code != SQLITE_DONE) return SqlError(file->path, file->database.get(), "reading topics");
-    return Status::Ok();
+    return status;
   }
 
   Status CountMessages() {
     for (BagDatabase& file : files_) {
-      Statement statement;
-      PATROLMAP_RETURN_IF_ERROR(Prepare(file.path, file.database.get(),
-                                        "SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id", &statement));
-      int code = SQLITE_ROW;
-      while ((code = sqlite3_step(statement.get())) == SQLITE_ROW) {
-        const auto topic = file.topic_of_id.find(sqlite3_column_int(statement.get(), 0));
-        if (topic != file.topic_of_id.end()) topics_[topic->second].count += sqlite3_column_int64(statement.get(), 1);
+      SqliteStatement statement;
+      PATROLMAP_RETURN_IF_ERROR(file.database.Prepare("SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id",
+                                                      &statement, "counting messages"));
+      Status status;
+      while (statement.Step(&status)) {
+        const auto topic = file.topic_of_id.find(static_cast<int>(statement.Int(0)));
+        if (topic != file.topic_of_id.end()) topics_[topic->second].count += statement.Int(1);
       }
-      if (code != SQLITE_DONE) return SqlError(file.path, file.database.get(), "counting messages");
+      PATROLMAP_RETURN_IF_ERROR(status);
     }
     return Status::Ok();
   }

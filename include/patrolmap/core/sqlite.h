@@ -28,7 +28,8 @@ class SqliteDatabase {
 
   // Runs statements that return no rows (schema, pragmas, transactions).
   Status Execute(const std::string& sql);
-  Status Prepare(const std::string& sql, SqliteStatement* statement);
+  // `doing` names the statement in errors ("reading topics"); the SQL itself when empty.
+  Status Prepare(const std::string& sql, SqliteStatement* statement, const std::string& doing = "");
   // Whether the database has a table of that name.
   bool HasTable(const std::string& name);
   Status Close();
@@ -74,7 +75,7 @@ class SqliteStatement {
   };
   std::unique_ptr<sqlite3_stmt, Finalizer> handle_;
   const SqliteDatabase* database_ = nullptr;
-  std::string sql_;
+  std::string doing_;
 };
 
 }  // namespace patrolmap
