@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "../src/graph/map_file_v12.h"
 #include "patrolmap/graph/map_file.h"
 #include "patrolmap/vocab/vocabulary.h"
 #include "sample_map.h"
@@ -37,7 +38,12 @@ int main(int argc, char** argv) {
   if (status.ok()) status = vocabulary.Save((corpus / "vocabulary/seed.pmvoc").string());
   graph::TopoMap map = testing::TwoFlights();
   map.set_vocabulary({vocabulary.Fingerprint(), "seed"});
-  if (status.ok()) status = graph::SaveMap(map, (corpus / "map_file/seed.pmap").string());
+  // Each as the SQLite database (format 13) and as the binary file of format 12, which maps still migrate from.
+  const auto save_both = [&corpus](const graph::TopoMap& m, const std::string& name) {
+    const Status db = graph::SaveMap(m, (corpus / ("map_file/" + name + "_db.pmap")).string());
+    return db.ok() ? graph::SaveLegacyMap(m, (corpus / ("map_file/" + name + ".pmap")).string()) : db;
+  };
+  if (status.ok()) status = save_both(map, "seed");
   // The same with two route frames (format 6): one with a pose and GPS, one without. Their bytes only start
   // like JPEG; the reader does not decode them.
   PatrolRecord record = *map.Patrol("b");
@@ -54,7 +60,7 @@ int main(int argc, char** argv) {
   frame.gps.reset();
   record.route.push_back(frame);
   map.SetPatrol(record);
-  if (status.ok()) status = graph::SaveMap(map, (corpus / "map_file/seed_route.pmap").string());
+  if (status.ok()) status = save_both(map, "seed_route");
   if (!status.ok()) {
     std::fprintf(stderr, "%s\n", status.message().c_str());
     return 1;
