@@ -10,6 +10,7 @@
 
 #include "patrolmap/change/change_detector.h"
 #include "patrolmap/change/site_objects.h"
+#include "patrolmap/change/site_state.h"
 #include "patrolmap/core/files.h"
 #include "patrolmap/core/flight_id.h"
 #include "patrolmap/graph/map_file.h"
@@ -220,11 +221,14 @@ const PatrolRecord* LatestGrid(const graph::TopoMap& map) {
 // Moves a new patrol onto the map's latest one with a grid, when a whole-voxel shift overlaps their surfaces
 // clearly better (change/grid_alignment.h): the poses of two flights can share an offset.
 void AlignToMap(const graph::TopoMap& map, const change::ChangeOptions& options, PatrolRecord* record) {
-  const PatrolRecord* reference = LatestGrid(map);
-  if (reference == nullptr) return;
-  const change::GridShift shift = change::ChangeDetector(*reference, options).Align(record);
+  const PatrolRecord* latest = LatestGrid(map);
+  if (latest == nullptr) return;
+  // Its grid as the site's latest state: a patrol read it with only the voxels no later patrol observed.
+  std::vector<change::GridSource> sources;
+  const PatrolRecord reference = change::LatestState(map, *latest, &sources);
+  const change::GridShift shift = change::ChangeDetector(reference, options).Align(record);
   if (shift.applied) {
-    spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference->flight));
+    spdlog::info("{}: {}", record->flight, change::DescribeShift(shift, record->grid.voxel_size, reference.flight));
   }
 }
 
