@@ -24,8 +24,8 @@ dpkg-deb -x "$runtime" "$root" && dpkg-deb -x "$development" "$root"
 cd "$work"
 expect "the packaged program simulates" 0 "frames at 30 Hz" -- \
   "$root/usr/bin/patrolmap" simulate --route street --walls 2 --speed 6 --out "$work/log"
-# Its vocabulary: the search tries the one beside the program (the packaged one) before the source tree.
-expect "the packaged program maps with its vocabulary" 0 "1 log: [0-9]+ nodes" -- \
+# It finds a vocabulary by itself (the search tries the packaged one, beside the program, before the source tree).
+expect "the packaged program maps" 0 "1 log: [0-9]+ nodes" -- \
   env PATROLMAP_VOCABULARY= "$root/usr/bin/patrolmap" map "$work/log" --out "$work/map"
 expect "the packaged onboard program runs" 0 "patrolmap-onboard" -- "$root/usr/bin/patrolmap-onboard" --help
 cmake -S "$source_dir/tests/downstream" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$root/usr" \

@@ -586,14 +586,32 @@ Status WriteWhole(const TopoMap& map, const MapRetention& retention, MapWriter* 
 
 // What `map` has that the database `db` (the map it was loaded from) does not: nodes and edges after the stored
 // ones, and records of flights it has no record of; and the nodes' layout and the objects' site ids, renewed.
-Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* db, MapWriter* writer) {
+// The nodes and edges the database `base` holds, checked to be what `map` was read from (no more of either, and its
+// last node the map's): another program may have replaced the file since.
+Status StoredCounts(const TopoMap& map, const std::string& base, SqliteDatabase* db, std::int64_t* nodes,
+                    std::int64_t* edges) {
   Status status;
-  const std::int64_t nodes = Count(db, "SELECT count(*) FROM nodes", &status);
+  *nodes = Count(db, "SELECT count(*) FROM nodes", &status);
+  if (status.ok()) *edges = Count(db, "SELECT count(*) FROM edges", &status);
   PATROLMAP_RETURN_IF_ERROR(status);
-  const std::int64_t edges = Count(db, "SELECT count(*) FROM edges", &status);
-  PATROLMAP_RETURN_IF_ERROR(status);
+  bool same = *nodes <= map.node_count() && *edges <= static_cast<std::int64_t>(map.edge_count());
+  if (same && *nodes > 0) {
+    const TimestampNs last = map.node(static_cast<int>(*nodes) - 1).timestamp_ns;
+    same = Count(db,
+                 "SELECT count(*) FROM nodes WHERE id = " + std::to_string(*nodes - 1) +
+                     " AND timestamp_ns = " + std::to_string(last),
+                 &status) == 1;
+    PATROLMAP_RETURN_IF_ERROR(status);
+  }
+  if (same) return Status::Ok();
+  return Status::DataLoss(base + ": changed since this run read it (it holds " + std::to_string(*nodes) +
+                          " nodes and " + std::to_string(*edges) + " edges); run again against the map as it is now");
+}
+
+Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* db, MapWriter* writer) {
+  std::int64_t nodes = 0, edges = 0;
+  PATROLMAP_RETURN_IF_ERROR(StoredCounts(map, base, db, &nodes, &edges));
   const std::vector<TopoMap::Edge> all_edges = map.Edges();
-  PATROLMAP_CHECK(nodes <= map.node_count() && edges <= static_cast<std::int64_t>(all_edges.size()));
   PATROLMAP_RETURN_IF_ERROR(writer->Prepare());
   PATROLMAP_RETURN_IF_ERROR(writer->Info(map));
   for (int i = static_cast<int>(nodes); i < map.node_count(); ++i)
@@ -612,6 +630,7 @@ Status WriteGrowth(const TopoMap& map, const std::string& base, SqliteDatabase* 
   PATROLMAP_RETURN_IF_ERROR(db->Prepare("SELECT id FROM patrols WHERE flight = ?1", &stored));
   PATROLMAP_RETURN_IF_ERROR(
       db->Prepare("UPDATE objects SET site_object = ?1 WHERE patrol = ?2 AND position = ?3", &site));
+  Status status;
   for (const PatrolRecord& p : map.patrols()) {
     stored.Bind(1, p.flight);
     const bool has = stored.Step(&status);
@@ -727,8 +746,8 @@ Status LoadMap(const std::string& path, TopoMap* map, PatrolDetail detail) {
   std::error_code error;
   const auto size = std::filesystem::file_size(path, error);
   if (error) return Status::NotFound(path + ": cannot read map: " + error.message());
-  if (IsDatabase(path)) return LoadDatabase(path, map, detail);
-  const std::string start = FileStart(path, 8);
+  const std::string start = FileStart(path, sizeof(kSqliteMagic));
+  if (start == std::string(kSqliteMagic, sizeof(kSqliteMagic))) return LoadDatabase(path, map, detail);
   if (start.size() < 8 || std::memcmp(start.data(), kLegacyMagic, 8) != 0) {
     return Status::DataLoss(path + ": not a patrolmap map file");
   }

@@ -612,12 +612,42 @@ TEST(MapFile, KillDuringSaveLeavesThePreviousMapIntact) {
   EXPECT_EQ(loaded.node_count(), 7);
 }
 
+// How damaged copies of a map fare, written one by one to `dir`/damaged.pmap: each loads the same way twice and then
+// survives a save and every export, or fails with a message that names the file. Counts the loaded and refused.
+struct DamageOutcome {
+  int loaded = 0, refused = 0;
+};
+DamageOutcome LoadEachDamaged(const std::vector<std::string>& cases, const std::string& dir) {
+  const std::string damaged = dir + "/damaged.pmap";
+  DamageOutcome outcome;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    std::ofstream(damaged, std::ios::binary | std::ios::trunc) << cases[i];
+    TopoMap first, second;
+    const Status a = LoadMap(damaged, &first), b = LoadMap(damaged, &second);
+    EXPECT_EQ(a.ok(), b.ok()) << "case " << i;
+    EXPECT_EQ(a.message(), b.message()) << "case " << i;
+    if (!a.ok()) {
+      EXPECT_NE(a.message().find(damaged), std::string::npos) << "case " << i << ": " << a.message();
+      ++outcome.refused;
+      continue;
+    }
+    ++outcome.loaded;
+    EXPECT_EQ(ToJson(first), ToJson(second)) << "case " << i;
+    for (const auto& format :
+         {ToGraphML(first), ToDot(first), ToSvg(first), ToHtml(first), ToGeoJson(first), ToKml(first)}) {
+      EXPECT_FALSE(format.empty()) << "case " << i;
+    }
+    EXPECT_TRUE(SaveMap(first, dir + "/again.pmap").ok()) << "case " << i;
+  }
+  return outcome;
+}
+
 // A damaged map behind good checksums (rules no paper gives): truncated at 64 offsets, and 200
 // single-bit flips with the checksums recomputed (fixed seed). Each file loads the same way twice and then
 // survives a save and every export, or fails with a message that names it.
 TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {
   testing::TempDir dir;
-  const std::string original = dir / "m.pmap", damaged = dir / "damaged.pmap";
+  const std::string original = dir / "m.pmap";
   ASSERT_TRUE(SaveLegacyMap(TwoFlights(), original).ok());
   const std::string bytes = testing::ReadText(original);
   std::vector<std::string> cases;
@@ -630,26 +660,7 @@ TEST(MapFile, DamageBehindGoodChecksumsLoadsIdenticallyOrFailsNamingTheFile) {
     testing::RecomputeMapChecksums(&flipped);
     cases.push_back(flipped);
   }
-  int loaded = 0, refused = 0;
-  for (std::size_t i = 0; i < cases.size(); ++i) {
-    std::ofstream(damaged, std::ios::binary | std::ios::trunc) << cases[i];
-    TopoMap first, second;
-    const Status a = LoadMap(damaged, &first), b = LoadMap(damaged, &second);
-    ASSERT_EQ(a.ok(), b.ok()) << "case " << i;
-    ASSERT_EQ(a.message(), b.message()) << "case " << i;
-    if (!a.ok()) {
-      EXPECT_NE(a.message().find(damaged), std::string::npos) << "case " << i << ": " << a.message();
-      ++refused;
-      continue;
-    }
-    ++loaded;
-    EXPECT_EQ(ToJson(first), ToJson(second)) << "case " << i;
-    for (const auto& format :
-         {ToGraphML(first), ToDot(first), ToSvg(first), ToHtml(first), ToGeoJson(first), ToKml(first)}) {
-      EXPECT_FALSE(format.empty()) << "case " << i;
-    }
-    EXPECT_TRUE(SaveMap(first, dir / "again.pmap").ok()) << "case " << i;
-  }
+  const auto [loaded, refused] = LoadEachDamaged(cases, dir.path());
   EXPECT_EQ(loaded + refused, 264);
   EXPECT_GE(refused, 64);  // every truncation (and the empty file) is refused
   EXPECT_GT(loaded, 100);  // most flips reach the parsers past the recomputed checksums (187 at seed 19)
@@ -764,6 +775,23 @@ TEST(MapStore, APartialLoadGrownAndSavedOntoItsFileEqualsAWholeSave) {
   EXPECT_EQ(Content(grown, dir / "a.bin"), Content(whole_archived, dir / "b.bin"));
 }
 
+// A map file replaced by another between a patrol's load and its save is refused, naming it; nothing is written.
+TEST(MapStore, ABaseReplacedSinceItWasReadIsRefused) {
+  testing::TempDir dir;
+  ASSERT_TRUE(SaveMap(TwoFlights(), dir / "m.pmap").ok());
+  TopoMap map;
+  ASSERT_TRUE(LoadMap(dir / "m.pmap", &map, PatrolDetail::kLatest).ok());
+  TopoMap other = TwoFlights();
+  other.mutable_node(6).timestamp_ns += 1;  // as many nodes, another last one
+  ASSERT_TRUE(SaveMap(other, dir / "m.pmap").ok());
+  const Status status = SaveMapOnto(map, dir / "m.pmap", dir / "out.pmap");
+  EXPECT_NE(status.message().find(dir / "m.pmap" + ": changed since this run read it"), std::string::npos)
+      << status.message();
+  EXPECT_FALSE(std::filesystem::exists(dir / "out.pmap"));
+  ASSERT_TRUE(SaveMap(ThreeFlights(), dir / "m.pmap").ok());  // more nodes than the run read
+  EXPECT_FALSE(SaveMapOnto(map, dir / "m.pmap", dir / "out.pmap").ok());
+}
+
 // Past the latest whole patrols, a patrol keeps the voxels no later patrol observed and a frame every 10 s: the
 // grids of the map hold each voxel once.
 TEST(MapStore, OlderPatrolsAreArchivedToWhatNoLaterPatrolSaw) {
@@ -848,10 +876,10 @@ TEST(MapStore, ForeignNewerAndDamagedDatabasesAreRefusedNamingTheFile) {
 }
 
 // Truncated at 32 lengths and with 300 single-byte changes (fixed seed), a database loads the same way twice and
-// saves, or fails naming the file.
+// saves and exports, or fails naming the file.
 TEST(MapStore, ADamagedDatabaseLoadsIdenticallyOrFailsNamingTheFile) {
   testing::TempDir dir;
-  const std::string original = dir / "m.pmap", damaged = dir / "damaged.pmap";
+  const std::string original = dir / "m.pmap";
   ASSERT_TRUE(SaveMap(ThreeFlights(), original).ok());
   const std::string bytes = testing::ReadText(original);
   std::vector<std::string> cases;
@@ -863,20 +891,7 @@ TEST(MapStore, ADamagedDatabaseLoadsIdenticallyOrFailsNamingTheFile) {
         static_cast<char>(std::uniform_int_distribution<int>(0, 255)(rng));
     cases.push_back(changed);
   }
-  int refused = 0;
-  for (std::size_t i = 0; i < cases.size(); ++i) {
-    std::ofstream(damaged, std::ios::binary | std::ios::trunc) << cases[i];
-    TopoMap first, second;
-    const Status a = LoadMap(damaged, &first), b = LoadMap(damaged, &second);
-    ASSERT_EQ(a.message(), b.message()) << "case " << i;
-    if (!a.ok()) {
-      EXPECT_NE(a.message().find(damaged), std::string::npos) << "case " << i << ": " << a.message();
-      ++refused;
-      continue;
-    }
-    EXPECT_EQ(ToJson(first), ToJson(second)) << "case " << i;
-    EXPECT_TRUE(SaveMap(first, dir / "again.pmap").ok()) << "case " << i;
-  }
+  const int refused = LoadEachDamaged(cases, dir.path()).refused;
   EXPECT_GE(refused, 31);  // every truncation but the whole file
 }
 
