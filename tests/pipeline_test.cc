@@ -1,8 +1,12 @@
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
+#include <regex>
 #include <set>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -160,6 +164,57 @@ TEST(Config, DefaultFileMirrorsTheOptionsStructsOneToOne) {
   FlattenKeys(YAML::LoadFile(kDefaultConfig), "", &file_keys);
   FlattenKeys(YAML::Load(ConfigToYaml(Config{})), "", &struct_keys);
   EXPECT_EQ(file_keys, struct_keys);
+}
+
+// Every key as a dotted path with its value as YAML writes it.
+void FlattenValues(const YAML::Node& node, const std::string& prefix, std::map<std::string, std::string>* values) {
+  for (const auto& item : node) {
+    const std::string path =
+        prefix.empty() ? item.first.as<std::string>() : prefix + "." + item.first.as<std::string>();
+    if (item.second.IsMap())
+      FlattenValues(item.second, path, values);
+    else
+      (*values)[path] = item.second.as<std::string>();
+  }
+}
+
+// Two defaults are the same when they are the same number (0.3 and 0.30, 64 and 64.0) or the same word.
+bool SameDefault(const std::string& documented, const std::string& value) {
+  char* documented_end = nullptr;
+  char* value_end = nullptr;
+  const double a = std::strtod(documented.c_str(), &documented_end);
+  const double b = std::strtod(value.c_str(), &value_end);
+  if (!documented.empty() && *documented_end == '\0' && !value.empty() && *value_end == '\0')
+    return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b));
+  return documented == value;
+}
+
+// docs/configuration.md is the configuration reference: one table row per key, with the default the options
+// structs give. A key added, renamed or given another default without the page fails here.
+TEST(Config, TheReferencePageListsEveryKeyWithItsDefault) {
+  std::ifstream page(std::string(PATROLMAP_SOURCE_DIR) + "/docs/configuration.md");
+  ASSERT_TRUE(page.good());
+  const std::regex row(R"(^\| `([a-z0-9_.]+)` \| ([^|]*[^ |]) \|)");
+  std::map<std::string, std::string> documented;
+  std::smatch match;
+  for (std::string line; std::getline(page, line);) {
+    if (std::regex_search(line, match, row)) {
+      EXPECT_TRUE(documented.emplace(match[1], match[2]).second) << match[1] << " has two rows";
+    }
+  }
+  std::map<std::string, std::string> defaults;
+  FlattenValues(YAML::Load(ConfigToYaml(Config{})), "", &defaults);
+  for (const auto& [key, value] : defaults) {
+    const auto found = documented.find(key);
+    if (found == documented.end()) {
+      ADD_FAILURE() << key << " has no row in docs/configuration.md";
+      continue;
+    }
+    EXPECT_TRUE(SameDefault(found->second, value))
+        << key << ": the page says " << found->second << ", the default is " << value;
+  }
+  for (const auto& [key, value] : documented)
+    EXPECT_TRUE(defaults.count(key)) << "docs/configuration.md documents " << key << ", which is no key";
 }
 
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
