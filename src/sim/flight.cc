@@ -351,6 +351,8 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   if (!flight.trajectory || flight.duration_s <= 0.0) return Status::InvalidArgument("flight has no trajectory");
   if (options.truth_only) {
     PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/groundtruth"));
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/objects.csv", ObjectsTable(flight.objects)));
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/changes.csv", ChangesTable(flight.changes)));
     return WriteFileAtomically(folder + "/groundtruth/key_locations.csv", TruthTable(KeyLocationTruth(flight)));
   }
   for (const char* sub : {"/cam0/data", "/imu0", "/state_groundtruth_estimate0", "/groundtruth"}) {

@@ -193,7 +193,7 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
       ->type_name("BASELINE_M")
       ->check(FiniteRange(0.01, 10.0));
   app->add_flag("--truth-only", arguments->log.truth_only,
-                "write only groundtruth/key_locations.csv into an existing log of the same options");
+                "write only groundtruth/ (key locations, objects, changes) as a log of the same options holds it");
   app->add_option("--motion-blur", arguments->log.exposure_s,
                   "exposure time for motion blur [s] (each frame averages 5 renders over it; 0 = sharp)")
       ->check(FiniteRange(0.0, 0.1))
