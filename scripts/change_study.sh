@@ -6,7 +6,8 @@
 # Usage: scripts/change_study.sh [OUT] [PATROLMAP]   (defaults: out/change_study, build/tools/patrolmap)
 # Environment: ROUTES, SEEDS (or SERIES="route:seed ..."), OBJECTS (30) choose the series; REUSE_LOGS=1 keeps logs simulated before;
 # STEREO=BASELINE_M also renders the right camera (cam1/); DEPTH (auto) sets depth.source: stereo or images;
-# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options; LIGHTING=0 leaves out the lighting-only series (inner-loop
+# STEREO_KEYS="KEY=VALUE ..." sets depth.stereo options and FLIGHT_KEYS depth.flight's (DEPTH=flight: depth from the
+# flight's own frames, depth0/ left unread); LIGHTING=0 leaves out the lighting-only series (inner-loop
 # seed 1 unless LIGHTING_ROUTE and LIGHTING_SEED say otherwise);
 # NO_DETECTOR=1 maps without the detections (objects0/ moved aside; the truth still counts them), so the objects
 # scored are the class-agnostic ones from changed geometry; RESOLUTION (376x240) and SCALE (1.0) the images;
@@ -45,6 +46,10 @@ printf 'depth:\n  source: %s\n' "${DEPTH:-auto}" >> "$config"
 if [ -n "${STEREO_KEYS:-}" ]; then  # STEREO_KEYS="edge_radius_px=2 edge_jump_px=2": depth.stereo options
   printf '  stereo:\n' >> "$config"
   for pair in $STEREO_KEYS; do printf '    %s: %s\n' "${pair%%=*}" "${pair#*=}" >> "$config"; done
+fi
+if [ -n "${FLIGHT_KEYS:-}" ]; then  # FLIGHT_KEYS="baseline_m=2": depth.flight options
+  printf '  flight:\n' >> "$config"
+  for pair in $FLIGHT_KEYS; do printf '    %s: %s\n' "${pair%%=*}" "${pair#*=}" >> "$config"; done
 fi
 [ -n "${EXTRA_CONFIG:-}" ] && cat "$EXTRA_CONFIG" >> "$config"  # EXTRA_CONFIG=FILE: more keys (not flow: or depth:)
 run_series() {  # name route seed extra-simulate-options...

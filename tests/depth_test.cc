@@ -1,5 +1,6 @@
 // The depth stage: stereo matching against Middlebury's true disparity (Debian's opencv-doc), stereo depth
-// of a synthetic pair whose geometry is known exactly, the fusion of depth frames along a flight, and the lens.
+// of a synthetic pair whose geometry is known exactly, depth from the flight's own frames, the fusion of depth frames
+// along a flight, and the lens.
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "patrolmap/depth/fusion.h"
 #include "patrolmap/depth/lens.h"
+#include "patrolmap/depth/motion_stereo.h"
 #include "patrolmap/depth/stereo.h"
 
 namespace patrolmap::depth {
@@ -385,6 +387,73 @@ CameraPoseSample At(double x) {
   CameraPoseSample pose;
   pose.position = Eigen::Vector3d(x, 0.0, 0.0);
   return pose;
+}
+
+// A camera flying sideways (+x, 1 m/s) past a textured wall 8 m away, face on (f = 400 px: 50 px per metre on the
+// wall): frame i stands at x = 0.2 i m, 0.2 i s into the flight, and sees the texture 10 i px further on.
+struct WallFlight {
+  const CameraIntrinsics camera{400.0, 400.0, 188.0, 120.0, 376, 240};
+  cv::Mat texture;
+  WallFlight() : texture(240, 376 + 200, CV_8UC1) {
+    cv::randu(texture, 0, 256);
+    cv::GaussianBlur(texture, texture, cv::Size(3, 3), 0.8);
+  }
+  cv::Mat Frame(int i) const { return texture.colRange(10 * i, 10 * i + 376).clone(); }
+  static CameraPoseSample Pose(int i, const Eigen::Vector3d& direction = Eigen::Vector3d::UnitX()) {
+    CameraPoseSample pose;
+    pose.timestamp_ns = SecondsToNs(0.2 * i);
+    pose.position = 0.2 * i * direction;
+    return pose;
+  }
+};
+
+// Each frame is matched with the earlier one whose baseline comes nearest depth.flight.baseline_m (1 m: frame i - 5),
+// none before one stands min_baseline_m (0.3 m) away, and the wall comes out at its 8 m.
+TEST(FlightDepth, AWallFlownPastComesOutAtItsDepth) {
+  const WallFlight flight;
+  FlightDepth depth(Lens(flight.camera), FlightDepthOptions(), StereoOptions());
+  for (int i = 0; i <= 8; ++i) {
+    cv::Mat depth_m;
+    double sigma = 0.0;
+    const bool paired = depth.Compute(flight.Frame(i), WallFlight::Pose(i), &depth_m, &sigma);
+    EXPECT_EQ(paired, i >= 2) << "frame " << i;
+    if (!paired) {
+      EXPECT_TRUE(depth_m.empty());
+      continue;
+    }
+    const double baseline = 0.2 * std::min(i, 5);
+    EXPECT_NEAR(sigma, depth.SigmaPerM2(baseline), 0.02 * sigma) << "frame " << i;
+    const auto [known, at_wall] = KnownAndAt(depth_m, 8.0, 0.08);
+    EXPECT_GT(known, 0.6 * 376 * 240) << "frame " << i;
+    EXPECT_GT(at_wall, 0.98 * known) << "frame " << i;
+  }
+  EXPECT_NEAR(depth.SigmaPerM2(1.0), 0.5 / 400.0, 1e-12);
+  EXPECT_NEAR(depth.NearestDepth(1.0), 400.0 / 64, 1e-12);
+}
+
+// Frames older than depth.flight.history_s are not kept: with 0.5 s the partner of frame 8 is frame 6, 0.4 m away.
+TEST(FlightDepth, OnlyTheFramesOfTheLastSecondsAreKept) {
+  const WallFlight flight;
+  FlightDepthOptions options;
+  options.history_s = 0.5;
+  FlightDepth depth(Lens(flight.camera), options, StereoOptions());
+  cv::Mat depth_m;
+  double sigma = 0.0;
+  for (int i = 0; i <= 8; ++i) depth.Compute(flight.Frame(i), WallFlight::Pose(i), &depth_m, &sigma);
+  ASSERT_FALSE(depth_m.empty());
+  EXPECT_NEAR(sigma, depth.SigmaPerM2(0.4), 0.02 * sigma);
+}
+
+// A camera flying along its optical axis has no baseline across it: no depth, whatever the distance flown.
+TEST(FlightDepth, FlyingAlongTheOpticalAxisGivesNoDepth) {
+  const WallFlight flight;
+  FlightDepth depth(Lens(flight.camera), FlightDepthOptions(), StereoOptions());
+  for (int i = 0; i <= 8; ++i) {
+    cv::Mat depth_m;
+    double sigma = 0.0;
+    EXPECT_FALSE(depth.Compute(flight.Frame(0), WallFlight::Pose(i, Eigen::Vector3d::UnitZ()), &depth_m, &sigma));
+    EXPECT_TRUE(depth_m.empty());
+  }
 }
 
 TEST(DepthFusion, AgreeingFramesAverageAwayTheirNoise) {

@@ -251,8 +251,9 @@ void SiteObjectTimelines(const ChangeReport& report, std::ostringstream* html) {
 }
 
 const char* DepthWords(const std::string& source) {
-  if (source == "images") return "depth images";
-  if (source == "stereo") return "stereo matching";
+  if (source == kDepthFromImages) return "depth images";
+  if (source == kDepthFromStereo) return "stereo matching";
+  if (source == kDepthFromFlight) return "motion stereo between the flight's frames";
   return "unrecorded";
 }
 

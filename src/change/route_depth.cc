@@ -9,29 +9,25 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "patrolmap/depth/stereo.h"
+#include "patrolmap/depth/motion_stereo.h"
 
 namespace patrolmap::change {
 namespace {
 
-depth::StereoOptions MatchingOptions(const RouteDepthOptions& options) {
-  depth::StereoOptions stereo;
-  stereo.num_disparities = options.num_disparities;
-  stereo.block_size = options.block_size;
-  stereo.disparity_sigma_px = options.disparity_sigma_px;
-  stereo.max_range_m = options.max_range_m;
-  return stereo;
+depth::MotionStereoOptions MatchingOptions(const RouteDepthOptions& options) {
+  depth::MotionStereoOptions motion;
+  motion.min_baseline_m = options.min_baseline_m;
+  motion.min_sideways_share = options.min_sideways_share;
+  motion.matching.num_disparities = options.num_disparities;
+  motion.matching.block_size = options.block_size;
+  motion.matching.disparity_sigma_px = options.disparity_sigma_px;
+  motion.matching.max_range_m = options.max_range_m;
+  motion.agree_m = options.min_change_m;
+  motion.agree_sigmas = options.sigmas;
+  return motion;
 }
 
-// The rigid motion taking points from the axes of a camera at `from` into those of a camera at `into`:
-// into.ToCamera(from.ToWorld(p)) as one matrix and one offset, for loops over every pixel.
-struct RelativePose {
-  Eigen::Matrix3d rotation;
-  Eigen::Vector3d translation;
-  RelativePose(const CameraPoseSample& from, const CameraPoseSample& into)
-      : rotation((into.rotation.conjugate() * from.rotation).toRotationMatrix()),
-        translation(into.ToCamera(from.position)) {}
-};
+using depth::RelativePose;
 
 // The depth image with each pixel the least depth around it (one pixel each way), and unknown (0) wherever a pixel
 // around it is unknown: a ray that lands beside a depth edge is compared with the nearer surface.
@@ -70,112 +66,6 @@ void MarkSeenThrough(const KeyFrameView& from, const KeyFrameView& into, const c
   }
 }
 
-// The image mirrored, transposed or turned so that a baseline in camera axes points along +x: a stereo pair must stand
-// side by side, the other camera to the right. The matching keeps the image's rows where it can (a mirror rather than
-// a half turn for a neighbour to the left): semi-global matching's paths run one way down the image.
-struct SideBySide {
-  enum Kind { kAsIs, kMirrored, kTransposed, kTurned } kind = kAsIs;  // kTurned: a clockwise quarter turn
-
-  static SideBySide Towards(const Eigen::Vector3d& baseline) {
-    const double along[4] = {baseline.x(), -baseline.x(), baseline.y(), -baseline.y()};
-    return {static_cast<Kind>(std::max_element(along, along + 4) - along)};
-  }
-  // Camera axes after (x' = axes * x).
-  Eigen::Matrix3d Axes() const {
-    Eigen::Matrix3d axes;
-    switch (kind) {
-      case kAsIs: axes << 1, 0, 0, 0, 1, 0, 0, 0, 1; break;
-      case kMirrored: axes << -1, 0, 0, 0, 1, 0, 0, 0, 1; break;
-      case kTransposed: axes << 0, 1, 0, 1, 0, 0, 0, 0, 1; break;
-      case kTurned: axes << 0, -1, 0, 1, 0, 0, 0, 0, 1; break;
-    }
-    return axes;
-  }
-  CameraIntrinsics Camera(const CameraIntrinsics& c) const {
-    CameraIntrinsics t = c;
-    if (kind == kMirrored) t.cx = c.width - 1 - c.cx;
-    if (kind == kTransposed || kind == kTurned) {
-      t.fx = c.fy, t.fy = c.fx, t.cx = c.cy, t.cy = c.cx, t.width = c.height, t.height = c.width;
-      if (kind == kTurned) t.cx = c.height - 1 - c.cy;  // u' = (height - 1) - v, v' = u
-    }
-    return t;
-  }
-  Distortion LensOf(const Distortion& d) const {
-    switch (kind) {
-      case kAsIs: return d;
-      case kMirrored: return depth::MirroredDistortion(d);
-      case kTransposed: return depth::TransposedDistortion(d);
-      case kTurned: return depth::TurnedDistortion(d);
-    }
-    return d;
-  }
-  // `image` as matched, into a new image (never the caller's pixels).
-  cv::Mat Image(const cv::Mat& image) const {
-    cv::Mat out;
-    switch (kind) {
-      case kAsIs: return image;
-      case kMirrored: cv::flip(image, out, 1); break;
-      case kTransposed: cv::transpose(image, out); break;
-      case kTurned: cv::rotate(image, out, cv::ROTATE_90_CLOCKWISE); break;
-    }
-    return out;
-  }
-  // A matched image brought back.
-  cv::Mat Back(const cv::Mat& image) const {
-    if (kind != kTurned) return Image(image);  // mirroring and transposing undo themselves
-    cv::Mat out;
-    cv::rotate(image, out, cv::ROTATE_90_COUNTERCLOCKWISE);
-    return out;
-  }
-};
-
-// Depth of the frame seen from `pose` by matching it against `other` (seen from `other_pose`), on the lens's
-// undistorted grid; the range error per squared metre into `sigma_per_m2`. Empty when the two stand too close or along
-// the optical axis. Whichever way across the optical axis the other camera stands (a camera looking sideways that flies
-// forward or back, or one looking down), the pair is matched side by side (SideBySide).
-cv::Mat PairDepth(const cv::Mat& image, const RouteNeighbour& other, const depth::Lens& lens,
-                  const CameraPoseSample& pose, const RouteDepthOptions& options, double* sigma_per_m2) {
-  const Eigen::Vector3d baseline = pose.ToCamera(other.pose.position);  // the other camera, seen from this one
-  const double length = baseline.norm();
-  if (other.image.size() != image.size() || length < options.min_baseline_m ||
-      std::hypot(baseline.x(), baseline.y()) < options.min_sideways_share * length) {
-    return cv::Mat();
-  }
-  const SideBySide turn = SideBySide::Towards(baseline);
-  const Eigen::Matrix3d axes = turn.Axes();
-  StereoCalibration calibration;
-  calibration.left = calibration.right = turn.Camera(lens.camera());
-  calibration.left_distortion = calibration.right_distortion = turn.LensOf(lens.distortion());
-  const RelativePose other_from(pose, other.pose);
-  calibration.right_from_left_rotation = axes * other_from.rotation * axes.transpose();
-  calibration.right_from_left_translation = axes * other_from.translation;
-  std::unique_ptr<depth::StereoDepth> stereo;
-  if (!depth::StereoDepth::Create(calibration, MatchingOptions(options), &stereo).ok()) return cv::Mat();
-  cv::Mat depth_m;
-  if (!stereo->Compute(turn.Image(image), turn.Image(other.image), &depth_m).ok()) return cv::Mat();
-  *sigma_per_m2 = stereo->RangeSigma(1.0);
-  return turn.Back(depth_m);
-}
-
-// `a` and `b` fused into `a`: averaged where both know the depth and agree within `sigmas` range errors (at least
-// min_change_m), unknown where they disagree, and the one depth where only one knows it.
-void Fuse(const cv::Mat& b, double sigma_a, double sigma_b, const RouteDepthOptions& options, cv::Mat* a) {
-  for (int y = 0; y < a->rows; ++y) {
-    float* za = a->ptr<float>(y);
-    const float* zb = b.ptr<float>(y);
-    for (int x = 0; x < a->cols; ++x) {
-      if (!(zb[x] > 0.0f)) continue;
-      if (!(za[x] > 0.0f)) {
-        za[x] = zb[x];
-        continue;
-      }
-      const double error = sigma_a * za[x] * za[x] + sigma_b * zb[x] * zb[x];
-      const bool agree = std::abs(za[x] - zb[x]) <= std::max(options.min_change_m, options.sigmas * error);
-      za[x] = agree ? 0.5f * (za[x] + zb[x]) : 0.0f;
-    }
-  }
-}
-
 }  // namespace
 
 bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const depth::Lens& lens,
@@ -184,19 +74,8 @@ bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const depth::
   if (view->image.empty() || !camera.valid() || camera.width != view->image.cols || camera.height != view->image.rows) {
     return false;
   }
-  cv::Mat fused;
   double fused_sigma = 0.0;
-  for (const RouteNeighbour& other : neighbours) {
-    double sigma = 0.0;
-    const cv::Mat depth_m = PairDepth(view->image, other, lens, pose, options, &sigma);
-    if (depth_m.empty()) continue;
-    if (fused.empty()) {
-      fused = depth_m, fused_sigma = sigma;
-    } else {
-      Fuse(depth_m, fused_sigma, sigma, options, &fused);
-      fused_sigma = std::max(fused_sigma, sigma);
-    }
-  }
+  const cv::Mat fused = depth::MotionDepth(view->image, pose, neighbours, lens, MatchingOptions(options), &fused_sigma);
   if (fused.empty()) return false;
   view->depth = lens.ToRaw(fused);
   view->lens = lens;

@@ -9,13 +9,15 @@ const char* ToString(DepthSource source) {
     case DepthSource::kAuto: return "auto";
     case DepthSource::kImages: return "images";
     case DepthSource::kStereo: return "stereo";
+    case DepthSource::kFlight: return "flight";
     case DepthSource::kNone: return "none";
   }
   return "auto";
 }
 
 bool ParseDepthSource(const std::string& text, DepthSource* source) {
-  for (DepthSource candidate : {DepthSource::kAuto, DepthSource::kImages, DepthSource::kStereo, DepthSource::kNone}) {
+  for (DepthSource candidate :
+       {DepthSource::kAuto, DepthSource::kImages, DepthSource::kStereo, DepthSource::kFlight, DepthSource::kNone}) {
     if (text == ToString(candidate)) return *source = candidate, true;
   }
   return false;
@@ -42,6 +44,17 @@ bool StereoOptions::IsValid(std::string* error) const {
       .InRange("depth.stereo.fuse_frames", fuse_frames, 0, 16)
       .AboveAtMost("depth.stereo.fuse_gate_sigmas", fuse_gate_sigmas, 0.0, 10.0)
       .InRange("depth.stereo.fuse_shared_variance", fuse_shared_variance, 0.0, 1.0);
+  return check.ok();
+}
+
+bool FlightDepthOptions::IsValid(std::string* error) const {
+  OptionCheck check(error);
+  check.AboveAtMost("depth.flight.baseline_m", baseline_m, 0.0, 100.0)
+      .AboveAtMost("depth.flight.min_baseline_m", min_baseline_m, 0.0, 100.0)
+      .Holds("depth.flight.baseline_m", baseline_m, baseline_m >= min_baseline_m,
+             "must be at least depth.flight.min_baseline_m")
+      .InRange("depth.flight.min_sideways_share", min_sideways_share, 0.0, 1.0)
+      .AboveAtMost("depth.flight.history_s", history_s, 0.0, 60.0);
   return check.ok();
 }
 

@@ -214,8 +214,7 @@ bool ValidGrid(const PatrolRecord& p) {
   const EvidenceGridData& grid = p.grid;
   if (!std::isfinite(grid.voxel_size) || grid.voxel_size < 0.0 || grid.evicted_voxels < 0) return false;
   if (!grid.voxels.empty() && (grid.voxel_size < kMinVoxelM || grid.voxel_size > kMaxVoxelM)) return false;
-  return SortedVoxels(grid.voxels) &&
-         (p.depth_source.empty() || p.depth_source == "images" || p.depth_source == "stereo");
+  return SortedVoxels(grid.voxels) && KnownDepthSource(p.depth_source);
 }
 
 // Frames in time order, each with a valid time and frame index, a valid pose and GPS where it has them, and

@@ -113,7 +113,7 @@ class YamlReader {
 
   void Parse(const std::string& path, const YAML::Node& node, depth::DepthSource* value) {
     if (!depth::ParseDepthSource(Scalar(node), value)) {
-      Fail(path, node, "expected auto, images, stereo or none, got '" + Scalar(node) + "'");
+      Fail(path, node, "expected auto, images, stereo, flight or none, got '" + Scalar(node) + "'");
     }
   }
 

@@ -35,6 +35,18 @@ void SayStereoReach(const std::string& path, const depth::StereoDepth& stereo, c
                views - 1, fused, views);
 }
 
+// Says how far depth from the flight marks surfaces, as SayStereoReach does for a rig of the baseline sought.
+void SayFlightReach(const std::string& path, const depth::FlightDepth& flight, const Config& config) {
+  const change::EvidenceGridOptions& grid = config.change.grid;
+  const double baseline = config.depth.flight.baseline_m;
+  const double marked = std::min(std::sqrt(grid.max_hit_sigma_m / flight.SigmaPerM2(baseline)), grid.max_range_m);
+  spdlog::info(
+      "{}: depth from the flight's own frames, each matched with an earlier one about {:.2f} m away across the optical "
+      "axis (depth.flight.baseline_m): nothing nearer than {:.1f} m is matched (depth.stereo.num_disparities {}); "
+      "surfaces are marked within {:.1f} m",
+      path, baseline, flight.NearestDepth(baseline), config.depth.stereo.num_disparities, marked);
+}
+
 }  // namespace
 
 PatrolRecorder::PatrolRecorder(const Config& config, const io::LogInfo& info)
@@ -71,15 +83,30 @@ void PatrolRecorder::ChooseDepth(const Config& config, const io::LogInfo& info) 
     const Status status = depth::StereoDepth::Create(*info.stereo, config.depth.stereo, &stereo_);
     if (!status.ok()) spdlog::warn("{}: {}; no stereo depth", info.path, status.message());
   }
-  if (stereo_ != nullptr) {
-    const depth::FusionOptions fusion{config.depth.stereo.fuse_frames, config.depth.stereo.fuse_gate_sigmas,
-                                      stereo_->RangeSigma(1.0), config.depth.stereo.fuse_shared_variance};
-    if (fusion.frames > 0) fusion_ = std::make_unique<depth::DepthFusion>(base_.camera, fusion);
-    SayStereoReach(info.path, *stereo_, fusion_.get(), config);
+  const bool precise_poses = info.pose_source != kPosesFromGps;
+  if (source == DepthSource::kFlight && !precise_poses) {
+    spdlog::warn("{}: depth.source is flight but the camera poses come from GPS fixes, metres off: no depth",
+                 info.path);
   }
+  if (!images && stereo_ == nullptr && precise_poses &&
+      (source == DepthSource::kAuto || source == DepthSource::kFlight)) {
+    flight_ = std::make_unique<depth::FlightDepth>(depth::Lens(base_.camera, base_.distortion), config.depth.flight,
+                                                   config.depth.stereo);
+    SayFlightReach(info.path, *flight_, config);
+  }
+  const double sigma_per_m2 = stereo_ != nullptr   ? stereo_->RangeSigma(1.0)
+                              : flight_ != nullptr ? flight_->SigmaPerM2(config.depth.flight.baseline_m)
+                                                   : 0.0;
+  if (stereo_ != nullptr || flight_ != nullptr) {
+    const depth::FusionOptions fusion{config.depth.stereo.fuse_frames, config.depth.stereo.fuse_gate_sigmas,
+                                      sigma_per_m2, config.depth.stereo.fuse_shared_variance};
+    if (fusion.frames > 0) fusion_ = std::make_unique<depth::DepthFusion>(base_.camera, fusion);
+  }
+  if (stereo_ != nullptr) SayStereoReach(info.path, *stereo_, fusion_.get(), config);
   use_stereo_ = stereo_ != nullptr;
-  has_depth_ = images || use_stereo_;
-  base_.depth_source = images ? "images" : (use_stereo_ ? "stereo" : "");
+  use_flight_ = flight_ != nullptr;
+  has_depth_ = images || use_stereo_ || use_flight_;
+  base_.depth_source = images ? kDepthFromImages : use_stereo_ ? kDepthFromStereo : use_flight_ ? kDepthFromFlight : "";
 }
 
 void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) {
@@ -97,7 +124,8 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
     next_view_ns_ = pose.timestamp_ns + step;
   }
   const std::size_t first = work->size();
-  if (has_depth_) {
+  if (use_flight_) PushFlightWork(frame, work);
+  if (has_depth_ && !use_flight_) {
     for (const DepthSample& depth : frame.depth) {
       if (depth.stereo() != use_stereo_) continue;
       if (use_stereo_ && !stereo_gate_.Due(depth.timestamp_ns)) continue;
@@ -130,6 +158,17 @@ void PatrolRecorder::Collect(const Frame& frame, std::vector<ChangeWork>* work) 
     work->push_back(std::move(objects));
   }
   if (work->size() > first) (*work)[first].views = std::move(pending_views_), pending_views_.clear();
+}
+
+void PatrolRecorder::PushFlightWork(const Frame& frame, std::vector<ChangeWork>* work) {
+  if (frame.image.empty() || !frame.pose || !stereo_gate_.Due(frame.timestamp_ns)) return;
+  stereo_gate_.Take(frame.timestamp_ns);
+  ChangeWork step_work;
+  step_work.kind = ChangeWork::Kind::kGrid;
+  step_work.timestamp_ns = frame.timestamp_ns;
+  step_work.pose = frame.pose;
+  step_work.image = frame.image.clone();  // the source reuses its buffer
+  work->push_back(std::move(step_work));
 }
 
 void PatrolRecorder::CollectKeyFrame(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
@@ -186,6 +225,18 @@ bool PatrolRecorder::ReadStereoDepth(const ChangeWork& work, cv::Mat* depth) {
   return false;
 }
 
+bool PatrolRecorder::FlightPairDepth(const ChangeWork& work, cv::Mat* depth, double* sigma_per_m2) {
+  if (work.image.cols != base_.camera.width || work.image.rows != base_.camera.height) {
+    spdlog::warn("frame at {} ns is {}x{}, the camera {}x{}: no depth from it", work.timestamp_ns, work.image.cols,
+                 work.image.rows, base_.camera.width, base_.camera.height);
+    ++stats_.skipped_depth_frames;
+    return false;
+  }
+  if (flight_->Compute(work.image, *work.pose, depth, sigma_per_m2)) return ++stats_.flight_pairs, true;
+  ++stats_.unpaired_frames;
+  return false;
+}
+
 bool PatrolRecorder::ReadDepth(const ChangeWork& work, cv::Mat* depth) {
   if (!work.right_path.empty() || !work.right_image.empty()) return ReadStereoDepth(work, depth);
   if (!work.depth_image.empty()) {
@@ -220,10 +271,12 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     mapper_.AddFrame(work.detections, *work.pose, depth_, work.image);
     return;
   }
-  // Stereo pairs were chosen as they came (Collect), depth images are chosen here.
-  if (!use_stereo_ && !grid_gate_.Due(work.timestamp_ns)) return;
+  // Stereo pairs and the flight's frames were chosen as they came (Collect), depth images are chosen here.
+  const bool chosen = use_stereo_ || use_flight_;
+  if (!chosen && !grid_gate_.Due(work.timestamp_ns)) return;
   const auto start = std::chrono::steady_clock::now();
-  if (!ReadDepth(work, &depth_)) return;
+  double sigma_per_m2 = stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0;
+  if (use_flight_ ? !FlightPairDepth(work, &depth_, &sigma_per_m2) : !ReadDepth(work, &depth_)) return;
   if (depth_.cols != base_.camera.width || depth_.rows != base_.camera.height) {
     spdlog::warn("{}: depth image is {}x{}, the camera {}x{}; skipped", work.depth_path, depth_.cols, depth_.rows,
                  base_.camera.width, base_.camera.height);
@@ -231,8 +284,8 @@ void PatrolRecorder::Apply(const ChangeWork& work) {
     return;
   }
   if (fusion_ != nullptr) fusion_->Fuse(*work.pose, grid_.RayStep(depth_.cols), &depth_, &error_scale_);
-  grid_.Integrate(depth_, base_.camera, *work.pose, stereo_ != nullptr ? stereo_->RangeSigma(1.0) : 0.0, error_scale_);
-  if (!use_stereo_) grid_gate_.Take(work.timestamp_ns);
+  grid_.Integrate(depth_, base_.camera, *work.pose, sigma_per_m2, error_scale_);
+  if (!chosen) grid_gate_.Take(work.timestamp_ns);
   ++stats_.depth_frames;
   stats_.grid_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

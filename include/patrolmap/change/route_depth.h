@@ -1,7 +1,7 @@
 // Depth along the route: a route frame with a pose gets depth by semi-global matching against the frames
 // before and after it in its own patrol (motion stereo; depth::StereoDepth with the pair's relative pose as its
-// calibration). Both frames come from one flight, so they share the light, and depth tells what brightness cannot: a
-// small face lit otherwise from a small object.
+// calibration; depth/motion_stereo.h). Both frames come from one flight, so they share the light, and depth tells what
+// brightness cannot: a small face lit otherwise from a small object.
 //
 // Two patrols' frames with depth are then compared by visibility: a current surface that the prior camera saw
 // through (its depth along that ray lies well beyond the surface) is new, and a prior surface the current camera
@@ -17,14 +17,12 @@
 #include "patrolmap/change/options.h"
 #include "patrolmap/core/types.h"
 #include "patrolmap/depth/lens.h"
+#include "patrolmap/depth/motion_stereo.h"
 
 namespace patrolmap::change {
 
-// Another frame of the same patrol, matched against a route frame for its depth.
-struct RouteNeighbour {
-  cv::Mat image;  // grey, the route frame's size
-  CameraPoseSample pose;
-};
+// Another frame of the same patrol (grey, the route frame's size), matched against a route frame for its depth.
+using RouteNeighbour = depth::MotionFrame;
 
 // Gives `view` (a route frame decoded, seen through `lens` at its own size from `pose`) depth from its
 // neighbours: each one standing far enough, across the optical axis (RouteDepthOptions), is matched as a stereo pair.

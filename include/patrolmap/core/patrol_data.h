@@ -109,6 +109,14 @@ inline bool KnownPoseSource(const std::string& source) {
          source == kPosesFromGps;
 }
 
+// Where a patrol's grid and object depth came from (PatrolRecord::depth_source); empty without depth.
+inline constexpr char kDepthFromImages[] = "images";  // depth0/
+inline constexpr char kDepthFromStereo[] = "stereo";  // the log's stereo pair
+inline constexpr char kDepthFromFlight[] = "flight";  // motion stereo between the flight's own frames
+inline bool KnownDepthSource(const std::string& source) {
+  return source.empty() || source == kDepthFromImages || source == kDepthFromStereo || source == kDepthFromFlight;
+}
+
 // What a patrol (one flight of a map) keeps for change detection.
 struct PatrolRecord {
   std::string flight;
@@ -119,7 +127,7 @@ struct PatrolRecord {
   bool has_objects = false;             // the log had detections
   std::vector<MapObject> objects;
   EvidenceGridData grid;          // voxel_size 0 when the log had no depth
-  std::string depth_source;       // where the grid's and objects' depth came from: "images" (depth0/), "stereo", ""
+  std::string depth_source;       // where the grid's and objects' depth came from: kDepthFrom...
   std::string pose_source;        // where its camera poses came from (kPosesFrom...; map format 9 on)
   std::vector<RouteFrame> route;  // in time order; key frames among them (map format 6 on)
   // Whether the log had timestamps (false: 'recent' nodes are counted in images; map format 7 on, true before),

@@ -8,9 +8,10 @@ namespace patrolmap::depth {
 
 // Which depth the change layer uses when a log has more than one.
 enum class DepthSource {
-  kAuto,    // depth0/ images when the log has them, else its stereo pair
+  kAuto,    // depth0/ images when the log has them, else its stereo pair, else the flight's own frames
   kImages,  // depth0/ images only
   kStereo,  // the stereo pair only (cam0 + cam1)
+  kFlight,  // motion stereo between frames of the flight (FlightDepth), with poses from a state estimate
   kNone,    // no depth: objects from detections without depth, no geometry
 };
 
@@ -58,10 +59,24 @@ struct StereoOptions {
   bool IsValid(std::string* error) const;
 };
 
+// Depth from the flight (depth/motion_stereo.h, FlightDepth): each frame the grid takes is matched, with
+// depth.stereo's options, against the earlier frame whose baseline across the optical axis comes nearest
+// baseline_m. The range error at depth z is z^2 * disparity_sigma_px / (f * baseline), so a longer baseline ranges
+// farther surfaces, at the cost of nearer ones (nothing nearer than f * b / num_disparities is matched) and of views
+// that differ more. Needs camera poses from a state estimate: GPS fixes are metres off.
+struct FlightDepthOptions {
+  double baseline_m = 1.0;          // the baseline sought [m]
+  double min_baseline_m = 0.3;      // no earlier frame nearer than this is matched [m]
+  double min_sideways_share = 0.7;  // ... nor one whose baseline runs less than this share across the optical axis
+  double history_s = 3.0;           // earlier frames are kept this long [s]
+  bool IsValid(std::string* error) const;
+};
+
 struct DepthOptions {
   DepthSource source = DepthSource::kAuto;
   StereoOptions stereo;
-  bool IsValid(std::string* error) const { return stereo.IsValid(error); }
+  FlightDepthOptions flight;
+  bool IsValid(std::string* error) const { return stereo.IsValid(error) && flight.IsValid(error); }
 };
 
 }  // namespace patrolmap::depth

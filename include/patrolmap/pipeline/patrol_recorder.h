@@ -22,6 +22,7 @@
 #include "patrolmap/core/rate_gate.h"
 #include "patrolmap/core/status.h"
 #include "patrolmap/depth/fusion.h"
+#include "patrolmap/depth/motion_stereo.h"
 #include "patrolmap/depth/stereo.h"
 #include "patrolmap/io/frame_source.h"
 #include "patrolmap/io/patrol_sensors.h"
@@ -37,6 +38,8 @@ struct PatrolRecordStats {
   int depth_frames = 0;
   int skipped_depth_frames = 0;  // unreadable or of the wrong size: reported and left out
   int stereo_pairs = 0;          // pairs matched, for the grid and the object map (once where both take a frame)
+  int flight_pairs = 0;          // depth from the flight: frames matched with an earlier one
+  int unpaired_frames = 0;       // ... frames no earlier one stood usably far from (the start, hovering, turning)
   double grid_seconds = 0.0;
   long long dropped_voxel_updates = 0;
   long long evicted_voxels = 0;        // the grid's least recently observed voxels, dropped at its memory budget
@@ -57,10 +60,10 @@ struct ChangeWork {
   std::string depth_path;                     // kGrid; kObjects: the frame's depth image, if any; stereo: left
   std::string right_path;                     // stereo: the right image of the pair
   cv::Mat depth_image, right_image;           // instead of the paths: the images a bag handed over (DepthSample)
-  cv::Mat image;                              // kObjects: the frame at the camera's size; kRoute: scaled
-  std::int64_t frame_index = 0;               // kRoute
-  std::optional<Eigen::Vector3d> gps;         // kRoute: latitude, longitude, altitude, when the log has GPS
-  bool key_frame = false;                     // kRoute: the frame is a node's key frame
+  cv::Mat image;                 // kObjects and kGrid from the flight: the frame at the camera's size; kRoute: scaled
+  std::int64_t frame_index = 0;  // kRoute
+  std::optional<Eigen::Vector3d> gps;  // kRoute: latitude, longitude, altitude, when the log has GPS
+  bool key_frame = false;              // kRoute: the frame is a node's key frame
 };
 
 class PatrolRecorder {
@@ -100,6 +103,11 @@ class PatrolRecorder {
   void ChooseDepth(const Config& config, const io::LogInfo& info);
   bool ReadDepth(const ChangeWork& work, cv::Mat* depth);
   bool ReadStereoDepth(const ChangeWork& work, cv::Mat* depth);
+  // Depth from the flight: `work`'s frame matched with an earlier one (FlightDepth), its range error per squared
+  // metre into `sigma_per_m2`.
+  bool FlightPairDepth(const ChangeWork& work, cv::Mat* depth, double* sigma_per_m2);
+  // Frame thread: a frame for depth from the flight, at the pairs' rate.
+  void PushFlightWork(const Frame& frame, std::vector<ChangeWork>* work);
   void AddRouteFrame(const ChangeWork& work);
   // Frame thread: a frame for the route strip, scaled, as work for the change thread.
   void PushRouteWork(TimestampNs timestamp_ns, std::int64_t frame_index, const cv::Mat& image,
@@ -109,16 +117,18 @@ class PatrolRecorder {
   bool active_ = false;
   bool has_depth_ = false;
   bool use_stereo_ = false;  // depth from the stereo pair, not depth0/
+  bool use_flight_ = false;  // depth from the flight's own frames
   PatrolRecord base_;        // flight, camera; views on the change thread
   // Frame thread:
   TimestampNs next_view_ns_;
   std::vector<CameraPoseSample> pending_views_;
-  RateGate stereo_gate_;  // stereo pairs come with every frame: only those at the lower of depth.stereo.rate_hz and
-                          // change.grid.rate_hz are work
+  RateGate stereo_gate_;  // stereo pairs (and frames for depth from the flight) come with every frame: only those at
+                          // the lower of depth.stereo.rate_hz and change.grid.rate_hz are work
   RouteStrip route_;      // Due() and Scale() on the frame thread, the rest on the change thread
   TimestampNs last_frame_ns_ = 0, frame_spacing_ns_ = 0;
   // Change thread:
   std::unique_ptr<depth::StereoDepth> stereo_;
+  std::unique_ptr<depth::FlightDepth> flight_;
   std::unique_ptr<depth::DepthFusion> fusion_;  // depth.stereo.fuse_frames; none when 0
   cv::Mat error_scale_;                         // the fused range error's factor at each traced pixel (fusion_)
   cv::Mat left_, right_;
