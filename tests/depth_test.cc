@@ -407,12 +407,12 @@ struct WallFlight {
   }
 };
 
-// Each frame is matched with the earlier one whose baseline comes nearest depth.flight.baseline_m (1 m: frame i - 5),
+// Each frame is matched with the earlier one whose baseline comes nearest depth.flight.baseline_m (2 m: frame i - 10),
 // none before one stands min_baseline_m (0.3 m) away, and the wall comes out at its 8 m.
 TEST(FlightDepth, AWallFlownPastComesOutAtItsDepth) {
   const WallFlight flight;
   FlightDepth depth(Lens(flight.camera), FlightDepthOptions(), StereoOptions());
-  for (int i = 0; i <= 8; ++i) {
+  for (int i = 0; i <= 14; ++i) {
     cv::Mat depth_m;
     double sigma = 0.0;
     const bool paired = depth.Compute(flight.Frame(i), WallFlight::Pose(i), &depth_m, &sigma);
@@ -421,14 +421,16 @@ TEST(FlightDepth, AWallFlownPastComesOutAtItsDepth) {
       EXPECT_TRUE(depth_m.empty());
       continue;
     }
-    const double baseline = 0.2 * std::min(i, 5);
+    const double baseline = 0.2 * std::min(i, 10);
     EXPECT_NEAR(sigma, depth.SigmaPerM2(baseline), 0.02 * sigma) << "frame " << i;
     const auto [known, at_wall] = KnownAndAt(depth_m, 8.0, 0.08);
     EXPECT_GT(known, 0.6 * 376 * 240) << "frame " << i;
     EXPECT_GT(at_wall, 0.98 * known) << "frame " << i;
   }
   EXPECT_NEAR(depth.SigmaPerM2(1.0), 0.5 / 400.0, 1e-12);
-  EXPECT_NEAR(depth.NearestDepth(1.0), 400.0 / 64, 1e-12);
+  EXPECT_EQ(depth.DisparitiesFor(1.0), 128);  // 400 px * 1 m / 3.5 m = 114 px, in steps of 16
+  EXPECT_NEAR(depth.NearestDepth(1.0), 400.0 / 128, 1e-12);
+  EXPECT_EQ(depth.DisparitiesFor(2.0), 240);  // 400 px * 2 m / 3.5 m = 229 px
 }
 
 // Frames older than depth.flight.history_s are not kept: with 0.5 s the partner of frame 8 is frame 6, 0.4 m away.

@@ -12,6 +12,10 @@
 namespace patrolmap::change {
 namespace {
 
+bool LexicographicLess(const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+  return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+}
+
 constexpr int kBits = 21;
 constexpr std::int64_t kOffset = 1 << 20;
 constexpr std::uint64_t kUsed = 1ull << 63;
@@ -460,10 +464,14 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
   std::vector<Eigen::Vector3i> changed;
   std::vector<Eigen::Vector3d> centres;
   std::vector<double> deltas;
+  std::vector<Eigen::Vector3i>& cells = change->compared_cells;
   const auto observed = [&options](const VoxelEvidence& v) { return v.hits + v.passes >= options.min_observations; };
   for_each_common([&](const VoxelEvidence& a, const VoxelEvidence& b) {
     if (!observed(a) || !observed(b)) return;
     ++change->compared_voxels;
+    const Eigen::Vector3i cell =
+        (Eigen::Vector3d(a.x, a.y, a.z) * (size / GeometryChange::kComparedCellM)).array().floor().cast<int>();
+    if (cells.empty() || cells.back() != cell) cells.push_back(cell);
     const double delta = Occupancy(b) - Occupancy(a);
     const bool one_free = std::min(Occupancy(a), Occupancy(b)) <= options.max_free_occupancy;
     if (std::max(Occupancy(a), Occupancy(b)) > options.max_free_occupancy + options.min_occupancy_change) {
@@ -484,6 +492,8 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     centres.push_back(index.cast<double>() * size);
     deltas.push_back(delta);
   });
+  std::sort(cells.begin(), cells.end(), LexicographicLess);
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
   change->differing_voxels = static_cast<long long>(changed.size());
   if (change->DifferingShare() > options.max_differing_share) {
     change->poses_disagree = true;  // surfaces a voxel or more apart everywhere: not changes, a pose error
@@ -520,10 +530,8 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
   }
   std::stable_sort(change->regions.begin(), change->regions.end(),
                    [](const GeometryRegion& x, const GeometryRegion& y) { return x.voxels > y.voxels; });
-  std::sort(members.begin(), members.end(), [&changed](std::size_t x, std::size_t y) {
-    return std::lexicographical_compare(changed[x].data(), changed[x].data() + 3, changed[y].data(),
-                                        changed[y].data() + 3);
-  });
+  std::sort(members.begin(), members.end(),
+            [&changed](std::size_t x, std::size_t y) { return LexicographicLess(changed[x], changed[y]); });
   for (std::size_t member : members) {
     change->changed_voxels.push_back(changed[member]);
     change->changed_deltas.push_back(static_cast<float>(deltas[member]));
@@ -531,6 +539,19 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
 }
 
 }  // namespace
+
+bool GeometryChange::ComparedNear(const Eigen::Vector3d& point) const {
+  const Eigen::Vector3i at = (point / kComparedCellM).array().floor().cast<int>();
+  for (int dx = -1; dx <= 1; ++dx)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dz = -1; dz <= 1; ++dz) {
+        if (std::binary_search(compared_cells.begin(), compared_cells.end(), at + Eigen::Vector3i(dx, dy, dz),
+                               LexicographicLess)) {
+          return true;
+        }
+      }
+  return false;
+}
 
 std::optional<int> GroundAround(const Eigen::Vector3i& low, const Eigen::Vector3i& high, double voxel, double ring_m,
                                 int above, const VoxelLookup& grid) {

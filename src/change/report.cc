@@ -358,6 +358,20 @@ std::string RouteChangeId(const RouteFrame& prior, const RouteFrame& current) {
   return "appearance-f" + std::to_string(prior.frame_index) + "-" + std::to_string(current.frame_index);
 }
 
+namespace {
+
+// ChangeItem::compared_in_3d.
+std::optional<bool> ComparedIn3d(const ChangeReport& report, const ChangeItem& item) {
+  if (!report.geometry_compared || report.geometry.poses_disagree) return std::nullopt;
+  for (const std::string& channel : item.channels) {
+    if (channel == "geometry" || channel == "geometry objects") return true;
+  }
+  if (!item.position) return std::nullopt;
+  return report.geometry.ComparedNear(*item.position) && (!item.from || report.geometry.ComparedNear(*item.from));
+}
+
+}  // namespace
+
 std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::TopoMap& map,
                                     const ReportOptions& options) {
   std::vector<ChangeItem> items;
@@ -384,7 +398,10 @@ std::vector<ChangeItem> ReportItems(const ChangeReport& report, const graph::Top
     if (repeat > 1) item.id += "-" + std::to_string(repeat);
   }
   items = FuseItems(std::move(items), options.fuse_distance_m);
-  for (std::size_t i = 0; i < items.size(); ++i) items[i].number = static_cast<int>(i) + 1;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    items[i].number = static_cast<int>(i) + 1;
+    items[i].compared_in_3d = ComparedIn3d(report, items[i]);
+  }
   return items;
 }
 

@@ -133,9 +133,12 @@ std::string SiteObject(const ChangeItem& item) {
 }
 
 // The channels that saw the change, in one line: each with how many findings it gave and the best one's confidence
-// (the findings themselves are in the row's tooltip and in changes.json).
+// (the findings themselves are in the row's tooltip and in changes.json); and whether its place was out of 3D reach.
 std::string SeenBy(const ChangeItem& item) {
-  if (item.evidence.empty()) return "";
+  const std::string unranged = item.compared_in_3d == false ? "<br><span class='seen'>not compared in 3D: no depth of "
+                                                              "one patrol or the other reached it</span>"
+                                                            : "";
+  if (item.evidence.empty()) return unranged;
   std::string text = "<br><span class='seen'>seen by " + graph::EscapeXml(item.channels.front());
   for (std::size_t c = 1; c < item.channels.size(); ++c) {
     int count = 0;
@@ -146,7 +149,7 @@ std::string SeenBy(const ChangeItem& item) {
     text += ", " + graph::EscapeXml(item.channels[c]) + (count > 1 ? " &#215;" + std::to_string(count) : "") + " (" +
             Number(best) + ")";
   }
-  return text + "</span>";
+  return text + "</span>" + unranged;
 }
 
 // The row's tooltip: its id and every finding fused into it.

@@ -181,6 +181,7 @@ json ChangeJson(const ChangeItem& item, const std::optional<GeoReference>& geo, 
                  {"longitude", nullptr},
                  {"channels", item.channels},
                  {"evidence", EvidenceJson(item)},
+                 {"compared_in_3d", item.compared_in_3d ? json(*item.compared_in_3d) : json(nullptr)},
                  {"before", ViewJson(item, true, images)},
                  {"after", ViewJson(item, false, images)}};
   if (geo && item.position) {

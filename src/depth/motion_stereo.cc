@@ -152,8 +152,25 @@ double FlightDepth::SigmaPerM2(double baseline_m) const {
   return stereo_.matching.disparity_sigma_px / (lens_.camera().fx * baseline_m);
 }
 
+int FlightDepth::DisparitiesFor(double baseline_m) const {
+  constexpr int kStep = 16, kMost = 512;  // SGBM's disparity ranges
+  const double needed = lens_.camera().fx * baseline_m / flight_.min_range_m;
+  return std::clamp(kStep * static_cast<int>(std::ceil(needed / kStep)), kStep, kMost);
+}
+
 double FlightDepth::NearestDepth(double baseline_m) const {
-  return lens_.camera().fx * baseline_m / stereo_.matching.num_disparities;
+  return lens_.camera().fx * baseline_m / DisparitiesFor(baseline_m);
+}
+
+const MotionFrame* FlightDepth::Partner(const CameraPoseSample& pose, double baseline_m) const {
+  const MotionFrame* best = nullptr;
+  double best_miss = std::numeric_limits<double>::infinity();
+  for (const MotionFrame& kept : kept_) {
+    if (!UsableBaseline(pose, kept.pose, stereo_)) continue;
+    const double miss = std::abs((kept.pose.position - pose.position).norm() - baseline_m);
+    if (miss < best_miss) best = &kept, best_miss = miss;
+  }
+  return best;
 }
 
 bool FlightDepth::Compute(const cv::Mat& image, const CameraPoseSample& pose, cv::Mat* depth_m, double* sigma_per_m2) {
@@ -162,16 +179,10 @@ bool FlightDepth::Compute(const cv::Mat& image, const CameraPoseSample& pose, cv
     spare_ = kept_.front().image;  // its buffer, reused by the next frame kept
     kept_.erase(kept_.begin());
   }
-  const MotionFrame* best = nullptr;
-  double best_miss = std::numeric_limits<double>::infinity();
-  for (const MotionFrame& kept : kept_) {
-    if (!UsableBaseline(pose, kept.pose, stereo_)) continue;
-    const double miss = std::abs((kept.pose.position - pose.position).norm() - flight_.baseline_m);
-    if (miss < best_miss) best = &kept, best_miss = miss;
-  }
   depth_m->release();
-  if (best != nullptr) {
-    partner_.assign(1, *best);
+  if (const MotionFrame* partner = Partner(pose, flight_.baseline_m)) {
+    stereo_.matching.num_disparities = DisparitiesFor((partner->pose.position - pose.position).norm());
+    partner_.assign(1, *partner);
     *depth_m = MotionDepth(image, pose, partner_, lens_, stereo_, sigma_per_m2);
     partner_.clear();
   }

@@ -54,6 +54,7 @@ bool FlightDepthOptions::IsValid(std::string* error) const {
       .Holds("depth.flight.baseline_m", baseline_m, baseline_m >= min_baseline_m,
              "must be at least depth.flight.min_baseline_m")
       .InRange("depth.flight.min_sideways_share", min_sideways_share, 0.0, 1.0)
+      .AboveAtMost("depth.flight.min_range_m", min_range_m, 0.0, 1000.0)
       .AboveAtMost("depth.flight.history_s", history_s, 0.0, 60.0);
   return check.ok();
 }

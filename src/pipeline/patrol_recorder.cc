@@ -42,9 +42,10 @@ void SayFlightReach(const std::string& path, const depth::FlightDepth& flight, c
   const double marked = std::min(std::sqrt(grid.max_hit_sigma_m / flight.SigmaPerM2(baseline)), grid.max_range_m);
   spdlog::info(
       "{}: depth from the flight's own frames, each matched with an earlier one about {:.2f} m away across the optical "
-      "axis (depth.flight.baseline_m): nothing nearer than {:.1f} m is matched (depth.stereo.num_disparities {}); "
-      "surfaces are marked within {:.1f} m",
-      path, baseline, flight.NearestDepth(baseline), config.depth.stereo.num_disparities, marked);
+      "axis (depth.flight.baseline_m): nothing nearer than {:.1f} m is matched ({} disparities, "
+      "depth.flight.min_range_m {}); surfaces are marked within {:.1f} m",
+      path, baseline, flight.NearestDepth(baseline), flight.DisparitiesFor(baseline), config.depth.flight.min_range_m,
+      marked);
 }
 
 }  // namespace

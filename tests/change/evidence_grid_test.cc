@@ -251,6 +251,14 @@ TEST(GeometryChange, AppearedCubeIsOneRegionAndUnobservedSpaceIsNoChange) {
   EXPECT_NEAR(change.regions[0].centroid.z(), 0.4, 1e-9);
   EXPECT_EQ(change.changed_voxels.size(), 48u);
   EXPECT_EQ(change.compared_voxels, 48 + 10 + 1);
+  // Compared: at the box, at the wall (x = 4 m), beside the outlier (12 m); not where either patrol saw too little
+  // (8 m, 10 m), nor far from everything.
+  EXPECT_TRUE(change.ComparedNear({0.3, 0.3, 0.4}));
+  EXPECT_TRUE(change.ComparedNear({4.0, 1.0, 0.2}));
+  EXPECT_TRUE(change.ComparedNear({12.5, 0.5, 0.2}));
+  EXPECT_FALSE(change.ComparedNear({8.0, 0.0, 0.2}));
+  EXPECT_FALSE(change.ComparedNear({10.0, 0.0, 0.2}));
+  EXPECT_FALSE(change.ComparedNear({-30.0, 40.0, 0.2}));
 }
 
 // A facade's edge seen from another angle: its voxels vanish at some heights and appear at others, all in one vertical

@@ -94,6 +94,21 @@ TEST(ReportItems, ANewObjectIsShownFromBothPatrolsBestFrames) {
   EXPECT_GT(RedPixels(item.after.image), 50);  // the box is outlined
 }
 
+// Whether the geometry was compared where the crate stands: unknown when no grids were compared, false when they were
+// but no compared voxel lies there (no depth reached it), true when one does.
+TEST(ReportItems, SaysWhetherTheGeometryWasComparedWhereAChangeStands) {
+  Scene scene = NewCrate();
+  EXPECT_FALSE(ReportItems(scene.report, scene.map)[0].compared_in_3d.has_value());
+  scene.report.geometry_compared = true;
+  scene.report.geometry.compared_cells = {{3, 0, 0}};  // 3-4 m along x: two cells short of the crate
+  EXPECT_EQ(ReportItems(scene.report, scene.map)[0].compared_in_3d, std::optional<bool>(false));
+  EXPECT_NE(ToHtml(scene.report, scene.map, ReportItems(scene.report, scene.map), std::nullopt, "")
+                .find("not compared in 3D"),
+            std::string::npos);
+  scene.report.geometry.compared_cells = {{9, -1, -1}};  // beside the crate's cell (10, 0, 0)
+  EXPECT_EQ(ReportItems(scene.report, scene.map)[0].compared_in_3d, std::optional<bool>(true));
+}
+
 // A voxel the current patrol found occupied between the first frame and the crate: the other frame shows it.
 TEST(ReportItems, AFrameWhoseViewTheGridBlocksIsPassedOver) {
   Scene scene = NewCrate();

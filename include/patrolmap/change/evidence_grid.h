@@ -121,6 +121,13 @@ struct GeometryChange {
   std::vector<Eigen::Vector3i> changed_voxels;  // of the reported regions, sorted
   std::vector<float> changed_deltas;            // ... and each one's occupancy now minus before (> 0: appeared)
   std::vector<GeometryRegion> regions;          // largest first
+  // Where the grids were compared: the cells of kComparedCellM a side (world index floor(x / kComparedCellM)) holding
+  // a compared voxel, sorted. A change another channel found outside them was not compared in 3D: no depth of one
+  // patrol or the other reached it (a rig's or the flight's range), so "no geometry change" says nothing there.
+  static constexpr double kComparedCellM = 1.0;
+  std::vector<Eigen::Vector3i> compared_cells;
+  // Whether a compared cell lies at `point` or beside it (its 26 neighbours).
+  bool ComparedNear(const Eigen::Vector3d& point) const;
 };
 
 // Whether two patrols whose camera poses came from `prior_source` and `current_source` (PatrolRecord::pose_source)

@@ -120,6 +120,10 @@ struct ChangeItem {
   // findings of the others fused into it.
   std::vector<std::string> channels;
   std::vector<ChangeEvidence> evidence;
+  // Whether the two patrols' geometry was compared where it is (GeometryChange::ComparedNear, at each end of a move):
+  // false when no depth of one patrol or the other reached it, so the geometry channel could not have seen it; none
+  // when the geometry was not compared at all, or for a bearing.
+  std::optional<bool> compared_in_3d;
   ReportSource source;
   ChangeView before, after;
 };

@@ -62,7 +62,7 @@ cv::Mat MotionDepth(const cv::Mat& image, const CameraPoseSample& pose, const st
 // (f b)). Only past frames are used, so it runs while flying; its buffers are reused from frame to frame.
 class FlightDepth {
  public:
-  // Pairs matched with `matching` (depth.stereo's options).
+  // Pairs matched with `matching` (depth.stereo's options) over the disparity range DisparitiesFor() their baseline.
   FlightDepth(const Lens& lens, const FlightDepthOptions& flight, const StereoOptions& matching);
 
   // Depth of `image` (grey, the lens's size) seen from `pose` into `depth_m` (the undistorted grid, 0 = unknown) and
@@ -71,7 +71,9 @@ class FlightDepth {
   bool Compute(const cv::Mat& image, const CameraPoseSample& pose, cv::Mat* depth_m, double* sigma_per_m2);
   // The range error per squared metre of a pair `baseline_m` apart.
   double SigmaPerM2(double baseline_m) const;
-  // The nearest depth [m] a pair `baseline_m` apart matches: f * b / num_disparities.
+  // The disparity range [px] a pair `baseline_m` apart is searched over: f * b / min_range_m, a multiple of 16.
+  int DisparitiesFor(double baseline_m) const;
+  // The nearest depth [m] it matches: f * b / DisparitiesFor(b) (min_range_m, or a little nearer).
   double NearestDepth(double baseline_m) const;
 
  private:
@@ -80,6 +82,9 @@ class FlightDepth {
   MotionStereoOptions stereo_;
   std::vector<MotionFrame> kept_;  // oldest first; images reused when dropped
   std::vector<MotionFrame> partner_;
+  // The kept frame usable with `pose` whose distance comes nearest `baseline_m`; null when none.
+  const MotionFrame* Partner(const CameraPoseSample& pose, double baseline_m) const;
+
   cv::Mat spare_;  // the image of the last frame dropped, its buffer reused
 };
 

@@ -65,10 +65,13 @@ struct StereoOptions {
 // farther surfaces, at the cost of nearer ones (nothing nearer than f * b / num_disparities is matched) and of views
 // that differ more. Needs camera poses from a state estimate: GPS fixes are metres off.
 struct FlightDepthOptions {
-  double baseline_m = 1.0;          // the baseline sought [m]
+  double baseline_m = 2.0;          // the baseline sought [m]
   double min_baseline_m = 0.3;      // no earlier frame nearer than this is matched [m]
   double min_sideways_share = 0.7;  // ... nor one whose baseline runs less than this share across the optical axis
-  double history_s = 3.0;           // earlier frames are kept this long [s]
+  // Each pair's disparity range reaches this near: f * baseline / min_range_m pixels (a multiple of 16, at most 512),
+  // so a longer baseline is searched wider instead of matching near surfaces beyond its range wrongly [m].
+  double min_range_m = 3.5;
+  double history_s = 3.0;  // earlier frames are kept this long [s]
   bool IsValid(std::string* error) const;
 };
 

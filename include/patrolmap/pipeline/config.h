@@ -230,6 +230,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("depth.flight.baseline_m", &depth.flight.baseline_m);
   visitor->Field("depth.flight.min_baseline_m", &depth.flight.min_baseline_m);
   visitor->Field("depth.flight.min_sideways_share", &depth.flight.min_sideways_share);
+  visitor->Field("depth.flight.min_range_m", &depth.flight.min_range_m);
   visitor->Field("depth.flight.history_s", &depth.flight.history_s);
   visitor->Field("map.whole_patrols", &config->map.whole_patrols);
   visitor->Field("map.archive_frame_interval_s", &config->map.archive_frame_interval_s);
