@@ -93,6 +93,14 @@ void LogRecord(const FlightResult& flight) {
                      ? " (" + std::to_string(stats.stereo_pairs) + " stereo pairs matched, with the object map's)"
                      : std::string());
   }
+  if (record.depth_source == kDepthFromFlight && stats.unpaired_frames > 0) {
+    spdlog::info(
+        "{}: depth from the flight: {} frames matched, {} without an earlier frame at least "
+        "depth.flight.min_baseline_m "
+        "away across the optical axis within depth.flight.history_s (the start, hovering, turning, or a camera "
+        "looking along the flight)",
+        record.flight, stats.flight_pairs, stats.unpaired_frames);
+  }
 }
 
 // The plot's truth (when the log has it) and each key location's node id in nodes.csv.
