@@ -182,9 +182,7 @@ bool FlightDepth::Compute(const cv::Mat& image, const CameraPoseSample& pose, cv
   depth_m->release();
   if (const MotionFrame* partner = Partner(pose, flight_.baseline_m)) {
     stereo_.matching.num_disparities = DisparitiesFor((partner->pose.position - pose.position).norm());
-    partner_.assign(1, *partner);
-    *depth_m = MotionDepth(image, pose, partner_, lens_, stereo_, sigma_per_m2);
-    partner_.clear();
+    *depth_m = PairDepth(image, *partner, lens_, pose, stereo_, sigma_per_m2);
   }
   MotionFrame kept{spare_, pose};
   spare_.release();

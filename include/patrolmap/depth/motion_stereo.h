@@ -81,7 +81,6 @@ class FlightDepth {
   FlightDepthOptions flight_;
   MotionStereoOptions stereo_;
   std::vector<MotionFrame> kept_;  // oldest first; images reused when dropped
-  std::vector<MotionFrame> partner_;
   // The kept frame usable with `pose` whose distance comes nearest `baseline_m`; null when none.
   const MotionFrame* Partner(const CameraPoseSample& pose, double baseline_m) const;
 
