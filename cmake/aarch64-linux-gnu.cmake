@@ -25,6 +25,9 @@ set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 set(ENV{PKG_CONFIG_LIBDIR}
     "${PATROLMAP_ARM64_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${PATROLMAP_ARM64_SYSROOT}/usr/share/pkgconfig")
 set(ENV{PKG_CONFIG_SYSROOT_DIR} "${PATROLMAP_ARM64_SYSROOT}")
+# GCC notes on every std::pair<double, double> passed by value that its arm64 ABI changed in GCC 10.1; everything
+# here is built by one compiler.
+set(CMAKE_CXX_FLAGS_INIT "-Wno-psabi")
 # The libraries' own dependencies (e.g. OpenCV's GDAL, Ceres's glog) are found in the sysroot at link time.
 set(CMAKE_EXE_LINKER_FLAGS_INIT
     "-Wl,-rpath-link,${PATROLMAP_ARM64_SYSROOT}/usr/lib/aarch64-linux-gnu:${PATROLMAP_ARM64_SYSROOT}/lib/aarch64-linux-gnu")

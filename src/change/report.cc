@@ -155,8 +155,8 @@ cv::Mat OutlinedFrame(const cv::Mat& frame, int reference_width, const std::vect
 }
 
 // The node's key frame with the regions outlined: the kept frame of the same frame index, else the thumbnail.
-ChangeView KeyFrameView(const graph::TopoMap& map, int node, const std::vector<cv::Rect>& boxes,
-                        const ReportOptions& options) {
+ChangeView KeyFramePicture(const graph::TopoMap& map, int node, const std::vector<cv::Rect>& boxes,
+                           const ReportOptions& options) {
   const KeyFrameNode& n = map.node(node);
   ChangeView view{n.flight, n.timestamp_ns, n.frame_index, cv::Mat()};
   cv::Mat frame;
@@ -281,8 +281,8 @@ ChangeItem AppearanceItem(const graph::TopoMap& map, const PlaceChange& place, c
     prior_boxes.push_back(r.prior_box);
     current_boxes.push_back(r.current_box);
   }
-  item.before = KeyFrameView(map, place.prior_node, prior_boxes, options);
-  item.after = KeyFrameView(map, place.current_node, current_boxes, options);
+  item.before = KeyFramePicture(map, place.prior_node, prior_boxes, options);
+  item.after = KeyFramePicture(map, place.current_node, current_boxes, options);
   return item;
 }
 

@@ -16,16 +16,10 @@
 namespace patrolmap::change {
 namespace {
 
-std::string Number(double value, int decimals = 2) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  return buffer;
-}
-
 // When a patrol was flown: a date for log times that are Unix times (after 1973), else the log's own seconds.
 std::string FlownAt(TimestampNs ns) {
   constexpr TimestampNs kUnixTimesFrom = 100000000LL * 1000000000LL;
-  if (ns < kUnixTimesFrom) return "at " + Number(NsToSeconds(ns), 1) + " s of its log";
+  if (ns < kUnixTimesFrom) return "at " + Fixed(NsToSeconds(ns), 1) + " s of its log";
   const std::time_t seconds = static_cast<std::time_t>(ns / 1000000000LL);
   std::tm utc{};
   gmtime_r(&seconds, &utc);
@@ -91,18 +85,18 @@ std::string Where(const ChangeItem& item, const std::optional<GeoReference>& geo
   if (!item.position && item.bearing) {
     const Eigen::Vector3d& o = item.bearing->origin;
     const double heading = std::atan2(item.bearing->direction.x(), item.bearing->direction.y()) * 180.0 / M_PI;
-    return "<span class='none'>on a bearing, no depth:</span> within " + Number(item.bearing_range_m, 0) +
-           " m of the camera at " + Number(o.x(), 1) + ", " + Number(o.y(), 1) + ", " + Number(o.z(), 1) +
-           " m, heading " + Number(std::fmod(heading + 360.0, 360.0), 0) + "&#176; (from +y, clockwise)";
+    return "<span class='none'>on a bearing, no depth:</span> within " + Fixed(item.bearing_range_m, 0) +
+           " m of the camera at " + Fixed(o.x(), 1) + ", " + Fixed(o.y(), 1) + ", " + Fixed(o.z(), 1) + " m, heading " +
+           Fixed(std::fmod(heading + 360.0, 360.0), 0) + "&#176; (from +y, clockwise)";
   }
   if (!item.position) return "<span class='none'>no pose</span>";
   const Eigen::Vector3d& p = *item.position;
-  std::string where = Number(p.x(), 1) + ", " + Number(p.y(), 1) + ", " + Number(p.z(), 1) + " m";
+  std::string where = Fixed(p.x(), 1) + ", " + Fixed(p.y(), 1) + ", " + Fixed(p.z(), 1) + " m";
   if (geo) {
     const Eigen::Vector2d ll = geo->LatitudeLongitude(p);
-    where += "<br>" + Number(ll.x(), 6) + "&#176;, " + Number(ll.y(), 6) + "&#176;";
+    where += "<br>" + Fixed(ll.x(), 6) + "&#176;, " + Fixed(ll.y(), 6) + "&#176;";
   }
-  if (item.from) where += "<br>moved " + Number((p - *item.from).head<2>().norm(), 1) + " m";
+  if (item.from) where += "<br>moved " + Fixed((p - *item.from).head<2>().norm(), 1) + " m";
   return where;
 }
 
@@ -121,7 +115,7 @@ std::string Figure(const ChangeItem& item, bool before, const std::string& image
   std::ostringstream out;
   out << "<figure><img loading='lazy' alt='" << word << "' " << source << " width='" << view.image.cols << "' height='"
       << view.image.rows << "'><figcaption>" << word << ": " << graph::EscapeXml(view.flight) << ", "
-      << Number(NsToSeconds(view.timestamp_ns), 1) << " s, frame " << view.frame_index << "</figcaption></figure>";
+      << Fixed(NsToSeconds(view.timestamp_ns), 1) << " s, frame " << view.frame_index << "</figcaption></figure>";
   return out.str();
 }
 
@@ -147,7 +141,7 @@ std::string SeenBy(const ChangeItem& item) {
       if (e.channel == item.channels[c]) ++count, best = std::max(best, e.confidence);
     }
     text += ", " + graph::EscapeXml(item.channels[c]) + (count > 1 ? " &#215;" + std::to_string(count) : "") + " (" +
-            Number(best) + ")";
+            Fixed(best, 2) + ")";
   }
   return text + "</span>" + unranged;
 }
@@ -156,7 +150,7 @@ std::string SeenBy(const ChangeItem& item) {
 std::string RowTitle(const ChangeItem& item) {
   std::string title = item.id;
   for (const ChangeEvidence& e : item.evidence) {
-    title += "\n" + e.id + ": " + e.kind + " " + e.state + ", " + e.label + " (" + Number(e.confidence) + ")";
+    title += "\n" + e.id + ": " + e.kind + " " + e.state + ", " + e.label + " (" + Fixed(e.confidence, 2) + ")";
   }
   return graph::EscapeXml(title);
 }
@@ -174,7 +168,7 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
           << RowTitle(item) << "'><td><span class='badge' style='background:" << ChangeColour(item) << "'>"
           << item.number << "</span></td><td><b>" << graph::EscapeXml(item.kind) << " " << graph::EscapeXml(item.state)
           << "</b>: " << graph::EscapeXml(item.label) << SiteObject(item) << SeenBy(item) << "</td><td>"
-          << Number(item.confidence) << "</td><td>" << Where(item, geo) << "</td><td>" << Figure(item, true, images)
+          << Fixed(item.confidence, 2) << "</td><td>" << Where(item, geo) << "</td><td>" << Figure(item, true, images)
           << "</td><td>" << Figure(item, false, images) << "</td></tr>\n";
   }
   *html << "</table>\n";
@@ -184,15 +178,15 @@ void ChangeRows(const std::vector<ChangeItem>& items, const std::optional<GeoRef
 // Why a class-agnostic object (a cluster of changed voxels) has its state.
 std::string GeometryReason(const ObjectChange& o) {
   const auto voxels = [](const Eigen::AlignedBox3d& box) {
-    return Number(box.sizes().x(), 1) + " x " + Number(box.sizes().y(), 1) + " m";
+    return Fixed(box.sizes().x(), 1) + " x " + Fixed(box.sizes().y(), 1) + " m";
   };
   switch (o.state) {
     case ObjectState::kNew: return "space free before is occupied now, over " + voxels(o.box_after) + " (no detector)";
     case ObjectState::kRemoved:
       return "space occupied before is seen free now, over " + voxels(o.box_before) + " (no detector)";
     case ObjectState::kMoved:
-      return "space freed and space filled alike in shape, " + Number((*o.after - *o.before).head<2>().norm(), 1) +
-             " m apart, turned " + Number(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) +
+      return "space freed and space filled alike in shape, " + Fixed((*o.after - *o.before).head<2>().norm(), 1) +
+             " m apart, turned " + Fixed(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) +
              "&#176; (no detector)";
     default: return "";
   }
@@ -204,27 +198,27 @@ std::string Reason(const ObjectChange& o) {
     case ObjectState::kPersistent: return "seen in both patrols at the same place";
     case ObjectState::kNew: return "not in the prior patrol's map there";
     case ObjectState::kMoved:
-      return "moved " + Number((*o.after - *o.before).head<2>().norm(), 1) + " m, turned " +
-             Number(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) + "&#176;";
+      return "moved " + Fixed((*o.after - *o.before).head<2>().norm(), 1) + " m, turned " +
+             Fixed(std::atan2(o.rotation(1, 0), o.rotation(0, 0)) * 180.0 / M_PI, 0) + "&#176;";
     case ObjectState::kRemoved:
       return Counted(o.covering_views, "view", "views") + " of this patrol covered it (about " +
-             Number(o.expected_detections, 1) + " detections expected); none found it";
+             Fixed(o.expected_detections, 1) + " detections expected); none found it";
     case ObjectState::kUnobserved:
       return "this patrol did not look at it closely enough to tell (" + Counted(o.covering_views, "view", "views") +
-             ", about " + Number(o.expected_detections, 1) + " detections expected)";
+             ", about " + Fixed(o.expected_detections, 1) + " detections expected)";
   }
   return "";
 }
 
 void ObjectTable(const ChangeReport& report, std::ostringstream* html) {
   const auto position = [](const std::optional<Eigen::Vector3d>& p) {
-    return p ? Number(p->x(), 1) + ", " + Number(p->y(), 1) + ", " + Number(p->z(), 1) : std::string("&ndash;");
+    return p ? Fixed(p->x(), 1) + ", " + Fixed(p->y(), 1) + ", " + Fixed(p->z(), 1) : std::string("&ndash;");
   };
   *html << "<section class='more'><h2>All objects</h2><table><tr><th>state</th><th>label</th><th>confidence</th>"
            "<th>before [m]</th><th>after [m]</th><th>why</th></tr>\n";
   for (const ObjectChange& o : report.objects) {
     *html << "<tr><td>" << ToString(o.state) << "</td><td>" << graph::EscapeXml(o.label) << "</td><td>"
-          << Number(o.confidence) << "</td><td>" << position(o.before) << "</td><td>" << position(o.after)
+          << Fixed(o.confidence, 2) << "</td><td>" << position(o.before) << "</td><td>" << position(o.after)
           << "</td><td>" << Reason(o) << "</td></tr>\n";
   }
   *html << "</table></section>\n";
@@ -234,7 +228,7 @@ void ObjectTable(const ChangeReport& report, std::ostringstream* html) {
 void SiteObjectTimelines(const ChangeReport& report, std::ostringstream* html) {
   if (report.site_objects.empty()) return;
   const auto where = [](const std::optional<Eigen::Vector3d>& p) {
-    return p ? "(" + Number(p->x(), 1) + ", " + Number(p->y(), 1) + ")" : std::string();
+    return p ? "(" + Fixed(p->x(), 1) + ", " + Fixed(p->y(), 1) + ")" : std::string();
   };
   *html << "<section class='more'><h2>Site objects</h2><p>Each object keeps its id across the map's patrols "
            "(<code>patrolmap history</code>).</p>\n";
@@ -275,7 +269,7 @@ void Summary(const ChangeReport& report, const std::vector<ChangeItem>& items, s
   if (report.route.compared) {
     *html << " Along the route: " << report.route.pairs.size() << " of "
           << Counted(report.route.current_frames, "frame", "frames") << " compared ("
-          << Number(100.0 * report.route.ComparedShare(), 0) << " %), "
+          << Fixed(100.0 * report.route.ComparedShare(), 0) << " %), "
           << Counted(static_cast<long long>(report.route.changes.size()), "appearance change", "appearance changes")
           << ".";
     if (report.route.current_depth_frames > 0) {
@@ -333,7 +327,7 @@ void Legend(const std::optional<GeoReference>& geo, std::ostringstream* html) {
   *html << "<span>&#9472; this flight</span><span>- - - prior flight</span><span style='color:#2563eb'>&#9671; "
            "place both saw</span>";
   if (geo) {
-    *html << "<span>grid: latitude and longitude (GPS fit of " << geo->fixes << " fixes, " << Number(geo->rms_m, 1)
+    *html << "<span>grid: latitude and longitude (GPS fit of " << geo->fixes << " fixes, " << Fixed(geo->rms_m, 1)
           << " m rms)</span>";
   }
   *html << "</div>\n";

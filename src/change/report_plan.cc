@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "patrolmap/core/words.h"
 #include "patrolmap/graph/export.h"
 
 namespace patrolmap::change {
@@ -15,12 +16,6 @@ constexpr double kPad = 30.0;           // around the drawing
 constexpr double kMarginM = 4.0;        // world margin around what is drawn [m]
 constexpr double kMarkerRadius = 13.0;  // a numbered marker's circle
 constexpr double kMarkerGap = 3.0;      // at least this between two markers' circles
-
-std::string Number(double value, int decimals = 1) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
-  return buffer;
-}
 
 // 1, 2 or 5 times a power of ten, at most `limit`.
 double NiceStep(double limit) {
@@ -49,7 +44,7 @@ class PlanFrame {
   }
   std::string Point(const Eigen::Vector3d& world) const {
     const Eigen::Vector2d p = (*this)(world.head<2>());
-    return Number(p.x()) + "," + Number(p.y());
+    return Fixed(p.x(), 1) + "," + Fixed(p.y(), 1);
   }
   double scale() const { return scale_; }  // SVG units per metre
   double height() const { return height_; }
@@ -72,9 +67,9 @@ void Path(const PatrolRecord* record, const PlanFrame& frame, const char* style,
 void ScaleBar(const PlanFrame& frame, std::ostringstream* svg) {
   const double metres = NiceStep(frame.width_m() / 4.0);
   const double length = metres * frame.scale(), y = frame.height() - 12.0;
-  *svg << "<g class='scale'><line x1='" << kPad << "' y1='" << y << "' x2='" << Number(kPad + length) << "' y2='" << y
-       << "' stroke='#111' stroke-width='3'/><text x='" << Number(kPad + length + 6) << "' y='" << y + 4
-       << "' font-size='12'>" << Number(metres, metres < 1 ? 1 : 0) << " m</text></g>\n";
+  *svg << "<g class='scale'><line x1='" << kPad << "' y1='" << y << "' x2='" << Fixed(kPad + length, 1) << "' y2='" << y
+       << "' stroke='#111' stroke-width='3'/><text x='" << Fixed(kPad + length + 6, 1) << "' y='" << y + 4
+       << "' font-size='12'>" << Fixed(metres, metres < 1 ? 1 : 0) << " m</text></g>\n";
 }
 
 void NorthArrow(const PlanFrame& frame, std::ostringstream* svg) {
@@ -101,9 +96,9 @@ void Graticule(const PlanFrame& frame, const GeoReference& geo, const std::vecto
       Eigen::Vector2d a = low, b = high;
       a[axis] = b[axis] = v;
       const Eigen::Vector2d p = frame(geo.WorldOf(a)), q = frame(geo.WorldOf(b));
-      *svg << "<line x1='" << Number(p.x()) << "' y1='" << Number(p.y()) << "' x2='" << Number(q.x()) << "' y2='"
-           << Number(q.y()) << "'/><text stroke='none' x='" << Number(p.x() + 3) << "' y='" << Number(p.y() - 3) << "'>"
-           << Number(v, decimals) << (axis == 0 ? "&#176;N" : "&#176;E") << "</text>\n";
+      *svg << "<line x1='" << Fixed(p.x(), 1) << "' y1='" << Fixed(p.y(), 1) << "' x2='" << Fixed(q.x(), 1) << "' y2='"
+           << Fixed(q.y(), 1) << "'/><text stroke='none' x='" << Fixed(p.x() + 3, 1) << "' y='" << Fixed(p.y() - 3, 1)
+           << "'>" << Fixed(v, decimals) << (axis == 0 ? "&#176;N" : "&#176;E") << "</text>\n";
     }
   }
   *svg << "</g>\n";
@@ -120,8 +115,8 @@ void Places(const ChangeReport& report, const graph::TopoMap& map, const PlanFra
                                          return std::llabs(a.timestamp_ns - t) < std::llabs(b.timestamp_ns - t);
                                        });
     const Eigen::Vector2d p = frame(view->position.head<2>());
-    *svg << "<rect class='place' x='" << Number(p.x() - 5) << "' y='" << Number(p.y() - 5)
-         << "' width='10' height='10' transform='rotate(45 " << Number(p.x()) << " " << Number(p.y())
+    *svg << "<rect class='place' x='" << Fixed(p.x() - 5, 1) << "' y='" << Fixed(p.y() - 5, 1)
+         << "' width='10' height='10' transform='rotate(45 " << Fixed(p.x(), 1) << " " << Fixed(p.y(), 1)
          << ")' fill='white' stroke='#2563eb' stroke-width='2'><title>place seen by both flights: node "
          << place.prior_node << " and node " << place.current_node << "</title></rect>\n";
   }
@@ -157,22 +152,22 @@ class MarkerLayout {
 // A leader from a change's place to its marker, when the marker had to move.
 void Leader(const Eigen::Vector2d& at, const Eigen::Vector2d& marker, const ChangeItem& item, std::ostringstream* svg) {
   if ((marker - at).norm() < 1e-9) return;
-  *svg << "<line x1='" << Number(at.x()) << "' y1='" << Number(at.y()) << "' x2='" << Number(marker.x()) << "' y2='"
-       << Number(marker.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='1.5'/><circle cx='"
-       << Number(at.x()) << "' cy='" << Number(at.y()) << "' r='3' fill='" << ChangeColour(item) << "'/>\n";
+  *svg << "<line x1='" << Fixed(at.x(), 1) << "' y1='" << Fixed(at.y(), 1) << "' x2='" << Fixed(marker.x(), 1)
+       << "' y2='" << Fixed(marker.y(), 1) << "' stroke='" << ChangeColour(item) << "' stroke-width='1.5'/><circle cx='"
+       << Fixed(at.x(), 1) << "' cy='" << Fixed(at.y(), 1) << "' r='3' fill='" << ChangeColour(item) << "'/>\n";
 }
 
 // A change placed by a bearing only: the ray from the camera it lies on, dashed, its number at the far end.
 void BearingMarker(const ChangeItem& item, const PlanFrame& frame, MarkerLayout* layout, std::ostringstream* svg) {
   const Eigen::Vector2d o = frame(item.bearing->origin.head<2>()), end = frame(BearingEnd(item).head<2>());
   const Eigen::Vector2d e = layout->Place(end);
-  *svg << "<g class='marker bearing' data-id='" << graph::EscapeXml(item.id) << "'><line x1='" << Number(o.x())
-       << "' y1='" << Number(o.y()) << "' x2='" << Number(end.x()) << "' y2='" << Number(end.y()) << "' stroke='"
+  *svg << "<g class='marker bearing' data-id='" << graph::EscapeXml(item.id) << "'><line x1='" << Fixed(o.x(), 1)
+       << "' y1='" << Fixed(o.y(), 1) << "' x2='" << Fixed(end.x(), 1) << "' y2='" << Fixed(end.y(), 1) << "' stroke='"
        << ChangeColour(item) << "' stroke-width='2' stroke-dasharray='6 4'/>";
   Leader(end, e, item, svg);
-  *svg << "<circle cx='" << Number(e.x()) << "' cy='" << Number(e.y()) << "' r='" << kMarkerRadius
-       << "' fill='white' stroke='" << ChangeColour(item) << "' stroke-width='2'/><text x='" << Number(e.x()) << "' y='"
-       << Number(e.y() + 5) << "' text-anchor='middle' font-size='14' fill='" << ChangeColour(item)
+  *svg << "<circle cx='" << Fixed(e.x(), 1) << "' cy='" << Fixed(e.y(), 1) << "' r='" << kMarkerRadius
+       << "' fill='white' stroke='" << ChangeColour(item) << "' stroke-width='2'/><text x='" << Fixed(e.x(), 1)
+       << "' y='" << Fixed(e.y() + 5, 1) << "' text-anchor='middle' font-size='14' fill='" << ChangeColour(item)
        << "' font-weight='bold'>" << item.number << "</text><title>" << item.number << ": "
        << graph::EscapeXml(item.kind + " " + item.state)
        << ", somewhere along this bearing from the camera (no depth there)</title></g>\n";
@@ -182,13 +177,13 @@ void Marker(const ChangeItem& item, const PlanFrame& frame, MarkerLayout* layout
   const Eigen::Vector2d at = frame(item.position->head<2>());
   if (item.from) {
     const Eigen::Vector2d q = frame(item.from->head<2>());
-    *svg << "<line x1='" << Number(q.x()) << "' y1='" << Number(q.y()) << "' x2='" << Number(at.x()) << "' y2='"
-         << Number(at.y()) << "' stroke='" << ChangeColour(item) << "' stroke-width='2' marker-end='url(#arrow)'/>\n";
+    *svg << "<line x1='" << Fixed(q.x(), 1) << "' y1='" << Fixed(q.y(), 1) << "' x2='" << Fixed(at.x(), 1) << "' y2='"
+         << Fixed(at.y(), 1) << "' stroke='" << ChangeColour(item) << "' stroke-width='2' marker-end='url(#arrow)'/>\n";
   }
   const Eigen::Vector2d p = layout->Place(at);
   Leader(at, p, item, svg);
-  *svg << "<g class='marker' data-id='" << graph::EscapeXml(item.id) << "' transform='translate(" << Number(p.x())
-       << " " << Number(p.y()) << ")'><circle r='" << kMarkerRadius << "' fill='" << ChangeColour(item)
+  *svg << "<g class='marker' data-id='" << graph::EscapeXml(item.id) << "' transform='translate(" << Fixed(p.x(), 1)
+       << " " << Fixed(p.y(), 1) << ")'><circle r='" << kMarkerRadius << "' fill='" << ChangeColour(item)
        << "' stroke='white' stroke-width='2'/><text text-anchor='middle' dy='5' font-size='14' fill='white' "
           "font-weight='bold'>"
        << item.number << "</text><title>" << item.number << ": " << graph::EscapeXml(item.kind + " " + item.state)
@@ -222,7 +217,7 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
   if (points.empty()) return "";
   const PlanFrame frame(points, geo);
   std::ostringstream svg;
-  svg << "<svg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 " << kWidth << " " << Number(frame.height(), 0)
+  svg << "<svg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 " << kWidth << " " << Fixed(frame.height(), 0)
       << "' font-family='sans-serif'>\n<defs><marker id='arrow' viewBox='0 0 10 10' refX='9' refY='5' "
          "markerWidth='6' markerHeight='6' orient='auto-start-reverse'><path d='M0,0 L10,5 L0,10 z' "
          "fill='#444'/></marker></defs>\n<rect width='100%' height='100%' fill='#fbfbfa'/>\n";
@@ -231,8 +226,8 @@ std::string PlanSvg(const ChangeReport& report, const graph::TopoMap& map, const
   Path(current, frame, "stroke='#374151' stroke-width='2'", &svg);
   for (const GeometryRegion& r : report.geometry.regions) {
     const Eigen::Vector2d a = frame(r.box_min.head<2>()), b = frame(r.box_max.head<2>());
-    svg << "<rect x='" << Number(std::min(a.x(), b.x())) << "' y='" << Number(std::min(a.y(), b.y())) << "' width='"
-        << Number(std::abs(b.x() - a.x()) + 2) << "' height='" << Number(std::abs(b.y() - a.y()) + 2)
+    svg << "<rect x='" << Fixed(std::min(a.x(), b.x()), 1) << "' y='" << Fixed(std::min(a.y(), b.y()), 1) << "' width='"
+        << Fixed(std::abs(b.x() - a.x()) + 2, 1) << "' height='" << Fixed(std::abs(b.y() - a.y()) + 2, 1)
         << "' fill='#7c3aed22' stroke='#7c3aed' stroke-dasharray='4 2'/>\n";
   }
   Places(report, map, frame, &svg);

@@ -15,6 +15,10 @@ namespace patrolmap::graph {
 // A double with 17 significant digits (enough to read back the same value).
 std::string Precise(double value);
 
+// Each flight's colour in the map's pictures (by its index in map.Flights(), modulo 5); clear of the verdict
+// colours (green, red, blue).
+inline constexpr const char* kFlightColours[] = {"#374151", "#d97706", "#7c3aed", "#0f766e", "#a16207"};
+
 // Each flight's GPS track as latitude, longitude [deg], in the order of map.Flights(): the fixes of its kept
 // route frames (PatrolRecord::route) when it has two or more, else its nodes' positions.
 std::vector<std::vector<Eigen::Vector2d>> FlightTracks(const TopoMap& map);

@@ -10,8 +10,6 @@
 namespace patrolmap::graph {
 namespace {
 
-constexpr const char* kFlightColours[] = {"#374151", "#d97706", "#7c3aed", "#0f766e", "#a16207"};
-
 nlohmann::json PageData(const TopoMap& map, const std::vector<ClosureMatches>* matches) {
   nlohmann::json nodes = nlohmann::json::array(), closures = nlohmann::json::array();
   for (int i = 0; i < map.node_count(); ++i) {
@@ -104,7 +102,7 @@ else if (nodes.length) showNode(0);
 document.body.dataset.ready = nodes.length + ' nodes, ' + closures.length + ' loop closures';
 )";
 
-void Legend(const TopoMap& map, const SvgTruth* truth, std::ostringstream* out) {
+void HtmlLegend(const TopoMap& map, const SvgTruth* truth, std::ostringstream* out) {
   const std::vector<std::string> flights = map.Flights();
   *out << "<div class='legend'>";
   for (std::size_t f = 0; f < flights.size(); ++f) {
@@ -130,7 +128,7 @@ std::string ToHtml(const TopoMap& map, const SvgTruth* truth, const std::vector<
       << Counted(map.loop_closure_count(), "loop closure", "loop closures") << ", "
       << Counted(static_cast<long long>(map.Flights().size()), "flight", "flights")
       << ". Drag to pan, wheel to zoom; click a node or a loop closure.</p>";
-  Legend(map, truth, &out);
+  HtmlLegend(map, truth, &out);
   out << "<p id='title'></p><img id='thumb' alt=''><canvas id='pair'></canvas><p id='about' class='muted'></p>"
       << "</div>\n<script type='application/json' id='data'>" << JsonForScript(PageData(map, matches))
       << "</script>\n<script>" << kScript << "</script>\n</body></html>\n";

@@ -15,8 +15,6 @@ constexpr double kWidth = 800.0;                // SVG user units across
 constexpr double kMargin = 30.0;                // around the nodes
 constexpr double kNodeR = 6.0;                  // node radius
 constexpr double kCoincidentPx = 2.5 * kNodeR;  // closer nodes: a closure between them is a ring
-// Flight colours stay clear of the verdict colours (green, red, blue).
-constexpr const char* kFlightColours[] = {"#374151", "#d97706", "#7c3aed", "#0f766e", "#a16207"};
 
 // Layout coordinates to the drawing's (y down), keeping the aspect, below a band `top` high (the legend's);
 // the height follows the layout.
@@ -113,7 +111,7 @@ void Nodes(const TopoMap& map, const Frame& frame, std::ostringstream* out) {
   }
 }
 
-void Legend(const TopoMap& map, const SvgTruth* truth, std::ostringstream* out) {
+void SvgLegend(const TopoMap& map, const SvgTruth* truth, std::ostringstream* out) {
   const std::vector<std::string> flights = map.Flights();
   for (std::size_t f = 0; f < flights.size(); ++f) {
     *out << "<text x='10' y='" << 18 + 16 * f << "' font-size='12' fill='" << kFlightColours[f % 5] << "'>"
@@ -140,7 +138,7 @@ std::string SvgDrawing(const TopoMap& map, const SvgTruth* truth, bool legend) {
   Traversals(map, frame, &out);
   Closures(map, frame, truth, &out);
   Nodes(map, frame, &out);
-  if (legend) Legend(map, truth, &out);
+  if (legend) SvgLegend(map, truth, &out);
   out << "</svg>\n";
   return out.str();
 }

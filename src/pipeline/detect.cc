@@ -52,7 +52,8 @@ std::pair<double, double> SmoothedRange(const std::vector<FlowSample>& samples) 
   return low <= high ? std::make_pair(low, high) : std::make_pair(0.0, 0.0);
 }
 
-std::string Number(double value) {
+// Three significant digits, for a message.
+std::string Short(double value) {
   char text[32];
   std::snprintf(text, sizeof(text), "%.3g", value);
   return text;
@@ -74,18 +75,18 @@ std::string WhyNoKeyLocation(const io::LogInfo& info, const DetectionResult& res
   }
   const auto [low, high] = SmoothedRange(result.samples);
   if (high - low < options.extrema.min_change) {
-    return prefix + "the smoothed response varies by " + Number(high - low) +
-           ", less than flow.extrema.min_change = " + Number(options.extrema.min_change) +
+    return prefix + "the smoothed response varies by " + Short(high - low) +
+           ", less than flow.extrema.min_change = " + Short(options.extrema.min_change) +
            " (a camera that hardly moves, or a uniform scene); lower "
            "flow.extrema.min_change to about a third of that range";
   }
   return prefix +
          "no peak or valley of the smoothed response was confirmed (the response must turn back by "
          "flow.extrema.min_change = " +
-         Number(options.extrema.min_change) +
+         Short(options.extrema.min_change) +
          " after it, at least "
          "flow.extrema.min_time_s = " +
-         Number(options.extrema.min_time_s) + " s after the previous one)";
+         Short(options.extrema.min_time_s) + " s after the previous one)";
 }
 
 }  // namespace
@@ -95,7 +96,7 @@ std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const Detect
   std::vector<std::string> warnings;
   if (!info.timed) {
     warnings.push_back(info.path + ": the log has no timestamps, so its frames are taken as " +
-                       Number(info.frame_rate_hz) +
+                       Short(info.frame_rate_hz) +
                        " Hz; give --fps (input.frame_rate_hz) for the real rate, or, for a collection of "
                        "photographs rather than a video's frames, map --every-frame (each image a node)");
   }
@@ -103,14 +104,14 @@ std::vector<std::string> DetectionWarnings(const io::LogInfo& info, const Detect
                                 ? 0.0
                                 : NsToSeconds(result.samples.back().timestamp_ns - result.samples.front().timestamp_ns);
   if (duration_s < 2.0 * options.smoothing.window_s) {
-    warnings.push_back(info.path + ": the log lasts " + Number(duration_s) +
+    warnings.push_back(info.path + ": the log lasts " + Short(duration_s) +
                        " s, less than twice the smoothing "
                        "window (flow.smoothing.window_s = " +
-                       Number(options.smoothing.window_s) + " s, " + std::to_string(result.timing.window) +
+                       Short(options.smoothing.window_s) + " s, " + std::to_string(result.timing.window) +
                        " processed frames), which flattens the response; "
                        "for short logs lower flow.smoothing.window_s to about a quarter of the log (--set "
                        "flow.smoothing.window_s=" +
-                       Number(std::max(0.1, duration_s / 4.0)) + ")");
+                       Short(std::max(0.1, duration_s / 4.0)) + ")");
   }
   if (result.unusable_frames > 0) {
     warnings.push_back(info.path + ": " + std::to_string(result.unusable_frames) + " frames were too small (under " +

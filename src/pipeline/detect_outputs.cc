@@ -10,7 +10,7 @@
 namespace patrolmap::pipeline {
 namespace {
 
-std::string Number(double value) {
+std::string CsvNumber(double value) {
   if (std::isnan(value)) return "nan";
   char buffer[32];
   std::snprintf(buffer, sizeof(buffer), "%.6g", value);
@@ -44,7 +44,7 @@ void Polyline(const std::vector<FlowSample>& samples, const PlotFrame& frame, bo
   for (const FlowSample& sample : samples) {
     const double value = smoothed ? sample.smoothed_response : sample.raw_response;
     if (std::isnan(value)) continue;
-    *svg << Number(frame.X(NsToSeconds(sample.timestamp_ns))) << "," << Number(frame.Y(value)) << " ";
+    *svg << CsvNumber(frame.X(NsToSeconds(sample.timestamp_ns))) << "," << CsvNumber(frame.Y(value)) << " ";
   }
   *svg << "'/>\n";
 }
@@ -64,13 +64,13 @@ void Axes(const PlotFrame& frame, std::ostringstream* svg) {
        << frame.bottom - frame.top << "' fill='white' stroke='#444'/>\n";
   const double t_step = NiceStep(frame.t1 - frame.t0, 10);
   for (double t = std::ceil(frame.t0 / t_step) * t_step; t <= frame.t1; t += t_step) {
-    *svg << "<text x='" << Number(frame.X(t)) << "' y='" << frame.bottom + 16
-         << "' font-size='11' text-anchor='middle'>" << Number(t) << "</text>\n";
+    *svg << "<text x='" << CsvNumber(frame.X(t)) << "' y='" << frame.bottom + 16
+         << "' font-size='11' text-anchor='middle'>" << CsvNumber(t) << "</text>\n";
   }
   const double y_step = NiceStep(frame.y1 - frame.y0, 5);
   for (double y = std::ceil(frame.y0 / y_step) * y_step; y <= frame.y1; y += y_step) {
-    *svg << "<text x='" << frame.left - 6 << "' y='" << Number(frame.Y(y) + 4) << "' font-size='11' text-anchor='end'>"
-         << Number(y) << "</text>\n";
+    *svg << "<text x='" << frame.left - 6 << "' y='" << CsvNumber(frame.Y(y) + 4)
+         << "' font-size='11' text-anchor='end'>" << CsvNumber(y) << "</text>\n";
   }
   *svg << "<text x='" << (frame.left + frame.right) / 2 << "' y='" << frame.bottom + 34
        << "' font-size='12' text-anchor='middle'>time [s]</text>\n"
@@ -81,8 +81,8 @@ void Axes(const PlotFrame& frame, std::ostringstream* svg) {
 // A key location: filled by its kind (peak red, valley blue); judged false, a hollow ring with a cross.
 void Markers(const DetectionResult& result, const PlotTruth& truth, const PlotFrame& frame, std::ostringstream* svg) {
   for (double t : truth.times_s) {
-    *svg << "<line x1='" << Number(frame.X(t)) << "' x2='" << Number(frame.X(t)) << "' y1='" << frame.top << "' y2='"
-         << frame.bottom << "' stroke='#2a9d3a' stroke-dasharray='4 3'/>\n";
+    *svg << "<line x1='" << CsvNumber(frame.X(t)) << "' x2='" << CsvNumber(frame.X(t)) << "' y1='" << frame.top
+         << "' y2='" << frame.bottom << "' stroke='#2a9d3a' stroke-dasharray='4 3'/>\n";
   }
   for (std::size_t k = 0; k < result.key_locations.size(); ++k) {
     const KeyLocation& node = result.key_locations[k];
@@ -91,14 +91,14 @@ void Markers(const DetectionResult& result, const PlotTruth& truth, const PlotFr
     const bool wrong = k < truth.correct.size() && !truth.correct[k];
     const int id = k < truth.node_ids.size() ? truth.node_ids[k] : node.node_index;
     if (wrong) {
-      *svg << "<circle class='false' cx='" << Number(x) << "' cy='" << Number(y) << "' r='6' fill='white' stroke='"
-           << colour << "' stroke-width='2'/><path d='M" << Number(x - 4) << "," << Number(y - 4)
-           << " l8,8 m0,-8 l-8,8'"
+      *svg << "<circle class='false' cx='" << CsvNumber(x) << "' cy='" << CsvNumber(y)
+           << "' r='6' fill='white' stroke='" << colour << "' stroke-width='2'/><path d='M" << CsvNumber(x - 4) << ","
+           << CsvNumber(y - 4) << " l8,8 m0,-8 l-8,8'"
            << " stroke='" << colour << "' stroke-width='1.5'/>";
     } else {
-      *svg << "<circle cx='" << Number(x) << "' cy='" << Number(y) << "' r='6' fill='" << colour << "'/>";
+      *svg << "<circle cx='" << CsvNumber(x) << "' cy='" << CsvNumber(y) << "' r='6' fill='" << colour << "'/>";
     }
-    *svg << "<text x='" << Number(x) << "' y='" << Number(y - 10) << "' font-size='11' text-anchor='middle'>"
+    *svg << "<text x='" << CsvNumber(x) << "' y='" << CsvNumber(y - 10) << "' font-size='11' text-anchor='middle'>"
          << (id >= 0 ? std::to_string(id) : std::string("-")) << "</text>\n";
   }
 }
@@ -130,8 +130,8 @@ std::string KeyLocationsCsv(const std::vector<KeyLocation>& key_locations) {
   std::ostringstream csv;
   csv << "node,timestamp_ns,frame_index,response,kind\n";
   for (const KeyLocation& node : key_locations) {
-    csv << node.node_index << "," << node.timestamp_ns << "," << node.frame_index << "," << Number(node.response) << ","
-        << ToString(node.kind) << "\n";
+    csv << node.node_index << "," << node.timestamp_ns << "," << node.frame_index << "," << CsvNumber(node.response)
+        << "," << ToString(node.kind) << "\n";
   }
   return csv.str();
 }
@@ -140,8 +140,9 @@ std::string ResponseCsv(const std::vector<FlowSample>& samples) {
   std::ostringstream csv;
   csv << "timestamp_ns,frame_index,raw_response,smoothed_response,tracked_vectors,accepted_vectors\n";
   for (const FlowSample& sample : samples) {
-    csv << sample.timestamp_ns << "," << sample.frame_index << "," << Number(sample.raw_response) << ","
-        << Number(sample.smoothed_response) << "," << sample.tracked_vectors << "," << sample.accepted_vectors << "\n";
+    csv << sample.timestamp_ns << "," << sample.frame_index << "," << CsvNumber(sample.raw_response) << ","
+        << CsvNumber(sample.smoothed_response) << "," << sample.tracked_vectors << "," << sample.accepted_vectors
+        << "\n";
   }
   return csv.str();
 }

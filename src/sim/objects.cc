@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "patrolmap/sim/village.h"
+#include "plane.h"
 
 namespace patrolmap::sim {
 namespace {
@@ -89,8 +90,6 @@ cv::Mat ObjectTexture(const WorldObject& object) {
   sum.convertTo(image, CV_8UC1);
   return image;
 }
-
-double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 // True when a wall (of a building or of another object) crosses the line of sight from the camera to the
 // object's centre below the line's height there. The object's own sides do not count.

@@ -7,13 +7,12 @@
 #include <opencv2/core.hpp>
 
 #include "patrolmap/core/status.h"
+#include "plane.h"
 
 namespace patrolmap::sim {
 namespace {
 
 constexpr double kNearestDepth = 0.05;  // surfaces closer than this are ignored [m]
-
-double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 std::uint8_t Bilinear(const cv::Mat& image, double u, double v, bool wrap) {
   const double x = u - 0.5, y = v - 0.5;

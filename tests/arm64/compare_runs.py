@@ -137,7 +137,7 @@ def main():
     }
     said = ", ".join(f"{n} {what}" for what, n in counts.items() if n is not None)
     largest = ", ".join(f"{what} {value:.3g}" for what, value in sorted(c.largest.items()))
-    name = os.path.basename(os.path.normpath(c.left))
+    name = os.path.basename(os.path.normpath(c.left)).removesuffix("-amd64")
     if c.failures:
         print(f"{name}: amd64 and arm64 differ ({said}):")
         for failure in c.failures[:20]:

@@ -306,7 +306,7 @@ TEST(RouteCompare, KittiFlownTwiceGivesNoChangeAndAPastedObjectIsFound) {
 // Real pairs of one unchanged scene (Debian's opencv-doc): an exposure change (leuven), a strong viewpoint change
 // of a plane (graf) and an aerial view from elsewhere (aero). At the route frames' width, none may give a region,
 // with both_ways or without.
-class RealUnchangedPair : public testing::TestWithParam<std::pair<const char*, const char*>> {};
+class RealUnchangedPair : public ::testing::TestWithParam<std::pair<const char*, const char*>> {};
 
 TEST_P(RealUnchangedPair, GivesNoRegion) {
   const std::string data = "/usr/share/doc/opencv-doc/examples/data/";
@@ -326,10 +326,10 @@ TEST_P(RealUnchangedPair, GivesNoRegion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(OpencvDoc, RealUnchangedPair,
-                         testing::Values(std::make_pair("leuvenA.jpg", "leuvenB.jpg"),
-                                         std::make_pair("graf1.png", "graf3.png"),
-                                         std::make_pair("graf3.png", "graf1.png"),
-                                         std::make_pair("aero1.jpg", "aero3.jpg")));
+                         ::testing::Values(std::make_pair("leuvenA.jpg", "leuvenB.jpg"),
+                                           std::make_pair("graf1.png", "graf3.png"),
+                                           std::make_pair("graf3.png", "graf1.png"),
+                                           std::make_pair("aero1.jpg", "aero3.jpg")));
 
 // Real revisits of one unchanged room (the shared EuRoC pairs, 752x480, a MAV seen from two viewpoints), at the route
 // frames' width, each pair both ways round: with both_ways, none gives a region. (With the defaults, left_img_3

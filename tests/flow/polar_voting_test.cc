@@ -13,15 +13,13 @@
 namespace patrolmap::flow {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 TEST(Polar, FollowsEquationsOneAndTwo) {
   const PolarVector a = ToPolar({{10.0f, 20.0f}, {3.0f, 4.0f}});
   EXPECT_NEAR(a.theta, std::atan2(4.0, 3.0), 1e-6);
   EXPECT_NEAR(a.r, 10.0 * 0.6 + 20.0 * 0.8, 1e-4);
   EXPECT_NEAR(a.length, 5.0, 1e-6);
   const PolarVector left = ToPolar({{50.0f, 7.0f}, {-2.0f, 0.0f}});
-  EXPECT_NEAR(std::abs(left.theta), kPi, 1e-6);
+  EXPECT_NEAR(std::abs(left.theta), M_PI, 1e-6);
   EXPECT_NEAR(left.r, -50.0, 1e-4);
   EXPECT_NEAR(left.length, 2.0, 1e-6);
 }

@@ -13,8 +13,6 @@
 namespace patrolmap::flow {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 std::vector<FlowSample> Samples(const std::vector<double>& values, double rate_hz = 1.0) {
   std::vector<FlowSample> samples(values.size());
   for (std::size_t i = 0; i < values.size(); ++i) {
@@ -83,7 +81,7 @@ TEST(ExtremumDetector, FindsEveryPeakAndValleyOfASineWithWiggles) {
   std::vector<double> values;
   for (int i = 0; i <= 300; ++i) {
     const double t = i / 10.0;
-    values.push_back(0.05 + 0.03 * std::sin(2 * kPi * t / 10.0) + 0.004 * std::sin(2 * kPi * t / 0.7));
+    values.push_back(0.05 + 0.03 * std::sin(2 * M_PI * t / 10.0) + 0.004 * std::sin(2 * M_PI * t / 0.7));
   }
   const std::vector<KeyLocation> events = Extrema(values, 10.0, {0.02, 2.0});
   ASSERT_EQ(events.size(), 6u);
@@ -98,7 +96,7 @@ TEST(ExtremumDetector, FindsEveryPeakAndValleyOfASineWithWiggles) {
 TEST(ExtremumDetector, ChangesSmallerThanTheThresholdAreNotNodes) {
   std::vector<double> values;
   // Starts in a valley; peaks at 5, 15, 25 s, valleys at 10, 20 s (the one at 30 s is never confirmed).
-  for (int i = 0; i <= 300; ++i) values.push_back(0.05 - 0.009 * std::cos(2 * kPi * i / 100.0));
+  for (int i = 0; i <= 300; ++i) values.push_back(0.05 - 0.009 * std::cos(2 * M_PI * i / 100.0));
   EXPECT_TRUE(Extrema(values, 10.0, {0.02, 2.0}).empty());  // swing 0.018 < 0.02
   const std::vector<KeyLocation> events = Extrema(values, 10.0, {0.015, 2.0});
   ASSERT_EQ(events.size(), 5u);
