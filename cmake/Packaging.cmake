@@ -12,7 +12,15 @@ set(CPACK_COMPONENTS_ALL runtime development)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME patrolmap)
-set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+if(CMAKE_CROSSCOMPILING)
+  # dpkg-shlibdeps reads the dpkg database of the machine it runs on, which holds no arm64 libraries:
+  # scripts/cross_arm64.sh names the packages of the libraries the programs need, from its sysroot.
+  set(PATROLMAP_DEB_RUNTIME_DEPENDS "" CACHE STRING "Depends of the runtime package when cross-building")
+  set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE arm64)
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "${PATROLMAP_DEB_RUNTIME_DEPENDS}")
+else()
+  set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+endif()
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_NAME libpatrolmap-dev)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_SECTION libdevel)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS

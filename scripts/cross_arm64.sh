@@ -30,7 +30,8 @@ packages=(libc6-dev libstdc++-12-dev libopencv-core-dev libopencv-imgproc-dev li
   libcli11-dev nlohmann-json3-dev libnanoflann-dev)
 sysroot=$out/sysroot
 apt_dir=$out/apt
-want="${packages[*]} libopencv-dev in $sysroot"  # Ceres's package below names the folder
+# The folder is part of the stamp (Ceres's package below names it), and so is the form of .sonames.
+want="${packages[*]} libopencv-dev in $sysroot, sonames 1"
 if [[ ! -f $sysroot/.packages || $(cat "$sysroot/.packages") != "$want" ]]; then
   stage "setting up the arm64 sysroot in $sysroot"
   rm -rf "$sysroot" "$apt_dir"
@@ -55,9 +56,12 @@ EOF
   apt-get install -y -qq --download-only "${packages[@]}" >/dev/null
   # libopencv-dev holds OpenCV's CMake package; its other dependencies are modules patrolmap does not link.
   (cd "$apt_dir/debs" && apt-get download -qq libopencv-dev)
+  # .sonames: each shared library's file name with its package and version, for the arm64 package's Depends.
   for deb in "$apt_dir"/cache/archives/*.deb "$apt_dir"/debs/*.deb; do
     dpkg-deb -x "$deb" "$sysroot"
-  done
+    dpkg-deb -c "$deb" | awk -v package="$(dpkg-deb -f "$deb" Package)" -v version="$(dpkg-deb -f "$deb" Version)" \
+      '$6 ~ /\.so\.[0-9]/ { n = split($6, path, "/"); print path[n], package, version }'
+  done >"$sysroot/.sonames"
   # What the packages' maintainer scripts would have done: absolute symbolic links point into the sysroot, and
   # BLAS and LAPACK (Debian's alternatives) are ATLAS's, as Ceres's CMake package names.
   while IFS= read -r link; do
@@ -85,6 +89,23 @@ cmake -S . -B "$out/build" -DCMAKE_TOOLCHAIN_FILE="$root/cmake/aarch64-linux-gnu
   -DPATROLMAP_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build "$out/build" -j "$(nproc)" --target patrolmap patrolmap-onboard
 readelf -h "$out/build/tools/patrolmap" | grep -q AArch64 || { echo "cross_arm64: not an arm64 binary" >&2; exit 1; }
+
+# The arm64 Debian packages. Depends: the package of each shared library the programs load, as dpkg-shlibdeps would
+# name it from an arm64 machine's dpkg database.
+stage "packaging"
+depends=()
+for soname in $(readelf -d "$out/build/tools/patrolmap" "$out/build/tools/patrolmap-onboard" |
+  sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | sort -u); do
+  entry=$(awk -v name="$soname" '$1 == name { print $2 " (>= " $3 ")"; exit }' "$sysroot/.sonames")
+  [[ -n $entry ]] || { echo "cross_arm64: no package in the sysroot holds $soname" >&2; exit 1; }
+  depends+=("$entry")
+done
+depends_line=$(printf '%s\n' "${depends[@]}" | sort -u | paste -sd, - | sed 's/,/, /g')
+cmake "$out/build" -DPATROLMAP_DEB_RUNTIME_DEPENDS="$depends_line" >/dev/null
+rm -rf "$out/packages"
+(cd "$out/build" && cpack -G DEB -B "$out/packages" >"$out/cpack.log" 2>&1) || { tail "$out/cpack.log" >&2; exit 1; }
+deb=$(ls "$out"/packages/patrolmap_*_arm64.deb)
+echo "$(basename "$deb"): Depends: $(dpkg-deb -f "$deb" Depends)"
 
 # 3. One short series through both builds. qemu-aarch64-static runs the arm64 binaries with the sysroot's loader
 # and libraries; each build reads the same files (PATROLMAP_VOCABULARY: the shipped vocabulary).
@@ -117,7 +138,13 @@ for arch in amd64 arm64; do
   step "$log" "${run[@]}" "$bin/patrolmap-onboard" "$runs/series/flight_2" --map "$runs/map-$arch/map.pmap" \
     --fast --out "$runs/onboard-$arch"
 done
+# The packaged program, unpacked as dpkg lays it out, finds its own vocabulary and maps as the build tree's does.
+stage "arm64 package: map"
+dpkg-deb -x "$deb" "$runs/package"
+step "$runs/package.log" env PATROLMAP_VOCABULARY= qemu-aarch64-static -L "$sysroot" \
+  "$runs/package/usr/bin/patrolmap" map "$runs/series/flight_1" --out "$runs/package-map"
 for what in map patrol onboard; do
   python3 tests/arm64/compare_runs.py "$runs/$what-amd64" "$runs/$what-arm64"
 done
+python3 tests/arm64/compare_runs.py "$runs/map-amd64" "$runs/package-map"
 stage "done"

@@ -58,7 +58,8 @@ sys.exit(0 if a == b and len(a) >= 1 and all(p['registered'] for p in a) else 1)
 # events.jsonl holds whole JSON lines, one per id, and announces every change of the report.
 for seed in 1 2 3; do
   series="$work/village$seed"
-  "$bin" -q simulate --route l-shape --flights 2 --detections --depth --resolution 376x240 --seed "$seed" --out "$series"
+  "$bin" -q simulate --route l-shape --speed 4 --flights 2 --detections --depth --resolution 376x240 --seed "$seed" \
+    --out "$series"
   "$bin" -q map "$series/flight_1" --vocabulary "$vocabulary" --out "$series/m1"
   "$bin" -q patrol "$series/flight_2" --map "$series/m1/map.pmap" --vocabulary "$vocabulary" --out "$series/p" >/dev/null
   "$onboard" -q "$series/flight_2" --map "$series/m1/map.pmap" --fast --vocabulary "$vocabulary" --out "$series/o" >/dev/null
