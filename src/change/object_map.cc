@@ -12,17 +12,6 @@
 namespace patrolmap::change {
 namespace {
 
-struct PointCloud {
-  const std::vector<Eigen::Vector3f>* points;
-  std::size_t kdtree_get_point_count() const { return points->size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t axis) const { return (*points)[i][static_cast<int>(axis)]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointCloud>, PointCloud, 3>;
-
 double Iou(const cv::Rect2d& a, const cv::Rect2d& b) {
   const double overlap = (a & b).area();
   const double total = a.area() + b.area() - overlap;
@@ -90,7 +79,20 @@ void Absorb(double point_voxel, MapObject* into, const MapObject& from) {
 
 }  // namespace
 
+// nanoflann's k-d tree over the points, which it reads through PointCloud (its dataset adaptor). Not in the
+// anonymous namespace: the members of an externally linked type.
 struct PointIndex::Tree {
+  struct PointCloud {
+    const std::vector<Eigen::Vector3f>* points;
+    std::size_t kdtree_get_point_count() const { return points->size(); }
+    float kdtree_get_pt(std::size_t i, std::size_t axis) const { return (*points)[i][static_cast<int>(axis)]; }
+    template <class Box>
+    bool kdtree_get_bbox(Box&) const {
+      return false;
+    }
+  };
+  using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointCloud>, PointCloud, 3>;
+
   explicit Tree(const std::vector<Eigen::Vector3f>& points)
       : cloud{&points}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {}
   PointCloud cloud;
