@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# A site object's history over seven patrols, against the simulator's truth: in this series (l-shape, seed 28, 30
-# objects) crate 8 stands from flight 1, is moved 2.3 m at flight 4 and removed at flight 7. Each patrol is compared
-# with the map the one before wrote; `history` must show one site object there, first seen at patrol 1, moved at
-# patrol 4 from where it stood to where it went, and not seen at patrol 7, and nothing else.
+# A site object's history over seven patrols, against the simulator's truth: in this series (l-shape at 4 m/s,
+# seed 28, 30 objects) crate 8 stands from flight 1, is moved 2.3 m at flight 4 and removed at flight 7. Each patrol
+# is compared with the map the one before wrote; `history` must show one site object there, first seen at patrol 1,
+# moved at patrol 4 from where it stood to where it went, and not seen at patrol 7, and nothing else.
 # Usage: site_history_test.sh PATROLMAP_BINARY
 set -u
 bin=$1
 source "$(dirname "$0")/shell_lib.sh"
 
-"$bin" -q simulate --route l-shape --flights 7 --seed 28 --objects 30 --detections --depth --resolution 376x240 \
-  --out "$work/logs" >/dev/null || { echo "FAIL simulate"; exit 1; }
+"$bin" -q simulate --route l-shape --flights 7 --speed 4 --seed 28 --objects 30 --detections --depth \
+  --resolution 376x240 --out "$work/logs" >/dev/null || { echo "FAIL simulate"; exit 1; }
 check "map flight 1" "$bin" -q map "$work/logs/flight_1" --out "$work/run_1"
 for i in 2 3 4 5 6 7; do
   check "patrol $i" "$bin" -q patrol "$work/logs/flight_$i" --map "$work/run_$((i - 1))/map.pmap" --out "$work/run_$i"
