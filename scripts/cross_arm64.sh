@@ -116,7 +116,7 @@ runs=$out/runs
 rm -rf "$runs"
 mkdir -p "$runs"
 export PATROLMAP_VOCABULARY=$root/vocab/default.pmvoc
-qemu() { qemu-aarch64-static -L "$sysroot" "$@"; }
+qemu=(qemu-aarch64-static -L "$sysroot")
 stage "simulating the series (376x240, two flights of about 620 frames, 12 objects with detections and depth)"
 "$amd64/patrolmap" simulate --route l-shape --speed 4 --flights 2 --objects 12 --detections --depth \
   --resolution 376x240 --seed 9 --out "$runs/series" >/dev/null
@@ -128,7 +128,7 @@ step() {
 }
 for arch in amd64 arm64; do
   run=()
-  [[ $arch == arm64 ]] && run=(qemu)
+  [[ $arch == arm64 ]] && run=("${qemu[@]}")
   bin=${!arch}
   log=$runs/$arch.log
   stage "$arch: map, patrol, patrolmap-onboard --fast"
@@ -141,8 +141,8 @@ done
 # The packaged program, unpacked as dpkg lays it out, finds its own vocabulary and maps as the build tree's does.
 stage "arm64 package: map"
 dpkg-deb -x "$deb" "$runs/package"
-step "$runs/package.log" env PATROLMAP_VOCABULARY= qemu-aarch64-static -L "$sysroot" \
-  "$runs/package/usr/bin/patrolmap" map "$runs/series/flight_1" --out "$runs/package-map"
+step "$runs/package.log" env PATROLMAP_VOCABULARY= "${qemu[@]}" "$runs/package/usr/bin/patrolmap" map \
+  "$runs/series/flight_1" --out "$runs/package-map"
 for what in map patrol onboard; do
   python3 tests/arm64/compare_runs.py "$runs/$what-amd64" "$runs/$what-arm64"
 done
