@@ -10,8 +10,12 @@ bin="${PATROLMAP_BIN:-$root/build/tools/patrolmap}"
 work="${TMPDIR:-/tmp}/patrolmap_vocabulary"
 "$root/scripts/install_deps.sh" mate-backgrounds lomiri-wallpapers-16.04 opencv-doc
 mkdir -p "$work"
-[[ -f "$work/inner101/cam0/data.csv" ]] || "$bin" --quiet simulate --route inner-loop --seed 101 --out "$work/inner101"
-[[ -f "$work/l102/cam0/data.csv" ]] || "$bin" --quiet simulate --route l-shape --seed 102 --out "$work/l102"
+# Only the frames the vocabulary is trained on are rendered: every 15th of the 30 Hz flights.
+for flight in inner-loop:101 l-shape:102; do
+  route=${flight%:*} seed=${flight#*:}
+  [[ -f "$work/$route-$seed-every-15/cam0/data.csv" ]] || "$bin" --quiet simulate --route "$route" --seed "$seed" \
+    --frame-step 15 --out "$work/$route-$seed-every-15"
+done
 
 # Photographs (vocab/README.md credits each): nature photographs of MATE's backgrounds, the photographs
 # of Ubuntu's 16.04 wallpaper contest, and the photographs among OpenCV's sample data. The image pairs
@@ -37,4 +41,5 @@ if ((${#missing[@]})); then
   echo "build_vocabulary.sh: training photographs missing (their Debian package changed?): ${missing[*]}" >&2
   exit 1
 fi
-"$bin" vocab build "$work/inner101" "$work/l102" "${photos[@]}" -k 10 -L 4 --seed 1 --out "$out"
+"$bin" vocab build "$work/inner-loop-101-every-15" "$work/l-shape-102-every-15" "${photos[@]}" -k 10 -L 4 --every 1 \
+  --seed 1 --out "$out"

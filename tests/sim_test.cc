@@ -119,5 +119,34 @@ TEST(EurocWriter, WrittenLogReadsBackWithSensorsAndSpeed) {
   EXPECT_NEAR(frame.imu.back().accel.z(), 9.81, 1e-6);
 }
 
+// A camera slower than the flight's frame rate: every third frame, each the image the full rate has at that time.
+TEST(EurocWriter, AFrameStepWritesEveryNthFrameOfTheFullRate) {
+  testing::TempDir dir;
+  StreetOptions options;
+  options.walls = 2;
+  options.speed_mps = 10.0;
+  SimulatedFlight flight = MakeStreetFlight(options);
+  flight.camera = {114.5, 114.5, 93.5, 59.5, 188, 120};  // small images: the test is about which frames
+  LogOptions every_third;
+  every_third.frame_step = 3;
+  ASSERT_TRUE(WriteEurocLog(flight, dir / "full").ok());
+  ASSERT_TRUE(WriteEurocLog(flight, dir / "third", every_third).ok());
+  std::unique_ptr<io::FrameSource> full, third;
+  ASSERT_TRUE(io::OpenLog(dir / "full", {}, &full).ok());
+  ASSERT_TRUE(io::OpenLog(dir / "third", {}, &third).ok());
+  EXPECT_EQ(third->info().frame_count, (FrameCount(flight) + 2) / 3);
+  Frame a, b;
+  for (int i = 0; i < third->info().frame_count; ++i) {
+    ASSERT_TRUE(third->Next(true, &b).ok());
+    for (int skip = 0; skip < (i == 0 ? 1 : 3); ++skip) ASSERT_TRUE(full->Next(true, &a).ok());
+    ASSERT_EQ(a.timestamp_ns, b.timestamp_ns) << "frame " << i;
+    ASSERT_EQ(cv::norm(a.image, b.image, cv::NORM_INF), 0.0) << "frame " << i;
+  }
+  EXPECT_FALSE(third->Next(true, &b).ok());
+  LogOptions none;
+  none.frame_step = 0;
+  EXPECT_FALSE(WriteEurocLog(flight, dir / "none", none).ok());
+}
+
 }  // namespace
 }  // namespace patrolmap::sim

@@ -45,23 +45,23 @@ std::string MatrixYaml(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& t
 }
 
 // cam0 (baseline 0) or, `baseline_m` to its right, cam1 of the stereo pair.
-std::string CameraYaml(const SimulatedFlight& flight, double baseline_m = 0.0) {
+std::string CameraYaml(const SimulatedFlight& flight, int frame_step, double baseline_m = 0.0) {
   const CameraIntrinsics& camera = flight.camera;
   const Eigen::Matrix3d body_from_camera = BodyFromCamera(flight.mount_angle);
   std::ostringstream out;
   out.precision(12);
   out << "sensor_type: camera\ncomment: patrolmap simulated camera\n"
       << MatrixYaml(body_from_camera, body_from_camera * Eigen::Vector3d(baseline_m, 0.0, 0.0))
-      << "rate_hz: " << flight.frame_rate_hz << "\nresolution: [" << camera.width << ", " << camera.height
+      << "rate_hz: " << flight.frame_rate_hz / frame_step << "\nresolution: [" << camera.width << ", " << camera.height
       << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", " << camera.fy << ", " << camera.cx << ", "
       << camera.cy << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
   return out.str();
 }
 
-std::string MetaYaml(const SimulatedFlight& flight) {
+std::string MetaYaml(const SimulatedFlight& flight, int frame_step) {
   std::ostringstream out;
   out.precision(12);
-  out << "flight_id: " << flight.flight_id << "\nsimulated: true\nframe_rate_hz: " << flight.frame_rate_hz
+  out << "flight_id: " << flight.flight_id << "\nsimulated: true\nframe_rate_hz: " << flight.frame_rate_hz / frame_step
       << "\nmount_angle_deg: " << flight.mount_angle * 180.0 / M_PI << "\ncamera:\n  fx: " << flight.camera.fx
       << "\n  fy: " << flight.camera.fy << "\n  cx: " << flight.camera.cx << "\n  cy: " << flight.camera.cy
       << "\n  width: " << flight.camera.width << "\n  height: " << flight.camera.height << "\n";
@@ -237,7 +237,8 @@ Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, con
   const int detector_step = std::max(1, static_cast<int>(std::lround(flight.frame_rate_hz / options.detector.rate_hz)));
   cv::Mat image, depth, sum, sample;
   const int frames = FrameCount(flight);
-  for (int frame = 0; frame < frames; ++frame) {
+  int next_detection = 0;  // the detector reports on the first written frame this many frames after its last
+  for (int frame = 0; frame < frames; frame += options.frame_step) {
     const TimestampNs timestamp = FrameTimestamp(flight, frame);
     const CameraPose pose = CameraPoseAt(flight, flight.trajectory(frame / flight.frame_rate_hz));
     const std::string name = std::to_string(timestamp) + ".png";
@@ -253,7 +254,8 @@ Status WriteFrames(const SimulatedFlight& flight, const std::string& folder, con
       PATROLMAP_RETURN_IF_ERROR(WriteImage(folder + "/depth0/data/" + name, depth));
       tables->depth << timestamp << "," << name << "\n";
     }
-    if (options.detections && frame % detector_step == 0) {
+    if (options.detections && frame >= next_detection) {
+      next_detection = frame + detector_step;
       AppendDetections(
           timestamp, DetectObjects(flight.objects, flight.scene, flight.camera, pose, options.detector, frame), tables);
     }
@@ -349,6 +351,7 @@ std::vector<TruthKeyLocation> KeyLocationTruth(const SimulatedFlight& flight) {
 Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, const LogOptions& options,
                      const ProgressCallback& progress) {
   if (!flight.trajectory || flight.duration_s <= 0.0) return Status::InvalidArgument("flight has no trajectory");
+  if (options.frame_step < 1) return Status::InvalidArgument("frame step must be at least 1");
   if (options.truth_only) {
     PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/groundtruth"));
     PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/groundtruth/objects.csv", ObjectsTable(flight.objects)));
@@ -362,15 +365,15 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   if (options.stereo_baseline_m > 0.0) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/cam1/data"));
   if (options.detections) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/objects0"));
   if (options.gps) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/gps0"));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight, options.frame_step)));
   FrameTables tables;
   PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, options, progress, &tables));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/data.csv", tables.images.str()));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight)));
+  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight, options.frame_step)));
   if (options.stereo_baseline_m > 0.0) {
     PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam1/data.csv", tables.images.str()));
-    PATROLMAP_RETURN_IF_ERROR(
-        WriteFileAtomically(folder + "/cam1/sensor.yaml", CameraYaml(flight, options.stereo_baseline_m)));
+    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam1/sensor.yaml",
+                                                  CameraYaml(flight, options.frame_step, options.stereo_baseline_m)));
   }
   PATROLMAP_RETURN_IF_ERROR(
       WriteFileAtomically(folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +

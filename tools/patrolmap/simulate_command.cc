@@ -103,8 +103,10 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   Progress progress("simulate");
   PATROLMAP_RETURN_IF_ERROR(sim::WriteEurocLog(flight, folder, arguments.log,
                                                [&progress](int done, int total) { progress.Update(done, total); }));
-  std::printf("%s: %d frames at %.0f Hz (%.1f s), %zu objects, written to %s\n", flight.flight_id.c_str(),
-              sim::FrameCount(flight), flight.frame_rate_hz, flight.duration_s, flight.objects.size(), folder.c_str());
+  const int step = arguments.log.frame_step;
+  std::printf("%s: %d frames at %.3g Hz (%.1f s), %zu objects, written to %s\n", flight.flight_id.c_str(),
+              (sim::FrameCount(flight) + step - 1) / step, flight.frame_rate_hz / step, flight.duration_s,
+              flight.objects.size(), folder.c_str());
   return Status::Ok();
 }
 
@@ -197,6 +199,11 @@ void AddPatrolOptions(CLI::App* app, SimulateArguments* arguments) {
   app->add_option("--motion-blur", arguments->log.exposure_s,
                   "exposure time for motion blur [s] (each frame averages 5 renders over it; 0 = sharp)")
       ->check(FiniteRange(0.0, 0.1))
+      ->capture_default_str();
+  app->add_option("--frame-step", arguments->log.frame_step,
+                  "write every n-th frame of the 30 Hz flight (a slower camera; each written frame is the one the "
+                  "full rate has, the poses, IMU and truth are the full rate's)")
+      ->check(CLI::Range(1, 300))
       ->capture_default_str();
 }
 

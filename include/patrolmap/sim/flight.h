@@ -49,6 +49,8 @@ struct LogOptions {
   double gps_bias_m = 0.0;          // ... of an offset drawn once per flight (each axis), shared by its fixes [m]
   double attitude_noise_deg = 0.5;  // standard deviation of the attitude's error about each axis, fixed per flight
   double exposure_s = 0.0;          // motion blur: average of 5 renders spread over this exposure time (0 = sharp)
+  int frame_step = 1;               // cam0 (cam1, depth0) written every this many frames of the flight: a camera at
+                                    // frame_rate_hz / frame_step; each frame as at full rate (poses, IMU, truth too)
   bool truth_only = false;          // write only groundtruth/key_locations.csv (after a change of its definition)
   DetectorOptions detector;
   double gps_origin_latitude = 47.3572;  // village origin (the paper's site is near Birmensdorf) [deg]
