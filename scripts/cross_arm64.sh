@@ -126,23 +126,28 @@ step() {
   shift
   "$@" >>"$log" 2>&1 || { tail -n 30 "$log" >&2; echo "cross_arm64: failed: $*" >&2; exit 1; }
 }
+# The runs after `map` read only its map, so they go side by side: under qemu each takes minutes.
+dpkg-deb -x "$deb" "$runs/package"
 for arch in amd64 arm64; do
   run=()
   [[ $arch == arm64 ]] && run=("${qemu[@]}")
   bin=${!arch}
-  log=$runs/$arch.log
-  stage "$arch: map, patrol, patrolmap-onboard --fast"
-  step "$log" "${run[@]}" "$bin/patrolmap" map "$runs/series/flight_1" --out "$runs/map-$arch"
-  step "$log" "${run[@]}" "$bin/patrolmap" patrol "$runs/series/flight_2" --map "$runs/map-$arch/map.pmap" \
-    --out "$runs/patrol-$arch"
-  step "$log" "${run[@]}" "$bin/patrolmap-onboard" "$runs/series/flight_2" --map "$runs/map-$arch/map.pmap" \
-    --fast --out "$runs/onboard-$arch"
+  stage "$arch: map, then patrol and patrolmap-onboard --fast side by side"
+  step "$runs/map-$arch.log" "${run[@]}" "$bin/patrolmap" map "$runs/series/flight_1" --out "$runs/map-$arch"
+  step "$runs/patrol-$arch.log" "${run[@]}" "$bin/patrolmap" patrol "$runs/series/flight_2" \
+    --map "$runs/map-$arch/map.pmap" --out "$runs/patrol-$arch" &
+  patrol=$!
+  step "$runs/onboard-$arch.log" "${run[@]}" "$bin/patrolmap-onboard" "$runs/series/flight_2" \
+    --map "$runs/map-$arch/map.pmap" --fast --out "$runs/onboard-$arch" &
+  onboard=$!
+  # The packaged program, unpacked as dpkg lays it out, finds its own vocabulary and maps as the build tree's does.
+  if [[ $arch == arm64 ]]; then
+    (step "$runs/package.log" env PATROLMAP_VOCABULARY= "${qemu[@]}" "$runs/package/usr/bin/patrolmap" map \
+      "$runs/series/flight_1" --out "$runs/package-map") || { kill "$patrol" "$onboard"; exit 1; }
+  fi
+  wait "$patrol" || exit 1
+  wait "$onboard" || exit 1
 done
-# The packaged program, unpacked as dpkg lays it out, finds its own vocabulary and maps as the build tree's does.
-stage "arm64 package: map"
-dpkg-deb -x "$deb" "$runs/package"
-step "$runs/package.log" env PATROLMAP_VOCABULARY= "${qemu[@]}" "$runs/package/usr/bin/patrolmap" map \
-  "$runs/series/flight_1" --out "$runs/package-map"
 for what in map patrol onboard; do
   python3 tests/arm64/compare_runs.py "$runs/$what-amd64" "$runs/$what-arm64"
 done
