@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DPATROLMAP_SANITIZE=ON -DPATROLMAP_BUILD_TESTS=ON -DPATROLMAP_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build build-sanitize -j "$(nproc)"
+cmake --build build-sanitize -j "$(nproc)" --target unit_tests
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp"
 # OpenCV's GStreamer and gphoto2 backends, tried on a file no other backend opens, leak in their own
