@@ -38,7 +38,11 @@ PY
 }
 
 "$bin" -q simulate --route street --walls 3 --speed 5 --flights 2 --resolution 376x240 --seed 3 --out "$work/series"
-"$bin" -q map "$work/series/flight_1" "$work/series/flight_2" --vocabulary "$vocabulary" --out "$work/euroc" >/dev/null
+# Nodes and loop closures do not depend on the evidence grids: these maps go without (depth.source none, 3x faster).
+nodes_only=$work/nodes_only.yaml
+printf 'depth:\n  source: none\n' >"$nodes_only"
+"$bin" -q map "$work/series/flight_1" "$work/series/flight_2" -c "$nodes_only" --vocabulary "$vocabulary" \
+  --out "$work/euroc" >/dev/null
 mkdir -p "$work/bags"
 write() {  # write NAME FORMAT ARGS...: both flights as bags NAME/flight_N(.bag)
   local name=$1 format=$2
@@ -58,7 +62,7 @@ write ros2_png ros2 --images png
 for variant in ros1_raw ros1_png_bz2 ros1_raw_lz4 ros2_raw ros2_png; do
   suffix="" shift_s=0
   [[ $variant == ros1* ]] && suffix=".bag" shift_s=$offset
-  "$bin" -q map "$work/bags/$variant/flight_1$suffix" "$work/bags/$variant/flight_2$suffix" \
+  "$bin" -q map "$work/bags/$variant/flight_1$suffix" "$work/bags/$variant/flight_2$suffix" -c "$nodes_only" \
     --vocabulary "$vocabulary" --out "$work/map_$variant" >/dev/null 2>"$work/map_$variant.err"
   check "$variant: the same nodes and loop closures as the EuRoC logs" same_map "$work/euroc" "$work/map_$variant" $shift_s
 done
@@ -66,7 +70,7 @@ done
 # JPEG is lossy: the map differs, but the flight maps.
 write ros2_jpeg ros2 --images jpeg
 expect "JPEG images map" 0 "2 logs: [0-9]+ nodes" -- "$bin" map "$work/bags/ros2_jpeg/flight_1" \
-  "$work/bags/ros2_jpeg/flight_2" --vocabulary "$vocabulary" --out "$work/map_jpeg"
+  "$work/bags/ros2_jpeg/flight_2" -c "$nodes_only" --vocabulary "$vocabulary" --out "$work/map_jpeg"
 
 # Every raw encoding gives the grey image mono8 gives: the same key locations.
 sample="$source_dir/flight_logs/sample"
