@@ -45,23 +45,23 @@ std::string MatrixYaml(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& t
 }
 
 // cam0 (baseline 0) or, `baseline_m` to its right, cam1 of the stereo pair.
-std::string CameraYaml(const SimulatedFlight& flight, int frame_step, double baseline_m = 0.0) {
+std::string CameraYaml(const SimulatedFlight& flight, double rate_hz, double baseline_m = 0.0) {
   const CameraIntrinsics& camera = flight.camera;
   const Eigen::Matrix3d body_from_camera = BodyFromCamera(flight.mount_angle);
   std::ostringstream out;
   out.precision(12);
   out << "sensor_type: camera\ncomment: patrolmap simulated camera\n"
       << MatrixYaml(body_from_camera, body_from_camera * Eigen::Vector3d(baseline_m, 0.0, 0.0))
-      << "rate_hz: " << flight.frame_rate_hz / frame_step << "\nresolution: [" << camera.width << ", " << camera.height
+      << "rate_hz: " << rate_hz << "\nresolution: [" << camera.width << ", " << camera.height
       << "]\ncamera_model: pinhole\nintrinsics: [" << camera.fx << ", " << camera.fy << ", " << camera.cx << ", "
       << camera.cy << "]\ndistortion_model: radial-tangential\ndistortion_coefficients: [0, 0, 0, 0]\n";
   return out.str();
 }
 
-std::string MetaYaml(const SimulatedFlight& flight, int frame_step) {
+std::string MetaYaml(const SimulatedFlight& flight, double rate_hz) {
   std::ostringstream out;
   out.precision(12);
-  out << "flight_id: " << flight.flight_id << "\nsimulated: true\nframe_rate_hz: " << flight.frame_rate_hz / frame_step
+  out << "flight_id: " << flight.flight_id << "\nsimulated: true\nframe_rate_hz: " << rate_hz
       << "\nmount_angle_deg: " << flight.mount_angle * 180.0 / M_PI << "\ncamera:\n  fx: " << flight.camera.fx
       << "\n  fy: " << flight.camera.fy << "\n  cx: " << flight.camera.cx << "\n  cy: " << flight.camera.cy
       << "\n  width: " << flight.camera.width << "\n  height: " << flight.camera.height << "\n";
@@ -314,6 +314,14 @@ int FrameCount(const SimulatedFlight& flight) {
   return static_cast<int>(std::floor(flight.duration_s * flight.frame_rate_hz)) + 1;
 }
 
+int WrittenFrameCount(const SimulatedFlight& flight, const LogOptions& options) {
+  return (FrameCount(flight) + options.frame_step - 1) / options.frame_step;
+}
+
+double WrittenFrameRate(const SimulatedFlight& flight, const LogOptions& options) {
+  return flight.frame_rate_hz / options.frame_step;
+}
+
 TimestampNs FrameTimestamp(const SimulatedFlight& flight, int frame) {
   return SecondsToNs(frame / flight.frame_rate_hz);
 }
@@ -365,15 +373,18 @@ Status WriteEurocLog(const SimulatedFlight& flight, const std::string& folder, c
   if (options.stereo_baseline_m > 0.0) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/cam1/data"));
   if (options.detections) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/objects0"));
   if (options.gps) PATROLMAP_RETURN_IF_ERROR(EnsureDirectory(folder + "/gps0"));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight, options.frame_step)));
+  PATROLMAP_RETURN_IF_ERROR(
+      WriteFileAtomically(folder + "/meta.yaml", MetaYaml(flight, WrittenFrameRate(flight, options))));
   FrameTables tables;
   PATROLMAP_RETURN_IF_ERROR(WriteFrames(flight, folder, options, progress, &tables));
   PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/data.csv", tables.images.str()));
-  PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight, options.frame_step)));
+  PATROLMAP_RETURN_IF_ERROR(
+      WriteFileAtomically(folder + "/cam0/sensor.yaml", CameraYaml(flight, WrittenFrameRate(flight, options))));
   if (options.stereo_baseline_m > 0.0) {
     PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam1/data.csv", tables.images.str()));
-    PATROLMAP_RETURN_IF_ERROR(WriteFileAtomically(folder + "/cam1/sensor.yaml",
-                                                  CameraYaml(flight, options.frame_step, options.stereo_baseline_m)));
+    PATROLMAP_RETURN_IF_ERROR(
+        WriteFileAtomically(folder + "/cam1/sensor.yaml",
+                            CameraYaml(flight, WrittenFrameRate(flight, options), options.stereo_baseline_m)));
   }
   PATROLMAP_RETURN_IF_ERROR(
       WriteFileAtomically(folder + "/imu0/sensor.yaml", "sensor_type: imu\n" + MatrixYaml(Eigen::Matrix3d::Identity()) +

@@ -103,10 +103,9 @@ Status WriteFlight(const SimulateArguments& arguments, int number, std::vector<s
   Progress progress("simulate");
   PATROLMAP_RETURN_IF_ERROR(sim::WriteEurocLog(flight, folder, arguments.log,
                                                [&progress](int done, int total) { progress.Update(done, total); }));
-  const int step = arguments.log.frame_step;
   std::printf("%s: %d frames at %.3g Hz (%.1f s), %zu objects, written to %s\n", flight.flight_id.c_str(),
-              (sim::FrameCount(flight) + step - 1) / step, flight.frame_rate_hz / step, flight.duration_s,
-              flight.objects.size(), folder.c_str());
+              sim::WrittenFrameCount(flight, arguments.log), sim::WrittenFrameRate(flight, arguments.log),
+              flight.duration_s, flight.objects.size(), folder.c_str());
   return Status::Ok();
 }
 

@@ -58,6 +58,10 @@ struct LogOptions {
   double gps_origin_altitude_m = 480.0;
 };
 
+// Frames a log written with `options` holds (every frame_step-th of the flight), and their rate [Hz].
+int WrittenFrameCount(const SimulatedFlight& flight, const LogOptions& options);
+double WrittenFrameRate(const SimulatedFlight& flight, const LogOptions& options);
+
 // Camera pose of the platform state for the flight's mount angle.
 CameraPose CameraPoseAt(const SimulatedFlight& flight, const PlatformState& state);
 
