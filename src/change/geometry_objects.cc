@@ -283,7 +283,7 @@ struct MoveCandidate {
 // Paper 003's weighted distance of a move `distance_m` long between shapes overlapping by `overlap`.
 double MoveCost(double distance_m, double overlap, const GeometryObjectOptions& options) {
   const double normalised = options.max_move_m > 0.0 ? distance_m / options.max_move_m : 0.0;
-  return options.physical_weight * normalised + options.shape_weight * (1.0 - overlap);
+  return options.physical_weight * normalised + (1.0 - options.physical_weight) * (1.0 - overlap);
 }
 
 // Whether appeared cluster `after` may be vanished cluster `before` moved; fills the candidate's cost. The shape

@@ -130,17 +130,6 @@ ByX ObjectsByX(const std::vector<MapObject>& objects) {
   return ByX(objects, [](const MapObject& object) { return object.centroid; });
 }
 
-// Paper 000's point-pair test for a moved object: the share of the current object's points that, shifted
-// by the centroid difference, lie within `distance` of the prior object's points. 1 without points.
-double MovedShapeOverlap(const MapObject& prior, const MapObject& current, double distance) {
-  if (prior.points.empty() || current.points.empty()) return 1.0;
-  const Eigen::Vector3f shift = (prior.centroid - current.centroid).cast<float>();
-  std::vector<Eigen::Vector3f> moved;
-  moved.reserve(current.points.size());
-  for (const Eigen::Vector3f& point : current.points) moved.push_back(point + shift);
-  return PairFraction(moved, prior.points, distance);
-}
-
 // A change that involves a prior object (`prior` may be null for new ones) and a current one (may be null).
 ObjectChange MakeChange(ObjectState state, const MapObject* prior, const MapObject* current, double confidence,
                         int covering_views = 0) {
@@ -296,16 +285,14 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
 }
 
 // Whether unmatched current object j may be unmatched prior object i moved: same label, within max_move_m,
-// alike in texture and top height, and of the same shape (paper 000's point-pair test after the move).
+// alike in texture and top height. (A shape test after the move, paper 000's point-pair test on the shifted
+// points, cost held-out series two of their four moves: a detected object's points are the sides one flight saw.)
 bool MayHaveMoved(const ObjectDiffOptions& options, const Matching& m, std::size_t i, std::size_t j) {
   if (m.prior_used[i] || m.current_used[j] || m.p[i].label != m.c[j].label) return false;
   if ((m.p[i].centroid - m.c[j].centroid).norm() > options.max_move_m) return false;
   if (CompareAppearance(m.p[i], m.c[j]).texture.value_or(0.0) > options.max_texture_distance) return false;
-  if (m.prior_top[i] > 0.0 && m.current_top[j] > 0.0 &&
-      std::abs(m.prior_top[i] - m.current_top[j]) > options.max_top_difference_m) {
-    return false;
-  }
-  return MovedShapeOverlap(m.p[i], m.c[j], options.moved_pair_distance_m) >= options.min_shape_overlap;
+  return m.prior_top[i] <= 0.0 || m.current_top[j] <= 0.0 ||
+         std::abs(m.prior_top[i] - m.current_top[j]) <= options.max_top_difference_m;
 }
 
 // How well the current patrol saw the place of every unmatched prior object: its covering views there and the
@@ -349,7 +336,7 @@ std::vector<Pair> MoveCandidates(const ObjectDiffOptions& options, const Matchin
   };
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     candidates[k].cost =
-        options.physical_weight * normalise(physical, k) + options.appearance_weight * normalise(appearance, k);
+        options.physical_weight * normalise(physical, k) + (1.0 - options.physical_weight) * normalise(appearance, k);
   }
   return candidates;
 }

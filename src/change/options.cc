@@ -48,14 +48,11 @@ void CheckObjects(const ObjectDiffOptions& o, OptionCheck* check) {
       .AboveAtMost("change.objects.pair_distance_m", o.pair_distance_m, 0.0, 1000.0)
       .InRange("change.objects.min_pair_fraction", o.min_pair_fraction, 0.0, 1.0)
       .InRange("change.objects.max_move_m", o.max_move_m, 0.0, 10000.0)
-      .InRange("change.objects.physical_weight", o.physical_weight, 0.0, 1000.0)
-      .InRange("change.objects.appearance_weight", o.appearance_weight, 0.0, 1000.0)
+      .InRange("change.objects.physical_weight", o.physical_weight, 0.0, 1.0)
       .InRange("change.objects.max_texture_distance", o.max_texture_distance, 0.0, 1.0)
       .AboveAtMost("change.objects.max_visible_range_m", o.max_visible_range_m, 0.0, 10000.0)
       .InRange("change.objects.min_visible_fraction", o.min_visible_fraction, 0.0, 1.0)
       .AboveAtMost("change.objects.min_expected_detections", o.min_expected_detections, 0.0, 1e6)
-      .InRange("change.objects.min_shape_overlap", o.min_shape_overlap, 0.0, 1.0)
-      .AboveAtMost("change.objects.moved_pair_distance_m", o.moved_pair_distance_m, 0.0, 1000.0)
       .InRange("change.objects.max_top_difference_m", o.max_top_difference_m, 0.0, 1000.0);
 }
 
@@ -111,8 +108,7 @@ void CheckGeometryObjects(const GeometryObjectOptions& g, OptionCheck* check) {
       .Holds("change.geometry_objects.shape_search_m", g.shape_search_m, g.shape_search_m <= 10.0 * g.shape_tolerance_m,
              "must be at most 10 times change.geometry_objects.shape_tolerance_m (the search's steps are at least "
              "half of it)")
-      .InRange("change.geometry_objects.physical_weight", g.physical_weight, 0.0, 1000.0)
-      .InRange("change.geometry_objects.shape_weight", g.shape_weight, 0.0, 1000.0)
+      .InRange("change.geometry_objects.physical_weight", g.physical_weight, 0.0, 1.0)
       .InRange("change.geometry_objects.detection_margin_m", g.detection_margin_m, 0.0, 100.0);
 }
 

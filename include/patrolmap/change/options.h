@@ -111,8 +111,8 @@ struct ObjectDiffOptions {
   double pair_distance_m = 0.25;       // ... and at least min_pair_fraction of the points of the object seen less
   double min_pair_fraction = 0.5;      // within this of the other's points (paper 000's point-pair test)
   double max_move_m = 8.0;             // moved: the two positions at most this far apart (farther: removed + new)
-  double physical_weight = 0.6;        // alpha of paper 003's weighted normalised distance
-  double appearance_weight = 0.4;      // beta
+  double physical_weight = 0.6;        // alpha of paper 003's weighted normalised distance; the appearance
+                                       // distance weighs 1 - alpha (only the ratio orders the candidates)
   double max_texture_distance = 0.25;  // pairs whose gradient-orientation histograms differ more (half their
                                        // L1 distance) are not a move
   double max_visible_range_m = 20.0;   // visibility: a prior object farther than this is not covered by a view
@@ -120,9 +120,6 @@ struct ObjectDiffOptions {
   double min_expected_detections = 3;  // removed: the current views covering a prior object would have given at
                                        // least this many detections (its prior detections x covering views now /
                                        // covering views in its own patrol); fewer: unobserved
-  double min_shape_overlap = 0.85;     // moved: share of the current object's points, shifted onto the prior
-                                       // object, within moved_pair_distance_m of its points (1 when either has none)
-  double moved_pair_distance_m = 0.15;
   double max_top_difference_m = 0.05;  // moved: the tops of the two objects (95th percentile of their points'
                                        // height) differ by at most this; objects stand on level ground
 };
@@ -154,8 +151,8 @@ struct GeometryObjectOptions {
                                        // voxel (at least shape_tolerance_m / 2), from centroid onto centroid (a
                                        // partial view pulls a centroid off the object's centre) [m]; 0 = centroids
                                        // only; at most 10 x shape_tolerance_m
-  double physical_weight = 0.6;        // alpha of paper 003's weighted distance (physical, normalised)
-  double shape_weight = 0.4;           // beta (1 - the shape overlap)
+  double physical_weight = 0.6;        // alpha of paper 003's weighted distance (physical, normalised); 1 - the
+                                       // shape overlap weighs 1 - alpha
   double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol,
                                        // or half of which lies in that object's box grown by this, is left to the
                                        // detector [m]

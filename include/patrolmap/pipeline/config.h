@@ -121,13 +121,10 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.objects.min_pair_fraction", &change.objects.min_pair_fraction);
   visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
   visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);
-  visitor->Field("change.objects.appearance_weight", &change.objects.appearance_weight);
   visitor->Field("change.objects.max_texture_distance", &change.objects.max_texture_distance);
   visitor->Field("change.objects.max_visible_range_m", &change.objects.max_visible_range_m);
   visitor->Field("change.objects.min_visible_fraction", &change.objects.min_visible_fraction);
   visitor->Field("change.objects.min_expected_detections", &change.objects.min_expected_detections);
-  visitor->Field("change.objects.min_shape_overlap", &change.objects.min_shape_overlap);
-  visitor->Field("change.objects.moved_pair_distance_m", &change.objects.moved_pair_distance_m);
   visitor->Field("change.objects.max_top_difference_m", &change.objects.max_top_difference_m);
   visitor->Field("change.grid.voxel_size_m", &change.grid.voxel_size_m);
   visitor->Field("change.grid.max_range_m", &change.grid.max_range_m);
@@ -177,7 +174,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.shape_tolerance_m", &change.geometry_objects.shape_tolerance_m);
   visitor->Field("change.geometry_objects.shape_search_m", &change.geometry_objects.shape_search_m);
   visitor->Field("change.geometry_objects.physical_weight", &change.geometry_objects.physical_weight);
-  visitor->Field("change.geometry_objects.shape_weight", &change.geometry_objects.shape_weight);
   visitor->Field("change.geometry_objects.detection_margin_m", &change.geometry_objects.detection_margin_m);
   visitor->Field("change.route_frames.interval_s", &change.route_frames.interval_s);
   visitor->Field("change.route_frames.max_width", &change.route_frames.max_width);
