@@ -399,57 +399,20 @@ int CappedColumns(const std::vector<std::size_t>& members, const std::vector<Eig
   return static_cast<int>(capped.size());
 }
 
-// A region's changed voxels seen from above (in voxels): their mean column, the horizontal direction they spread
-// along most, and their spread across it (standard deviation; 0 for voxels in one vertical plane).
-struct Slab {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero(), along = Eigen::Vector2d::UnitX();
-  double thickness = 0.0;
-};
-
-Slab SlabOf(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3i>& changed) {
-  Slab slab;
-  for (std::size_t m : members) slab.mean += changed[m].head<2>().cast<double>();
-  slab.mean /= static_cast<double>(members.size());
+// How thin a region's changed voxels are seen from above: their spread across the horizontal direction they spread
+// along most (standard deviation, in voxels; 0 for voxels in one vertical plane).
+double Thickness(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3i>& changed) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t m : members) mean += changed[m].head<2>().cast<double>();
+  mean /= static_cast<double>(members.size());
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   for (std::size_t m : members) {
-    const Eigen::Vector2d d = changed[m].head<2>().cast<double>() - slab.mean;
+    const Eigen::Vector2d d = changed[m].head<2>().cast<double>() - mean;
     covariance += d * d.transpose();
   }
   covariance /= static_cast<double>(members.size());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
-  slab.thickness = std::sqrt(std::max(0.0, solver.eigenvalues()(0)));  // the smaller, first
-  slab.along = solver.eigenvectors().col(1);
-  return slab;
-}
-
-// The voxels both patrols (`find_before`, `find_after`) saw occupied in a region's slab within `reach` voxels beyond
-// its ends along `slab.along`, at the region's heights: the fewer of its two ends. A standing surface that runs
-// through the region counts at both ends; a thing standing free, or against the end of a wall, at one at most.
-template <typename FindBefore, typename FindAfter>
-int FlankingVoxels(const std::vector<std::size_t>& members, const std::vector<Eigen::Vector3i>& changed,
-                   const Slab& slab, const FindBefore& find_before, const FindAfter& find_after, int reach) {
-  double first = std::numeric_limits<double>::infinity(), last = -first;
-  int low = std::numeric_limits<int>::max(), high = std::numeric_limits<int>::min();
-  for (std::size_t m : members) {
-    const double t = (changed[m].head<2>().cast<double>() - slab.mean).dot(slab.along);
-    first = std::min(first, t);
-    last = std::max(last, t);
-    low = std::min(low, changed[m].z());
-    high = std::max(high, changed[m].z());
-  }
-  int ends[2] = {0, 0};
-  VoxelEvidence before, after;
-  for (int end = 0; end < 2; ++end) {
-    for (int step = 1; step <= reach; ++step) {
-      const double t = end == 0 ? first - step : last + step;
-      const Eigen::Vector2i column = (slab.mean + t * slab.along).array().round().cast<int>();
-      for (int z = low; z <= high; ++z) {
-        const Eigen::Vector3i v(column.x(), column.y(), z);
-        ends[end] += find_before(v, &before) && IsOccupied(&before) && find_after(v, &after) && IsOccupied(&after);
-      }
-    }
-  }
-  return std::min(ends[0], ends[1]);
+  return std::sqrt(std::max(0.0, solver.eigenvalues()(0)));  // the smaller, first
 }
 
 // DiffGrids over `before` and a grid read through `find_after` (as OccupiedNeighbour) whose common voxels
@@ -506,13 +469,9 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     if (!region.alive || region.data.voxels < options.min_region_voxels) continue;
     const Eigen::Vector3d extent = region.data.box_max - region.data.box_min + Eigen::Vector3d::Constant(size);
     if (std::max(extent.x(), extent.y()) < options.min_region_width_m - 1e-9) continue;
-    const Slab slab = SlabOf(region.members, changed);
-    const bool thin = slab.thickness < options.min_shift_thickness_voxels;
-    if (thin && region.data.appeared > 0 && region.data.vanished > 0) continue;  // an edge seen a voxel off
-    if (thin && options.min_flank_voxels > 0 &&
-        FlankingVoxels(region.members, changed, slab, find_before, find_after, options.flank_search_voxels) >=
-            options.min_flank_voxels) {
-      continue;  // a strip of a standing surface seen through
+    if (region.data.appeared > 0 && region.data.vanished > 0 &&
+        Thickness(region.members, changed) < options.min_shift_thickness_voxels) {
+      continue;  // an edge seen a voxel off
     }
     if (options.min_capped_columns > 0 && (region.data.appeared == 0 || region.data.vanished == 0) &&
         CappedColumns(region.members, changed, find_before, find_after, options.cap_search_voxels) >=
@@ -589,7 +548,6 @@ GeometryDiffOptions ForPoseSources(GeometryDiffOptions options, const std::strin
   options.drop_ground_sheets &= PosesHaveZUp(prior_source, current_source);
   if (!ZPointsUp(prior_source, current_source)) {
     options.min_capped_columns = 0;
-    options.min_flank_voxels = 0;
   }
   return options;
 }

@@ -80,8 +80,6 @@ void CheckGeometry(const GeometryDiffOptions& g, OptionCheck* check) {
       .InRange("change.geometry.min_region_voxels", g.min_region_voxels, 1, 100000000)
       .InRange("change.geometry.min_region_width_m", g.min_region_width_m, 0.0, 1000.0)
       .InRange("change.geometry.min_shift_thickness_voxels", g.min_shift_thickness_voxels, 0.0, 100.0)
-      .InRange("change.geometry.min_flank_voxels", g.min_flank_voxels, 0, 100000)
-      .InRange("change.geometry.flank_search_voxels", g.flank_search_voxels, 1, 100)
       .InRange("change.geometry.min_capped_columns", g.min_capped_columns, 0, 100000)
       .InRange("change.geometry.cap_search_voxels", g.cap_search_voxels, 1, 100)
       .InRange("change.geometry.max_differing_share", g.max_differing_share, 0.0, 1.0);

@@ -420,55 +420,6 @@ TEST(GeometryChange, AThingWhoseTopStillStandsWasSeenThroughNotRemoved) {
   EXPECT_EQ(ForPoseSources(SceneOfChanges(), kPosesFromGps, kPosesFromStateEstimate).min_capped_columns, 2);
 }
 
-// A wall 15 voxels long and 8 high, seen solid by both patrols but for a strip 5 columns wide that the second
-// patrol's rays passed through (its middle 3 columns change; the outer 2 have the wall beside them). The wall runs on
-// beyond both ends of the strip: no region. A board that left, standing free, and one that left from against the end
-// of a wall (the wall on one side only), are regions; so is a crate two voxels deep that left from between two
-// walls in line with it (not thin). With the test off, or for a --poses file (z may not point up), the strip is a
-// region too.
-TEST(GeometryChange, AStripOfAWallSeenThroughIsNoRegionABoardThatLeftIs) {
-  Cells before, after;
-  const std::pair<int, int> solid(8, 0), free(0, 10);
-  for (int z = 1; z <= 8; ++z) {
-    for (int x = 0; x < 15; ++x) {
-      before.push_back({{x, 0, z}, solid});
-      after.push_back({{x, 0, z}, x >= 5 && x <= 9 ? free : solid});
-    }
-  }
-  for (int z = 1; z <= 3; ++z) {
-    for (int x = 30; x < 34; ++x) {  // the free board
-      before.push_back({{x, 0, z}, solid});
-      after.push_back({{x, 0, z}, free});
-    }
-    for (int x = 50; x < 62; ++x) {  // the board at x 50-53, air at 54, the wall from 55
-      before.push_back({{x, 0, z}, x == 54 ? free : solid});
-      after.push_back({{x, 0, z}, x <= 54 ? free : solid});
-    }
-    for (int x = 66; x < 78; ++x) {  // walls at x 66-68 and 75-77, the crate at 70-73, air between
-      for (int y = 0; y < 2; ++y) {
-        const bool wall = x <= 68 || x >= 75, crate = x >= 70 && x <= 73;
-        before.push_back({{x, y, z}, wall || crate ? solid : free});
-        after.push_back({{x, y, z}, wall ? solid : free});
-      }
-    }
-  }
-  const std::vector<GeometryRegion> found = RegionsBetween(before, after, SceneOfChanges());
-  ASSERT_EQ(found.size(), 3u);
-  EXPECT_EQ(found[0].vanished, 24);  // the crate
-  EXPECT_EQ(found[1].vanished, 12);
-  EXPECT_EQ(found[2].vanished, 12);
-  EXPECT_GT(std::min(found[1].centroid.x(), found[2].centroid.x()), 5.9);  // at x 6.0-6.6 and 10.0-10.6 [m]
-  GeometryDiffOptions off = SceneOfChanges(), more = SceneOfChanges();
-  off.min_flank_voxels = 0;
-  more.min_flank_voxels = 17;  // the strip's ends have 16 each: 2 wall columns 8 high within 3 voxels
-  EXPECT_EQ(RegionsBetween(before, after, off).size(), 4u);
-  EXPECT_EQ(RegionsBetween(before, after, more).size(), 4u);
-  EXPECT_EQ(
-      RegionsBetween(before, after, ForPoseSources(SceneOfChanges(), kPosesFromFile, kPosesFromStateEstimate)).size(),
-      4u);
-  EXPECT_EQ(ForPoseSources(SceneOfChanges(), kPosesFromGps, kPosesFromStateEstimate).min_flank_voxels, 2);
-}
-
 TEST(GeometryChange, DistantClustersStaySeparateAndOverlappingRegionsMerge) {
   Cells before, after;
   const auto removed_box = [&](int x0, int length) {

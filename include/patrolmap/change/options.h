@@ -217,13 +217,6 @@ struct GeometryDiffOptions {
   // horizontal axis by under this (standard deviation, in voxels): one voxel thick, a facade's edge seen a voxel off
   // from another angle, not a thing that came or left. 0 = off.
   double min_shift_thickness_voxels = 0.4;
-  // ... and so are regions as thin (min_shift_thickness_voxels) of one sign through which a standing surface runs:
-  // at both ends, within flank_search_voxels along the region's slab and at its heights, at least min_flank_voxels
-  // voxels both patrols saw occupied. A strip of a facade that one patrol's stereo saw through at a grazing angle,
-  // not a thing that came or left. Only where z points up (ForPoseSources). 0 = off (as is min_shift_thickness_voxels
-  // 0, which leaves no region thin).
-  int min_flank_voxels = 2;
-  int flank_search_voxels = 3;
   // ... and so are regions whose voxels all appeared or all vanished when, in at least min_capped_columns of their
   // columns, a voxel both patrols saw occupied stands at most cap_search_voxels above a changed one: the top of a
   // thing still there, whose lower part one patrol's stereo saw through (a plain or dark side). Only where z points

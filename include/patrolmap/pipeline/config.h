@@ -144,8 +144,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry.min_region_width_m", &change.geometry.min_region_width_m);
   visitor->Field("change.geometry.drop_ground_sheets", &change.geometry.drop_ground_sheets);
   visitor->Field("change.geometry.min_shift_thickness_voxels", &change.geometry.min_shift_thickness_voxels);
-  visitor->Field("change.geometry.min_flank_voxels", &change.geometry.min_flank_voxels);
-  visitor->Field("change.geometry.flank_search_voxels", &change.geometry.flank_search_voxels);
   visitor->Field("change.geometry.min_capped_columns", &change.geometry.min_capped_columns);
   visitor->Field("change.geometry.cap_search_voxels", &change.geometry.cap_search_voxels);
   visitor->Field("change.geometry.max_differing_share", &change.geometry.max_differing_share);
