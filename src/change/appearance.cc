@@ -272,7 +272,6 @@ const char* DropReasonName(DropReason reason) {
     case DropReason::kAtPriorEdge: return "at_prior_edge";
     case DropReason::kFeaturesStillMatch: return "features_still_match";
     case DropReason::kShiftedCopy: return "shifted_copy";
-    case DropReason::kSameDepth: return "same_depth";
     case DropReason::kNotSeenFromSecondPrior: return "not_seen_from_second_prior";
   }
   return "unknown";

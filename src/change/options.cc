@@ -134,8 +134,6 @@ void CheckRoute(const RouteCompareOptions& r, OptionCheck* check) {
       .AboveAtMost("change.route.depth.max_range_m", r.depth.max_range_m, 0.0, 10000.0)
       .AboveAtMost("change.route.depth.min_change_m", r.depth.min_change_m, 0.0, 1000.0)
       .InRange("change.route.depth.sigmas", r.depth.sigmas, 0.0, 100.0)
-      .InRange("change.route.depth.unchanged_known_share", r.depth.unchanged_known_share, 0.0, 1.0)
-      .InRange("change.route.depth.unchanged_max_marked_share", r.depth.unchanged_max_marked_share, 0.0, 1.0)
       .InRange("change.route.depth.parallax_min_marked_share", r.depth.parallax_min_marked_share, 0.0, 1.0)
       .InRange("change.route.depth.parallax_known_share", r.depth.parallax_known_share, 0.0, 1.0)
       .InRange("change.route.depth.parallax_slack_px", r.depth.parallax_slack_px, 0, 100);

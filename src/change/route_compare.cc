@@ -158,7 +158,6 @@ RoutePair ComparePair(const Alignment& alignment, const std::vector<KeyFrameView
   const cv::Mat marks = VisibilityChange(prior_views[prior], current, options.depth);
   pair.appearance = CompareRegistered(prior_views[prior], current, registration, appearance, marks,
                                       parallax(prior, registration, marks));
-  DropWhereDepthAgrees(prior_views[prior], current, marks, options.depth, &pair.appearance);
   if (alignment.registered.size() > 1 && !pair.appearance.regions.empty()) {
     const auto& [second_registration, second_prior] = alignment.registered[1];
     const cv::Mat second_marks = VisibilityChange(prior_views[second_prior], current, options.depth);

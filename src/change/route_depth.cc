@@ -92,29 +92,6 @@ cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current,
   return marks;
 }
 
-void DropWhereDepthAgrees(const KeyFrameView& prior, const KeyFrameView& current, const cv::Mat& marks,
-                          const RouteDepthOptions& options, AppearanceChange* change) {
-  if (options.unchanged_max_marked_share <= 0.0 || prior.depth.empty() || current.depth.empty() || marks.empty()) {
-    return;  // off (no share is under 0), or nothing to test
-  }
-  const auto share = [](const cv::Mat& image, const cv::Rect& box) {  // of the box's pixels above 0
-    const cv::Rect inside = box & cv::Rect(0, 0, image.cols, image.rows);
-    return inside.area() > 0 ? static_cast<double>(cv::countNonZero(image(inside) > 0)) / inside.area() : 0.0;
-  };
-  std::vector<AppearanceRegion> kept;
-  for (AppearanceRegion& region : change->regions) {
-    const bool same = share(current.depth, region.current_box) >= options.unchanged_known_share &&
-                      share(prior.depth, region.prior_box) >= options.unchanged_known_share &&
-                      share(marks, region.current_box) < options.unchanged_max_marked_share;
-    if (same) {
-      change->dropped.push_back({std::move(region), DropReason::kSameDepth});
-    } else {
-      kept.push_back(std::move(region));
-    }
-  }
-  change->regions = std::move(kept);
-}
-
 std::optional<ParallaxPrediction> PredictParallax(const KeyFrameView& prior, const KeyFrameView& current,
                                                   const cv::Mat& current_from_prior, const cv::Mat& marks,
                                                   const cv::Rect& box, const RouteDepthOptions& options) {

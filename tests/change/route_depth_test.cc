@@ -316,56 +316,6 @@ TEST(RouteDepth, ASurfaceTheOtherPatrolSawThroughIsChangedAndNothingElse) {
   EXPECT_TRUE(VisibilityChange(no_depth, empty, RouteDepthOptions{}).empty());
 }
 
-// With the test on, a region on an unchanged wall (both depths known, nothing marked) is dropped; one on a new
-// surface, one where either frame lacks depth over half its box, and every region of a pair without depth are kept.
-// Off (the default: paint looks the same), none is dropped.
-TEST(RouteDepth, ARegionWhereBothDepthsAgreeIsLightAndDropped) {
-  const cv::Rect box(150, 100, 60, 50), on_wall(20, 20, 40, 40), blind(250, 20, 40, 40), half_blind(20, 160, 40, 40);
-  const KeyFrameView prior = WithDepth(At(0.0), cv::Rect());
-  KeyFrameView current = WithDepth(At(0.0), box);
-  current.depth(blind).setTo(0.0f);
-  current.depth(cv::Rect(half_blind.x, half_blind.y, half_blind.width, half_blind.height * 6 / 10)).setTo(0.0f);
-  const cv::Mat marks = VisibilityChange(prior, current, RouteDepthOptions{});
-  AppearanceChange change;
-  for (const cv::Rect& r : {box, on_wall, blind, half_blind}) {
-    AppearanceRegion region;
-    region.current_box = region.prior_box = r;
-    change.regions.push_back(region);
-  }
-  const AppearanceChange all = change;
-  RouteDepthOptions on;
-  on.unchanged_max_marked_share = 0.02;
-  DropWhereDepthAgrees(prior, current, marks, on, &change);
-  ASSERT_EQ(change.regions.size(), 3u);
-  EXPECT_EQ(change.regions[0].current_box, box);
-  EXPECT_EQ(change.regions[1].current_box, blind);
-  EXPECT_EQ(change.regions[2].current_box, half_blind);
-  ASSERT_EQ(change.dropped.size(), 1u);
-  EXPECT_EQ(change.dropped[0].region.current_box, on_wall);
-  EXPECT_EQ(change.dropped[0].reason, DropReason::kSameDepth);
-  // The prior's box counts on its own: a prior frame without depth there keeps the region.
-  KeyFrameView prior_blind = prior;
-  prior_blind.depth = prior.depth.clone();
-  prior_blind.depth(on_wall).setTo(0.0f);
-  change = all;
-  DropWhereDepthAgrees(prior_blind, current, marks, on, &change);
-  EXPECT_EQ(change.regions.size(), 4u);
-  // A few marked pixels (a twentieth of the box) keep it too.
-  cv::Mat some = marks.clone();
-  some(cv::Rect(on_wall.x, on_wall.y, on_wall.width, 2)).setTo(255);
-  change = all;
-  DropWhereDepthAgrees(prior, current, some, on, &change);
-  EXPECT_EQ(change.regions.size(), 4u);
-  KeyFrameView no_depth = current;
-  no_depth.depth.release();
-  change = all;
-  DropWhereDepthAgrees(prior, no_depth, marks, on, &change);
-  EXPECT_EQ(change.regions.size(), 4u);
-  change = all;
-  DropWhereDepthAgrees(prior, current, marks, RouteDepthOptions{}, &change);
-  EXPECT_EQ(change.regions.size(), 4u);
-}
-
 // The current camera stands 1 m to the right of the prior one; the pair is registered on the wall 10 m away (the
 // prior 23 px to the right). A wall pixel then shows in the registered prior where it is, and the box 6 m away
 // 15.3 px further right (f * 1 m / 6 m - f * 1 m / 10 m). The prediction needs the box marked changed, its depth

@@ -61,7 +61,6 @@ enum class DropReason {
   kAtPriorEdge,             // within edge_margin_px of where the registered prior frame ends
   kFeaturesStillMatch,      // under min_unmatched_share of its features lost their match (parallax)
   kShiftedCopy,             // the prior shows its content a few pixels off (parallax_search_px; parallax)
-  kSameDepth,               // along the route: both frames know its depth and it did not change (light)
   kNotSeenFromSecondPrior,  // along the route: a second prior frame shows no region there
 };
 const char* DropReasonName(DropReason reason);  // snake case, as in the evaluation's JSON

@@ -59,11 +59,6 @@ struct RouteDepthOptions {
   // this, and by more than sigmas times the two range errors.
   double min_change_m = 0.5;
   double sigmas = 3.0;
-  // A region whose box both frames know the depth of over this share, and ...
-  double unchanged_known_share = 0.5;
-  // ... of which the visibility test marked under this share, lies on unchanged geometry and is dropped: light, but
-  // also paint, a stain or a crack. 0 (the default) drops none.
-  double unchanged_max_marked_share = 0.0;
   // Where the visibility test marked at least parallax_min_marked_share of a region's box (the geometry changed)
   // and the current frame knows the depth of over parallax_known_share of it, the depth predicts where the
   // registered prior shows the region's content if nothing changed there (its parallax), and the shifted-copy test

@@ -37,13 +37,6 @@ bool AddMotionDepth(const std::vector<RouteNeighbour>& neighbours, const depth::
 // saw through; empty when either view has no depth.
 cv::Mat VisibilityChange(const KeyFrameView& prior, const KeyFrameView& current, const RouteDepthOptions& options);
 
-// Moves to `change->dropped` (DropReason::kSameDepth) each region whose box the current view and whose prior box the
-// prior view know the depth of over `unchanged_known_share`, and of which `marks` (VisibilityChange's) hold under
-// `unchanged_max_marked_share`: the same surfaces at the same depth, lit otherwise. Nothing is dropped where either
-// view has no depth or `marks` is empty.
-void DropWhereDepthAgrees(const KeyFrameView& prior, const KeyFrameView& current, const cv::Mat& marks,
-                          const RouteDepthOptions& options, AppearanceChange* change);
-
 // Where the prior view, registered onto the current one by `current_from_prior`, shows the content of the current
 // view's `box` if nothing changed there: each pixel of the box with depth is put in space, seen from the prior camera
 // and carried by the homography; the shift is the median over them, its slack `parallax_slack_px`. None where either

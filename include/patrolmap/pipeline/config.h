@@ -192,8 +192,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.depth.max_range_m", &change.route.depth.max_range_m);
   visitor->Field("change.route.depth.min_change_m", &change.route.depth.min_change_m);
   visitor->Field("change.route.depth.sigmas", &change.route.depth.sigmas);
-  visitor->Field("change.route.depth.unchanged_known_share", &change.route.depth.unchanged_known_share);
-  visitor->Field("change.route.depth.unchanged_max_marked_share", &change.route.depth.unchanged_max_marked_share);
   visitor->Field("change.route.depth.parallax_min_marked_share", &change.route.depth.parallax_min_marked_share);
   visitor->Field("change.route.depth.parallax_known_share", &change.route.depth.parallax_known_share);
   visitor->Field("change.route.depth.parallax_slack_px", &change.route.depth.parallax_slack_px);
