@@ -5,7 +5,6 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/video/tracking.hpp>
 
 #include "patrolmap/vocab/descriptors.h"
 
@@ -131,31 +130,6 @@ void ComparePixels(const cv::Mat& current, const cv::Mat& warped, double gain, d
   *difference = cv::max(*difference, SmallestDifference(compensated, current, r));
   const cv::Mat prior_way = 1.0 - BestStructure(warped, current, r, sigma);
   *structure_change = cv::max(*structure_change, prior_way);
-}
-
-// Registers `warped` (the prior image, carried onto the current one by the homography) onto `current`
-// locally: DIS dense flow from the current image to the gain-compensated prior, flows longer than
-// `max_flow_px` left at zero (what the flow cannot explain stays for the comparison), and `warped` resampled
-// along it. Parallax off the homography's plane is then registered too.
-void FollowFlow(const cv::Mat& current, double gain, double offset, double max_flow_px, cv::Mat* warped) {
-  cv::Mat current8, prior8, flow;
-  current.convertTo(current8, CV_8U);
-  warped->convertTo(prior8, CV_8U, gain, offset);
-  cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM)->calc(current8, prior8, flow);
-  cv::Mat map(flow.size(), CV_32FC2);
-  const float max_squared = static_cast<float>(max_flow_px * max_flow_px);
-  for (int y = 0; y < flow.rows; ++y) {
-    const cv::Vec2f* f = flow.ptr<cv::Vec2f>(y);
-    cv::Vec2f* m = map.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < flow.cols; ++x) {
-      const bool kept = f[x].dot(f[x]) <= max_squared;
-      m[x] =
-          cv::Vec2f(static_cast<float>(x) + (kept ? f[x][0] : 0.0f), static_cast<float>(y) + (kept ? f[x][1] : 0.0f));
-    }
-  }
-  cv::Mat resampled;
-  cv::remap(*warped, resampled, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-  *warped = resampled;
 }
 
 // Fits up to max_planes - 1 more homographies, each to the matches (`from` -> `to`) that no plane before
@@ -331,7 +305,6 @@ AppearanceChange CompareRegistered(const KeyFrameView& prior, const KeyFrameView
   result.compared_fraction = static_cast<double>(compared) / mask.total();
   if (compared == 0) return result;
   FitLighting(warped, current_f, mask, &result.gain, &result.offset);
-  if (options.dense_flow) FollowFlow(current_f, result.gain, result.offset, options.max_flow_px, &warped);
 
   cv::Mat global, local;
   ComparePixels(current_f, warped, result.gain, result.offset, options, &global, &local);

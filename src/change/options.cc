@@ -22,7 +22,6 @@ void CheckAppearance(const AppearanceOptions& a, OptionCheck* check) {
       .InRange("change.appearance.horizontal_parallax_search_px", a.horizontal_parallax_search_px, 0, 200)
       .InRange("change.appearance.max_shifted_similarity", a.max_shifted_similarity, -1.0, 1.0)
       .InRange("change.appearance.edge_margin_px", a.edge_margin_px, 0, 1000)
-      .InRange("change.appearance.max_flow_px", a.max_flow_px, 0.0, 1000.0)
       .InRange("change.appearance.max_planes", a.max_planes, 1, 8);
 }
 

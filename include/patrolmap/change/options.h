@@ -29,10 +29,6 @@ struct AppearanceOptions {
   int horizontal_parallax_search_px = 24;
   // ... and regions within this far of where the registered prior frame ends inside the current one (0: kept).
   int edge_margin_px = 1;
-  // After the homography, register the pair locally by dense optical flow (DIS), so parallax off the
-  // homography's plane does not differ; flows longer than max_flow_px are not followed.
-  bool dense_flow = false;
-  double max_flow_px = 12.0;
   // Planes registered per pair: after the dominant homography, further ones are fitted to the matches none
   // before explains (each needs min_inliers), and each pixel is compared through the plane that registers it
   // best: a facade and the ground, or a nearer building, seen with parallax. 1: the dominant plane only.

@@ -98,9 +98,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.appearance.horizontal_parallax_search_px", &change.appearance.horizontal_parallax_search_px);
   visitor->Field("change.appearance.max_shifted_similarity", &change.appearance.max_shifted_similarity);
   visitor->Field("change.appearance.edge_margin_px", &change.appearance.edge_margin_px);
-  visitor->Field("change.appearance.dense_flow", &change.appearance.dense_flow);
   visitor->Field("change.appearance.both_ways", &change.appearance.both_ways);
-  visitor->Field("change.appearance.max_flow_px", &change.appearance.max_flow_px);
   visitor->Field("change.appearance.max_planes", &change.appearance.max_planes);
   visitor->Field("change.object_map.centroid_gate_m", &change.object_map.centroid_gate_m);
   visitor->Field("change.object_map.pair_distance_m", &change.object_map.pair_distance_m);
