@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ablation of the change layer's rules (BENCHMARKS.md, "What each change rule is worth"): re-runs the comparison
+# Ablation of the change layer's rules (docs/change_rules.md): re-runs the comparison
 # of every patrol of finished scripts/change_study.sh runs once per line of ABLATIONS, with that line's keys set
 # over the study's configuration (`diff --set`, without mapping again), scores each with `eval`, and prints one
 # markdown row per line: object changes, changed voxels, appearance at places and along the route, the fused list
@@ -37,7 +37,8 @@ run_ablation() {  # name key=value...: one jsonl line per patrol into OUT/NAME.j
         local logs=(--log "$dir/logs/flight_$n" --log "$dir/logs/flight_$((n - 1))")
         [ "$n" = 3 ] && logs+=(--log "$dir/logs/flight_1")
         "$pm" eval "$run" "${logs[@]}" -c "$study/study.yaml" ${sets[@]+"${sets[@]}"} --json 2>"$run/eval.log" |
-          /usr/bin/python3 -c "import json,sys; r=json.load(sys.stdin)['changes']; r['series']='$(basename "$dir")'; print(json.dumps(r))" \
+          /usr/bin/python3 -c "import json,sys; r=json.load(sys.stdin)['changes']; r['series']=sys.argv[1]; print(json.dumps(r))" \
+            "$(basename "$dir")" \
           >> "$out/$name.jsonl"
       done
     done

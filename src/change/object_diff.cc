@@ -286,7 +286,7 @@ void MatchPersistent(const ObjectDiffOptions& options, Matching* m, std::vector<
 
 // Whether unmatched current object j may be unmatched prior object i moved: same label, within max_move_m,
 // alike in texture and top height. (A shape test after the move, paper 000's point-pair test on the shifted
-// points, cost held-out series two of their four moves: a detected object's points are the sides one flight saw.)
+// points, lost two of ten moves on held-out series: a detected object's points are the sides one flight saw.)
 bool MayHaveMoved(const ObjectDiffOptions& options, const Matching& m, std::size_t i, std::size_t j) {
   if (m.prior_used[i] || m.current_used[j] || m.p[i].label != m.c[j].label) return false;
   if ((m.p[i].centroid - m.c[j].centroid).norm() > options.max_move_m) return false;

@@ -12,8 +12,8 @@
 // best horizontal shift of up to shape_search_m each way in steps of a voxel or half shape_tolerance_m, since a partial
 // view pulls a centroid off the object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its
 // voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper 003's weighted distance
-// (physical_weight x distance / max_move_m + (1 - physical_weight) x (1 - overlap)). An object moved less than its own length
-// changes only at the ground it left and took; where one patrol's grid completes it whole and the other's holds only
+// (physical_weight x distance / max_move_m + (1 - physical_weight) x (1 - overlap)). An object moved less than its
+// own length changes only at the ground it left and took; where one patrol's grid completes it whole and the other's holds only
 // that changed part, the two are one move (partial_moves) when the whole, shifted, covers the part and lands on
 // surfaces the other grid holds and its own does not (the whole reported at both places). Unchanged space never makes
 // an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a cluster
