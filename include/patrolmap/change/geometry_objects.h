@@ -13,12 +13,13 @@
 // view pulls a centroid off the object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its
 // voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper 003's weighted distance
 // (physical_weight x distance / max_move_m + (1 - physical_weight) x (1 - overlap)). An object moved less than its
-// own length changes only at the ground it left and took; where one patrol's grid completes it whole and the other's holds only
-// that changed part, the two are one move (partial_moves) when the whole, shifted, covers the part and lands on
-// surfaces the other grid holds and its own does not (the whole reported at both places). Unchanged space never makes
-// an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a cluster
-// whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at least
-// half of whose voxels lie in that object's box grown by detection_margin_m, is left to the detected objects' states.
+// own length changes only at the ground it left and took; where one patrol's grid completes it whole and the other's
+// holds only that changed part, the two are one move (partial_moves) when the whole, shifted, covers the part and lands
+// on surfaces the other grid holds and its own does not (the whole reported at both places). Unchanged space never
+// makes an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a
+// cluster whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at
+// least half of whose voxels lie in that object's box grown by detection_margin_m, is left to the detected objects'
+// states.
 #pragma once
 
 #include <vector>
