@@ -16,12 +16,10 @@ namespace {
 
 depth::MotionStereoOptions MatchingOptions(const RouteDepthOptions& options) {
   depth::MotionStereoOptions motion;
-  motion.min_baseline_m = options.min_baseline_m;
-  motion.min_sideways_share = options.min_sideways_share;
+  motion.min_baseline_m = options.baselines.min_baseline_m;
+  motion.min_sideways_share = options.baselines.min_sideways_share;
+  motion.matching = options.matching;
   motion.matching.num_disparities = options.num_disparities;
-  motion.matching.block_size = options.block_size;
-  motion.matching.disparity_sigma_px = options.disparity_sigma_px;
-  motion.matching.max_range_m = options.max_range_m;
   motion.agree_m = options.min_change_m;
   motion.agree_sigmas = options.sigmas;
   return motion;

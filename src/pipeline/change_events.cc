@@ -131,7 +131,7 @@ ChangeMonitor::ChangeMonitor(const graph::TopoMap* prior, const std::string& pri
   std::vector<change::GridSource> sources;
   reference_ = change::LatestState(*prior, *prior_record_, &sources);
   prior_record_ = &reference_;
-  change::ChangeOptions live = config.change;
+  change::ChangeOptions live = ChangeOptionsOf(config);
   live.geometry.min_observations = options.min_observations;
   detector_.emplace(*prior_record_, live);
 }

@@ -183,6 +183,13 @@ Status LoadConfig(const std::string& path, Config* config) {
   return Status::Ok();
 }
 
+::patrolmap::change::ChangeOptions ChangeOptionsOf(const Config& config) {
+  ::patrolmap::change::ChangeOptions options = config.change;
+  options.route.depth.matching = config.depth.stereo;
+  options.route.depth.baselines = config.depth.flight;
+  return options;
+}
+
 std::string ConfigToYaml(const Config& config) {
   Config copy = config;
   YamlWriter writer;

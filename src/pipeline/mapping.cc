@@ -282,11 +282,11 @@ Status RunMapping(const MappingRequest& request, MappingOutcome* outcome) {
   for (const std::string& source : request.sources) {
     PATROLMAP_RETURN_IF_ERROR(MapSource(request, source, config, prior, &recognizer, monitor.get(), outcome));
   }
-  graph::TopoMap map = AssembleMap(prior, TagOf(vocabulary, vocabulary_path), config.change, outcome);
+  graph::TopoMap map = AssembleMap(prior, TagOf(vocabulary, vocabulary_path), ChangeOptionsOf(config), outcome);
   std::vector<change::ChangeItem> entries;
   if (!request.prior_map.empty()) {
-    PATROLMAP_RETURN_IF_ERROR(
-        ReportLastFlight(prior, &map, config.change, request.out, &outcome->report, &outcome->compared, &entries));
+    PATROLMAP_RETURN_IF_ERROR(ReportLastFlight(prior, &map, ChangeOptionsOf(config), request.out, &outcome->report,
+                                               &outcome->compared, &entries));
   }
   change::NumberAllSiteObjects(&map);
   if (monitor != nullptr && outcome->compared) {

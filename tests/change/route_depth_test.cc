@@ -175,7 +175,7 @@ TEST(RouteDepth, NeighboursTooCloseOrAheadGiveNoDepth) {
       AddMotionDepth({{View(wall, 8.0, 0.2), At(0.2)}}, depth::Lens(Camera()), At(0.0), options, &view));      // 0.2 m
   EXPECT_FALSE(AddMotionDepth({{view.image, At(0.0, 1.5)}}, depth::Lens(Camera()), At(0.0), options, &view));  // ahead
   EXPECT_TRUE(view.depth.empty());
-  options.min_baseline_m = 0.1;
+  options.baselines.min_baseline_m = 0.1;
   EXPECT_TRUE(AddMotionDepth({{View(wall, 8.0, 0.2), At(0.2)}}, depth::Lens(Camera()), At(0.0), options, &view));
 }
 
@@ -205,8 +205,8 @@ std::vector<AloeShares> AloeAsRouteFrames(const Distortion& distortion) {
   }
   RouteDepthOptions options;
   options.num_disparities = 256;  // Aloe's disparities reach 211 px
-  options.max_range_m = 1000.0;
-  options.min_baseline_m = 0.05;
+  options.matching.max_range_m = 1000.0;
+  options.baselines.min_baseline_m = 0.05;
   enum Way { kAsFlown, kMirrored, kTransposed };
   std::vector<AloeShares> shares;
   for (const Way way : {kAsFlown, kMirrored, kTransposed}) {

@@ -36,7 +36,7 @@ int RunDiff(const DiffArguments& arguments) {
     return Fail(Status::InvalidArgument(arguments.map + ": needs two flights to compare"));
   if (from == to) return Fail(Status::InvalidArgument("--from and --to name the same flight '" + from + "'"));
   change::ChangeReport report;
-  status = pipeline::CompareFlights(map, from, to, config.change, &report);
+  status = pipeline::CompareFlights(map, from, to, pipeline::ChangeOptionsOf(config), &report);
   if (!status.ok()) return Fail(Status::InvalidArgument(arguments.map + ": " + status.message()));
   pipeline::AddSiteHistories(map, config.change.objects, &report);
   status = change::WriteChangeReport(report, map, arguments.out);

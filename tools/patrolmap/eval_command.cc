@@ -27,7 +27,7 @@ int RunEval(EvalArguments arguments) {
   pipeline::Config config;
   nlohmann::json report;
   Status status = LoadCheckedConfig(arguments.config, arguments.settings, &config);
-  arguments.scores.change = config.change;
+  arguments.scores.change = pipeline::ChangeOptionsOf(config);
   if (status.ok()) status = eval::ScoreRun(arguments.run, arguments.logs, arguments.scores, &report);
   if (!status.ok()) {
     spdlog::error("{}", status.message());

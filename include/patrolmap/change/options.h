@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include "patrolmap/depth/options.h"
+
 namespace patrolmap::change {
 
 // Appearance: changed regions between two registered key frames.
@@ -44,13 +46,13 @@ struct AppearanceOptions {
 // it in its own patrol (motion stereo: one flight, so one light), and a compared pair's pixels also count as changed
 // where one patrol's surface lies in the space the other patrol saw through.
 struct RouteDepthOptions {
-  bool enabled = true;              // needs poses both patrols place in one world frame (not GPS fixes)
-  double min_baseline_m = 0.3;      // frames closer together than this give no depth [m]
-  double min_sideways_share = 0.7;  // ... nor frames whose baseline runs less than this share across the optical axis
-  int num_disparities = 128;        // disparity search range [px], a multiple of 16
-  int block_size = 5;               // matched block side [px], odd
-  double disparity_sigma_px = 0.5;  // matching noise: the range error is z^2 * this / (f * baseline)
-  double max_range_m = 30.0;        // depths beyond this are left unknown [m]
+  bool enabled = true;        // needs poses both patrols place in one world frame (not GPS fixes)
+  int num_disparities = 128;  // disparity search range [px], a multiple of 16
+  // How the frames are matched and which neighbours are used: the configuration's depth.stereo options (block size,
+  // matching noise, range) and depth.flight's baseline limits, which pipeline::ChangeOptionsOf copies here; not keys
+  // of their own.
+  depth::StereoOptions matching;
+  depth::FlightDepthOptions baselines;
   // A surface counts as gone (or new) where the other patrol's depth along the ray lies beyond it by more than
   // this, and by more than sigmas times the two range errors.
   double min_change_m = 0.5;

@@ -182,12 +182,7 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.route.min_votes", &change.route.min_votes);
   visitor->Field("change.route.min_overlap", &change.route.min_overlap);
   visitor->Field("change.route.depth.enabled", &change.route.depth.enabled);
-  visitor->Field("change.route.depth.min_baseline_m", &change.route.depth.min_baseline_m);
-  visitor->Field("change.route.depth.min_sideways_share", &change.route.depth.min_sideways_share);
   visitor->Field("change.route.depth.num_disparities", &change.route.depth.num_disparities);
-  visitor->Field("change.route.depth.block_size", &change.route.depth.block_size);
-  visitor->Field("change.route.depth.disparity_sigma_px", &change.route.depth.disparity_sigma_px);
-  visitor->Field("change.route.depth.max_range_m", &change.route.depth.max_range_m);
   visitor->Field("change.route.depth.min_change_m", &change.route.depth.min_change_m);
   visitor->Field("change.route.depth.sigmas", &change.route.depth.sigmas);
   visitor->Field("change.route.depth.parallax_min_marked_share", &change.route.depth.parallax_min_marked_share);
@@ -239,6 +234,11 @@ Status ApplySettings(const std::vector<std::string>& settings, Config* config);
 // (Config::IsValid).
 Status LoadCheckedConfig(const std::string& path, const std::vector<std::string>& settings, Config* config);
 inline Status LoadCheckedConfig(const std::string& path, Config* config) { return LoadCheckedConfig(path, {}, config); }
+
+// The change stage's options as the configuration sets them: config.change, with the depth section's matching and
+// baseline options copied into the route's motion stereo (change.route.depth matches route frames as depth.stereo
+// and depth.flight say).
+::patrolmap::change::ChangeOptions ChangeOptionsOf(const Config& config);
 
 // The configuration as YAML (every key, nested sections).
 std::string ConfigToYaml(const Config& config);
