@@ -21,7 +21,7 @@ std::vector<graph::ClosureMatches> MatchClosures(const graph::TopoMap& map, cons
     const double scale_a = ThumbnailScale(map, e.a), scale_b = ThumbnailScale(map, e.b);
     if (scale_a <= 0.0 || scale_b <= 0.0) continue;
     const KeyFrameNode &a = map.node(e.a), &b = map.node(e.b);
-    place::VerifyPair(options, a.points, a.descriptors, b.points, b.descriptors, nullptr, nullptr, &inliers);
+    place::VerifyPair(options, a.points, a.descriptors, b.points, b.descriptors, &inliers);
     for (const auto& [i, j] : inliers) {
       matches.pairs.push_back({static_cast<float>(a.points[i].x * scale_a), static_cast<float>(a.points[i].y * scale_a),
                                static_cast<float>(b.points[j].x * scale_b),

@@ -45,26 +45,6 @@ struct Match {
   float distance = 0.0f;
 };
 
-// Ratio-test matches of query features among the candidate features of the same group.
-void MatchWithinGroups(const cv::Mat& query, const std::vector<std::uint32_t>& query_groups, const cv::Mat& candidate,
-                       const std::vector<std::uint32_t>& candidate_groups, double ratio, std::vector<Match>* matches) {
-  std::multimap<std::uint32_t, int> by_group;
-  for (int j = 0; j < candidate.rows; ++j) by_group.emplace(candidate_groups[j], j);
-  for (int i = 0; i < query.rows; ++i) {
-    double best = std::numeric_limits<double>::max(), second = best;
-    int best_index = -1;
-    const auto range = by_group.equal_range(query_groups[i]);
-    for (auto it = range.first; it != range.second; ++it) {
-      const double distance = cv::norm(query.row(i), candidate.row(it->second), cv::NORM_L2);
-      if (distance < best)
-        second = best, best = distance, best_index = it->second;
-      else if (distance < second)
-        second = distance;
-    }
-    if (best_index >= 0 && best < ratio * second) matches->push_back({i, best_index, static_cast<float>(best)});
-  }
-}
-
 void MatchAll(const cv::Mat& query, const cv::Mat& candidate, double ratio, std::vector<Match>* matches) {
   if (query.type() == CV_8U && candidate.type() == CV_8U) {  // as a node keeps them: BFMatcher's result, faster
     std::vector<vocab::NearestTwo> nearest;
@@ -179,8 +159,6 @@ bool PlaceOptions::IsValid(std::string* error) const {
              .AboveAtMost("place.inlier_threshold_px", inlier_threshold_px, 0.0, 100.0)
              .InRange("place.min_inliers", min_inliers, 8, 100000)
              .InRange("place.max_log_nfa", max_log_nfa, -1000.0, 1000.0)
-             .InRange("place.max_topological_gap", max_topological_gap, 0, 1000000)
-             .InRange("place.direct_index_levels_up", direct_index_levels_up, 0, 32)
              .ok() &&
          query.IsValid(error);
 }
@@ -210,27 +188,20 @@ cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& option
 }
 
 Verification PlaceRecognizer::Verify(const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
-                                     const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
-                                     const std::vector<std::uint32_t>* query_groups,
-                                     const std::vector<std::uint32_t>* candidate_groups) const {
-  return VerifyPair(options_, query_points, query, candidate_points, candidate, query_groups, candidate_groups);
+                                     const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate) const {
+  return VerifyPair(options_, query_points, query, candidate_points, candidate);
 }
 
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point2f>& query_points,
                         const cv::Mat& query_descriptors, const std::vector<cv::Point2f>& candidate_points,
-                        const cv::Mat& candidate_descriptors, const std::vector<std::uint32_t>* query_groups,
-                        const std::vector<std::uint32_t>* candidate_groups, std::vector<std::pair<int, int>>* inliers) {
+                        const cv::Mat& candidate_descriptors, std::vector<std::pair<int, int>>* inliers) {
   // Packed 4-bit rows are matched as the 8-bit values they stand for.
   const cv::Mat query = vocab::Expanded(query_descriptors), candidate = vocab::Expanded(candidate_descriptors);
   Verification verification;
   if (inliers != nullptr) inliers->clear();
   if (query.rows < 2 || candidate.rows < 2 || query.type() != candidate.type()) return verification;
   std::vector<Match> matches;
-  if (query_groups != nullptr && candidate_groups != nullptr) {
-    MatchWithinGroups(query, *query_groups, candidate, *candidate_groups, options.ratio, &matches);
-  } else {
-    MatchAll(query, candidate, options.ratio, &matches);
-  }
+  MatchAll(query, candidate, options.ratio, &matches);
   if (options.one_to_one) KeepOneToOne(candidate.rows, &matches);
   std::vector<cv::Point2f> from, to;
   for (const Match& match : matches) {
@@ -257,47 +228,24 @@ Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point
 }
 
 bool PlaceRecognizer::Allowed(const KeyFrame& query, int node) const {
-  const KeyFrameNode& candidate = nodes_[node].key;
-  if (!Plausible(query, node)) return false;
+  const KeyFrameNode& candidate = nodes_[node];
   if (candidate.flight != query.flight) return true;
   if (!query.timed) return query.frame_index - candidate.frame_index > options_.exclude_recent_images;
   return NsToSeconds(query.timestamp_ns - candidate.timestamp_ns) >= options_.exclude_recent_s;
 }
 
-bool PlaceRecognizer::Plausible(const KeyFrame& query, int node) const {
-  if (options_.max_topological_gap <= 0) return true;
-  const auto last = last_match_.find(query.flight);
-  if (last == last_match_.end() || last->second < 0) return true;
-  const int anchor = last->second;
-  return nodes_[node].key.flight == nodes_[anchor].key.flight &&
-         std::abs(node - anchor) <= options_.max_topological_gap;
-}
-
-std::vector<std::uint32_t> PlaceRecognizer::Groups(const cv::Mat& descriptors) const {
-  // The words of the features are not kept in a map file; re-quantise float descriptors to group them.
-  cv::Mat as_float;
-  vocab::Expanded(descriptors)
-      .convertTo(as_float, CV_32F, descriptors.type() == CV_8U && options_.root_sift ? 1.0 / 255 : 1.0);
-  std::vector<vocab::WordId> words;
-  vocabulary_->Quantize(as_float, &words);
-  std::vector<std::uint32_t> groups;
-  for (vocab::WordId word : words) groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
-  return groups;
-}
-
-PlaceRecognizer::Node PlaceRecognizer::StoredNode(const KeyFrameNode& described) const {
-  Node node;
-  node.key.flight = described.flight;
-  node.key.timestamp_ns = described.timestamp_ns;
-  node.key.frame_index = described.frame_index;
-  node.key.points = described.points;
-  node.key.descriptors = described.descriptors;  // shared
-  if (options_.direct_index_levels_up > 0) node.groups = Groups(node.key.descriptors);
+KeyFrameNode PlaceRecognizer::StoredNode(const KeyFrameNode& described) const {
+  KeyFrameNode node;
+  node.flight = described.flight;
+  node.timestamp_ns = described.timestamp_ns;
+  node.frame_index = described.frame_index;
+  node.points = described.points;
+  node.descriptors = described.descriptors;  // shared
   return node;
 }
 
 int PlaceRecognizer::AddDescribedNode(const KeyFrameNode& described) {
-  Node node = StoredNode(described);
+  KeyFrameNode node = StoredNode(described);
   const int id = static_cast<int>(database_.Add(described.bow));
   nodes_.push_back(std::move(node));
   return id;
@@ -309,21 +257,17 @@ Status PlaceRecognizer::AddKeyFrame(const KeyFrame& key_frame, PlaceResult* resu
   }
   *result = PlaceResult();
   const auto start = std::chrono::steady_clock::now();
-  Node node;
-  node.key.flight = key_frame.flight;
-  node.key.timestamp_ns = key_frame.timestamp_ns;
-  node.key.frame_index = key_frame.frame_index;
-  DescribeFeatures(key_frame.image, options_, &node.key.points, &node.key.descriptors);
+  KeyFrameNode node;
+  node.flight = key_frame.flight;
+  node.timestamp_ns = key_frame.timestamp_ns;
+  node.frame_index = key_frame.frame_index;
+  DescribeFeatures(key_frame.image, options_, &node.points, &node.descriptors);
   vocab::BowVector bow;
   std::vector<vocab::WordId> words;
-  vocabulary_->Quantize(node.key.descriptors, &words);
+  vocabulary_->Quantize(node.descriptors, &words);
   vocab::MakeBowVector(words, vocabulary_->idf().data(), &bow);
-  if (options_.direct_index_levels_up > 0) {
-    for (vocab::WordId word : words)
-      node.groups.push_back(vocabulary_->AncestorOf(word, options_.direct_index_levels_up));
-  }
-  result->features = node.key.descriptors.rows;
-  node.key.descriptors = StoredDescriptors(node.key.descriptors, options_);
+  result->features = node.descriptors.rows;
+  node.descriptors = StoredDescriptors(node.descriptors, options_);
   result->seconds_features = Since(start);
   Recognise(key_frame, std::move(node), bow, result);
   return Status::Ok();
@@ -336,12 +280,12 @@ void PlaceRecognizer::AddDescribedKeyFrame(const KeyFrameNode& described, bool t
   key_frame.timestamp_ns = described.timestamp_ns;
   key_frame.frame_index = described.frame_index;
   key_frame.timed = timed;
-  Node node = StoredNode(described);
-  result->features = node.key.descriptors.rows;
+  KeyFrameNode node = StoredNode(described);
+  result->features = node.descriptors.rows;
   Recognise(key_frame, std::move(node), described.bow, result);
 }
 
-void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow,
+void PlaceRecognizer::Recognise(const KeyFrame& key_frame, KeyFrameNode node, const vocab::BowVector& bow,
                                 PlaceResult* result) {
   auto start = std::chrono::steady_clock::now();
   std::vector<vocab::QueryResult> candidates;
@@ -352,10 +296,8 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
 
   start = std::chrono::steady_clock::now();
   for (const vocab::QueryResult& candidate : candidates) {
-    const Node& other = nodes_[candidate.entry];
-    const bool direct = options_.direct_index_levels_up > 0;
-    Verification verification = Verify(node.key.points, node.key.descriptors, other.key.points, other.key.descriptors,
-                                       direct ? &node.groups : nullptr, direct ? &other.groups : nullptr);
+    const KeyFrameNode& other = nodes_[candidate.entry];
+    Verification verification = Verify(node.points, node.descriptors, other.points, other.descriptors);
     verification.node = static_cast<int>(candidate.entry);
     verification.bow_score = candidate.score;
     result->candidates.push_back(verification);
@@ -365,10 +307,9 @@ void PlaceRecognizer::Recognise(const KeyFrame& key_frame, Node node, const voca
   }
   result->seconds_verify = Since(start);
 
-  last_match_[key_frame.flight] = result->match ? result->match->node : -1;
   start = std::chrono::steady_clock::now();
   result->node = static_cast<int>(database_.Add(bow));
-  result->described = node.key;  // the descriptors shared
+  result->described = node;  // the descriptors shared
   result->described.bow = bow;
   nodes_.push_back(std::move(node));
   result->seconds_add = Since(start);

@@ -185,12 +185,6 @@ void Vocabulary::Transform(const cv::Mat& descriptors, BowVector* bow) const {
   MakeBowVector(words, idf_.data(), bow);
 }
 
-std::uint32_t Vocabulary::AncestorOf(WordId word, int levels_up) const {
-  std::uint32_t node = leaf_[word];
-  for (int i = 0; i < levels_up && node != 0; ++i) node = parent_[node];
-  return node;
-}
-
 std::uint64_t Vocabulary::Fingerprint() const {
   const std::int32_t parameters[3] = {branching_, depth_, dimension_};
   std::uint64_t hash = Checksum(reinterpret_cast<const char*>(parameters), sizeof(parameters));

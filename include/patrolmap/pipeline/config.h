@@ -76,8 +76,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.one_to_one", &place.one_to_one);
   visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.descriptor_bits", &place.descriptor_bits);
-  visitor->Field("place.max_topological_gap", &place.max_topological_gap);
-  visitor->Field("place.direct_index_levels_up", &place.direct_index_levels_up);
   visitor->Field("place.query_words", &place.query.max_words);
   visitor->Field("place.rescored_entries", &place.query.rescored);
   visitor->Field("place.query_min_skipped_postings", &place.query.min_skipped_postings);

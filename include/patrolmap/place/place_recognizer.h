@@ -58,13 +58,6 @@ struct PlaceOptions {
   // feature. Query and stored descriptors are quantised alike.
   bool compact_descriptors = true;
   int descriptor_bits = 4;  // 8 or 4, when compact
-  // Reject topologically implausible candidates (the paper's future work): when the previous node
-  // of the query's flight closed a loop to node m, a candidate must lie on m's flight within this
-  // many nodes of m along the path. 0 turns the check off.
-  int max_topological_gap = 0;
-  // Direct index: match only features that share the vocabulary node this many levels above
-  // their words (DBoW2's direct index), instead of every feature with every feature. 0 = brute force.
-  int direct_index_levels_up = 0;
   // How much of the inverted index a query reads (vocab::QueryOptions): exhaustive, or two-stage (the lists
   // of the query's rarest words, then the best entries scored exactly).
   vocab::QueryOptions query;
@@ -131,13 +124,11 @@ struct PlaceResult {
   double seconds_features = 0.0, seconds_query = 0.0, seconds_verify = 0.0, seconds_add = 0.0;
 };
 
-// Verifies two described frames: ratio-test matching (within equal direct-index groups when both are given),
+// Verifies two described frames: ratio-test matching of every feature with every feature,
 // the matched-fraction rule, a fundamental matrix by `options.method`, and the inlier and a-contrario rules.
 // With `inliers`, the fundamental matrix's inlier matches as (query feature, candidate feature) pairs.
 Verification VerifyPair(const PlaceOptions& options, const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
                         const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
-                        const std::vector<std::uint32_t>* query_groups = nullptr,
-                        const std::vector<std::uint32_t>* candidate_groups = nullptr,
                         std::vector<std::pair<int, int>>* inliers = nullptr);
 
 class PlaceRecognizer {
@@ -157,36 +148,25 @@ class PlaceRecognizer {
 
   // Recognises a node described earlier (a map's, when maps are merged) as AddKeyFrame recognises a key
   // frame, from its stored features and BoW vector, then adds it. `timed`: its log had timestamps. With the
-  // stored features of a key frame, the result is AddKeyFrame's (with the direct index, up to the words
-  // re-quantised from 8-bit descriptors).
+  // stored features of a key frame, the result is AddKeyFrame's.
   void AddDescribedKeyFrame(const KeyFrameNode& node, bool timed, PlaceResult* result);
 
-  // Verifies two described frames (matching, fraction rule, F-RANSAC). With `groups` (the
-  // direct-index node of each feature) matching stays inside equal groups.
+  // Verifies two described frames (matching, fraction rule, F-RANSAC).
   Verification Verify(const std::vector<cv::Point2f>& query_points, const cv::Mat& query,
-                      const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate,
-                      const std::vector<std::uint32_t>* query_groups = nullptr,
-                      const std::vector<std::uint32_t>* candidate_groups = nullptr) const;
+                      const std::vector<cv::Point2f>& candidate_points, const cv::Mat& candidate) const;
 
  private:
-  // What the recognizer keeps of a node: its flight, time, frame and features (its BoW vector is the database's),
-  // with the direct-index node of each feature (when enabled).
-  struct Node {
-    KeyFrameNode key;
-    std::vector<std::uint32_t> groups;
-  };
-  Node StoredNode(const KeyFrameNode& described) const;  // a described node's, its groups re-quantised
+  // What the recognizer keeps of a described node: its flight, time, frame and features (its BoW vector is the
+  // database's; the descriptors shared).
+  KeyFrameNode StoredNode(const KeyFrameNode& described) const;
   bool Allowed(const KeyFrame& query, int node) const;
   // Queries the database for `node`'s place, verifies the candidates, and adds it.
-  void Recognise(const KeyFrame& key_frame, Node node, const vocab::BowVector& bow, PlaceResult* result);
-  std::vector<std::uint32_t> Groups(const cv::Mat& descriptors) const;  // direct-index groups of stored features
-  bool Plausible(const KeyFrame& query, int node) const;
+  void Recognise(const KeyFrame& key_frame, KeyFrameNode node, const vocab::BowVector& bow, PlaceResult* result);
 
   const vocab::Vocabulary* vocabulary_;
   PlaceOptions options_;
   vocab::Database database_;
-  std::vector<Node> nodes_;
-  std::map<std::string, int> last_match_;  // per flight: loop closure of its latest node, -1 for none
+  std::vector<KeyFrameNode> nodes_;
 };
 
 }  // namespace patrolmap::place

@@ -62,10 +62,6 @@ class Vocabulary {
   void Quantize(const cv::Mat& descriptors, std::vector<WordId>* words) const;
   void Transform(const cv::Mat& descriptors, BowVector* bow) const;
 
-  // The ancestor at `levels_up` levels above the word's leaf (0: the leaf
-  // itself); groups features for matching (the direct index).
-  std::uint32_t AncestorOf(WordId word, int levels_up) const;
-
   int word_count() const { return static_cast<int>(idf_.size()); }
   int node_count() const { return static_cast<int>(first_child_.size()); }
   int dimension() const { return dimension_; }
