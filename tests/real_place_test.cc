@@ -113,13 +113,12 @@ TEST(RealPairs, DefaultVerificationFindsRevisitsAndRejectsEveryOtherPair) {
   EXPECT_EQ(alone.false_accepts, 0);
   EXPECT_EQ(alone.found, counts.found);
   // Nodes keep 4-bit descriptors by default; with 8 bits and with floats every pair is judged the same.
-  for (const bool compact : {true, false}) {
+  for (const int bits : {8, 32}) {
     PlaceOptions wider;
-    wider.compact_descriptors = compact;
-    wider.descriptor_bits = 8;
+    wider.descriptor_bits = bits;
     const PairCounts other = VerifyAllPairs(images, wider);
-    EXPECT_EQ(other.found, counts.found) << compact;
-    EXPECT_EQ(other.false_accepts, counts.false_accepts) << compact;
+    EXPECT_EQ(other.found, counts.found) << bits;
+    EXPECT_EQ(other.false_accepts, counts.false_accepts) << bits;
   }
 }
 

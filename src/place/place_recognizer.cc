@@ -150,7 +150,8 @@ bool ParseFundamentalMethod(const std::string& text, FundamentalMethod* method) 
 bool PlaceOptions::IsValid(std::string* error) const {
   return OptionCheck(error)
              .InRange("place.max_features", max_features, 8, 100000)
-             .Holds("place.descriptor_bits", descriptor_bits, descriptor_bits == 4 || descriptor_bits == 8, "4 or 8")
+             .Holds("place.descriptor_bits", descriptor_bits,
+                    descriptor_bits == 4 || descriptor_bits == 8 || descriptor_bits == 32, "4, 8 or 32")
              .InRange("place.candidates", candidates, 1, 1000)
              .InRange("place.exclude_recent_s", exclude_recent_s, 0.0, 1e10)
              .InRange("place.exclude_recent_images", exclude_recent_images, 0, 1000000)
@@ -181,7 +182,7 @@ void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::ve
 }
 
 cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& options) {
-  if (!options.compact_descriptors) return descriptors;
+  if (options.descriptor_bits == 32) return descriptors;
   cv::Mat bytes(0, vocab::kDescriptorDimension, CV_8U);  // RootSIFT (0..1) scaled by 255, SIFT (0..255) as it is
   if (descriptors.rows > 0) descriptors.convertTo(bytes, CV_8U, options.root_sift ? 255.0 : 1.0);
   return options.descriptor_bits == 4 ? vocab::PackDescriptors(bytes) : bytes;

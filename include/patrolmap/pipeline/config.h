@@ -74,7 +74,6 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("place.max_log_nfa", &place.max_log_nfa);
   visitor->Field("place.accept_best", &place.accept_best);
   visitor->Field("place.one_to_one", &place.one_to_one);
-  visitor->Field("place.compact_descriptors", &place.compact_descriptors);
   visitor->Field("place.descriptor_bits", &place.descriptor_bits);
   visitor->Field("place.query_words", &place.query.max_words);
   visitor->Field("place.rescored_entries", &place.query.rescored);

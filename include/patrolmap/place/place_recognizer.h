@@ -53,11 +53,10 @@ struct PlaceOptions {
   // repeated facades 26 m apart); BENCHMARKS.md, "Verification on real revisits".
   double max_log_nfa = -20.0;
   bool accept_best = false;  // verify every candidate and keep the best (paper: the first that passes)
-  // Keep node descriptors in 8 bits (RootSIFT scaled by 255; SIFT is 0..255 already), matched as such; with
-  // descriptor_bits 4, two components a byte at steps of 7 (vocab/descriptors.h): 64 instead of 512 bytes a
-  // feature. Query and stored descriptors are quantised alike.
-  bool compact_descriptors = true;
-  int descriptor_bits = 4;  // 8 or 4, when compact
+  // Bits a node keeps of each descriptor component, matched as such: 32 (floats), 8 (RootSIFT scaled by 255; SIFT is
+  // 0..255 already) or 4 (two components a byte at steps of 7, vocab/descriptors.h: 64 instead of 512 bytes a
+  // feature). Query and stored descriptors are quantised alike.
+  int descriptor_bits = 4;
   // How much of the inverted index a query reads (vocab::QueryOptions): exhaustive, or two-stage (the lists
   // of the query's rarest words, then the best entries scored exactly).
   vocab::QueryOptions query;
@@ -72,7 +71,7 @@ void DescribeFeatures(const cv::Mat& image, const PlaceOptions& options, std::ve
                       cv::Mat* descriptors);
 
 // The descriptors a node keeps of DescribeFeatures' float rows: as they are, 8-bit, or packed 4-bit
-// (`compact_descriptors`, `descriptor_bits`; vocab/descriptors.h).
+// (`descriptor_bits`; vocab/descriptors.h).
 cv::Mat StoredDescriptors(const cv::Mat& descriptors, const PlaceOptions& options);
 
 // A key frame to recognise.
