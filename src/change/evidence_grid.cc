@@ -437,9 +437,11 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
     if (cells.empty() || cells.back() != cell) cells.push_back(cell);
     const double delta = Occupancy(b) - Occupancy(a);
     const bool one_free = std::min(Occupancy(a), Occupancy(b)) <= options.max_free_occupancy;
-    if (std::max(Occupancy(a), Occupancy(b)) > options.max_free_occupancy + options.min_occupancy_change) {
-      ++change->surface_voxels;
-    }
+    // A surface voxel: occupied in one patrol at least; a changed voxel counts as one, so the differing share
+    // stays within 1.
+    const bool surface =
+        std::max(Occupancy(a), Occupancy(b)) > options.max_free_occupancy + options.min_occupancy_change;
+    if (surface) ++change->surface_voxels;
     const Eigen::Vector3i index(a.x, a.y, a.z);
     if (std::abs(delta) <= options.min_occupancy_change || !one_free) return;
     const VoxelEvidence &free = delta > 0 ? a : b, &occupied = delta > 0 ? b : a;
@@ -451,6 +453,7 @@ void DiffVoxels(const EvidenceGridData& before, const FindAfter& find_after, con
               : OccupiedNeighbour(find_after, index, options.surface_tolerance_voxels, options.vertical_tolerance);
       if (explained) return;
     }
+    if (!surface) ++change->surface_voxels;
     changed.push_back(index);
     centres.push_back(index.cast<double>() * size);
     deltas.push_back(delta);

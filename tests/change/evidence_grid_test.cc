@@ -482,6 +482,22 @@ TEST(GeometryChange, SurfacesThatDifferEverywhereAreAPoseErrorNotAChange) {
   EXPECT_TRUE(change.poses_disagree);
 }
 
+// A voxel free in one patrol and half occupied in the other (8 hits of 15 rays: 0.53) has changed, though it stays
+// under the surface voxels' occupancy (0.55); it counts as a surface voxel too, so the share of differing surface
+// voxels never exceeds one (the warning said "differ in 110 %").
+TEST(GeometryChange, TheDifferingShareCountsEveryChangedVoxelAsASurface) {
+  Cells before, after;
+  for (int x = 0; x < 10; ++x) {
+    before.push_back({{x, 0, 1}, {0, 15}});
+    after.push_back({{x, 0, 1}, {8, 7}});
+  }
+  GeometryChange change;
+  ASSERT_TRUE(DiffGrids(GridOf(before), GridOf(after), GeometryDiffOptions{}, &change));
+  EXPECT_EQ(change.differing_voxels, 10);
+  EXPECT_EQ(change.surface_voxels, 10);
+  EXPECT_DOUBLE_EQ(change.DifferingShare(), 1.0);
+}
+
 TEST(GeometryChange, DifferentVoxelSizesCannotBeCompared) {
   EvidenceGridData a, b;
   a.voxel_size = 0.2, b.voxel_size = 0.25;
