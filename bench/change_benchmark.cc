@@ -212,42 +212,6 @@ void BM_GeometryObjectsMovedVehicle(benchmark::State& state) {
 }
 BENCHMARK(BM_GeometryObjectsMovedVehicle)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
-// The partial move test (change.geometry_objects.partial_moves; argument 1 on, 0 off) on a vehicle's surfaces
-// (6.2 x 1.8 x 1.4 m, about 1,100 voxels) moved 2 m along itself: seen whole in the later patrol, in slices every
-// third voxel in the earlier one, so only the slices it left change
-// (GeometryObjects.AVehicleMovedLessThanItsLength...).
-void BM_GeometryObjectsPartialMove(benchmark::State& state) {
-  const auto grid = [](int x0, bool sliced) {
-    EvidenceGridData g;
-    g.voxel_size = 0.2;
-    for (int x = -10; x <= 50; ++x) {
-      for (int y = -10; y <= 20; ++y) {
-        for (int z = 0; z <= 10; ++z) {
-          const bool in = x >= x0 && x <= x0 + 30 && y >= 0 && y <= 8 && z >= 1 && z <= 7;
-          const bool inside = in && x > x0 && x < x0 + 30 && y > 0 && y < 8 && z > 1 && z < 7;
-          if (inside || (in && sliced && (x - x0) % 3 != 0)) continue;  // unseen
-          const bool occupied = z == 0 || in;
-          g.voxels.push_back(
-              {x, y, z, static_cast<std::uint16_t>(occupied ? 8 : 0), static_cast<std::uint16_t>(occupied ? 0 : 8)});
-        }
-      }
-    }
-    return g;
-  };
-  const EvidenceGridData before = grid(0, true), after = grid(10, false);
-  change::GeometryDiffOptions diff;
-  diff.max_differing_share = 1.0;
-  change::GeometryChange change;
-  change::DiffGrids(before, after, diff, &change);
-  const change::VoxelLookup prior = change::LookupIn(before), current = change::LookupIn(after);
-  change::GeometryObjectOptions options;
-  options.partial_moves = state.range(0) == 1;
-  std::vector<change::ObjectChange> objects;
-  for (auto _ : state) objects = change::GeometryObjects(change, prior, current, {}, {}, options);
-  state.counters["moved"] = static_cast<double>(objects.size() == 1 && objects[0].state == change::ObjectState::kMoved);
-}
-BENCHMARK(BM_GeometryObjectsPartialMove)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-
 change::KeyFrameView Describe(const cv::Mat& image) {
   change::KeyFrameView view;
   cv::Mat thumbnail;

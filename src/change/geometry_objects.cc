@@ -178,30 +178,6 @@ std::vector<VoxelCluster> MergeWhere(std::vector<VoxelCluster> objects, double v
   return objects;
 }
 
-// A voxel rays passed (at least separating_rays) that holds no surface.
-bool SeenFree(const VoxelEvidence& voxel, const GeometryObjectOptions& options) {
-  return voxel.hits + voxel.passes >= options.separating_rays && !IsSurface(voxel, options.min_surface_occupancy);
-}
-
-// Whether the patrol's grid shows free space between two objects: a voxel on the straight line between their
-// centroids, in neither of them, that rays passed (at least `separating_rays`) and that holds no surface. A vehicle
-// seen by stereo only at its ends (its flat sides give no match) has no ray inside it: unseen, not free.
-bool SeenApart(const VoxelCluster& a, const VoxelCluster& b, const VoxelLookup& grid, double voxel,
-               const GeometryObjectOptions& options) {
-  std::unordered_set<std::uint64_t> members;
-  for (const Eigen::Vector3i& v : a.voxels) members.insert(VoxelKey(v));
-  for (const Eigen::Vector3i& v : b.voxels) members.insert(VoxelKey(v));
-  const Eigen::Vector3d from = a.Centroid(), to = b.Centroid();
-  const int steps = static_cast<int>(std::ceil((to - from).norm() / (voxel / 2)));
-  VoxelEvidence evidence;
-  for (int i = 1; i < steps; ++i) {
-    const Eigen::Vector3i index = VoxelIndex(from + (to - from) * (static_cast<double>(i) / steps), voxel);
-    if (members.count(VoxelKey(index)) > 0 || !grid(index, &evidence)) continue;
-    if (SeenFree(evidence, options)) return true;
-  }
-  return false;
-}
-
 std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appeared, const VoxelLookup& grid,
                                          const std::vector<MapObject>& detected, const GeometryObjectOptions& options) {
   std::vector<VoxelCluster> seeds;
@@ -218,12 +194,6 @@ std::vector<VoxelCluster> ObjectClusters(const GeometryChange& change, bool appe
   objects = MergeWhere(std::move(objects), change.voxel_size, [&options](const VoxelCluster& a, const VoxelCluster& b) {
     return FootprintsMeet(a, b, options.footprint_gap_m + 1e-6);
   });
-  // Near, and no free space seen between them: the ends of a vehicle whose sides and top stereo does not see.
-  if (grid && options.unseen_join_m > 0.0) {
-    objects = MergeWhere(std::move(objects), change.voxel_size, [&](const VoxelCluster& a, const VoxelCluster& b) {
-      return FootprintsMeet(a, b, options.unseen_join_m) && !SeenApart(a, b, grid, change.voxel_size, options);
-    });
-  }
   for (VoxelCluster& cluster : objects) {
     if (IsObjectSized(cluster, options) && !HoldsDetection(cluster, detected, options.detection_margin_m)) {
       clusters.push_back(std::move(cluster));
@@ -295,8 +265,7 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double 
   const Eigen::Vector3d shift = after_centroid - before_centroid;
   const double distance = shift.head<2>().norm();
   if (distance > options.max_move_m) return false;
-  const double top_difference = std::abs(after.box.max().z() - before.box.max().z());
-  if (top_difference > std::max(options.max_top_difference_m, options.alike_top_difference_m)) return false;
+  if (std::abs(after.box.max().z() - before.box.max().z()) > options.max_top_difference_m) return false;
   // The registration of partial surfaces can flip an axis: keep it only where it fits better than none.
   const Eigen::Matrix3d registered = RegisterRotation(before.points, after.points);
   const ShapePair pair(before, after, before_centroid, after_centroid);
@@ -307,8 +276,6 @@ bool MayHaveMoved(const VoxelCluster& before, const VoxelCluster& after, double 
   candidate->overlap = std::max(unrotated, rotated);
   candidate->rotation = rotated > unrotated ? registered : Eigen::Matrix3d::Identity();
   if (candidate->overlap < options.min_shape_overlap) return false;
-  // A top a voxel apart only for shapes that agree closely (the top of a crate whose lid lies on a voxel boundary).
-  if (top_difference > options.max_top_difference_m && candidate->overlap < options.alike_shape_overlap) return false;
   candidate->cost = MoveCost(distance, candidate->overlap, options);
   return true;
 }
@@ -342,183 +309,6 @@ std::vector<MoveCandidate> PairMoves(const std::vector<VoxelCluster>& vanished,
     }
   }
   return TakeCheapest(std::move(candidates), vanished_used, appeared_used);
-}
-
-// The voxel keys of `cluster` and of every voxel within `reach` voxels of one of them.
-std::unordered_set<std::uint64_t> Dilated(const VoxelCluster& cluster, int reach) {
-  std::unordered_set<std::uint64_t> keys;
-  for (const Eigen::Vector3i& v : cluster.voxels) {
-    for (int dz = -reach; dz <= reach; ++dz) {
-      for (int dy = -reach; dy <= reach; ++dy) {
-        for (int dx = -reach; dx <= reach; ++dx) keys.insert(VoxelKey(v + Eigen::Vector3i(dx, dy, dz)));
-      }
-    }
-  }
-  return keys;
-}
-
-// Whether `grid` holds a surface within `reach` voxels of `index` at its height (a moved object keeps its height;
-// the ground below it is no surface it left).
-bool SurfaceNear(const Eigen::Vector3i& index, int reach, const VoxelLookup& grid, double min_occupancy) {
-  VoxelEvidence evidence;
-  for (int dy = -reach; dy <= reach; ++dy) {
-    for (int dx = -reach; dx <= reach; ++dx) {
-      if (grid(index + Eigen::Vector3i(dx, dy, 0), &evidence) && IsSurface(evidence, min_occupancy)) return true;
-    }
-  }
-  return false;
-}
-
-// One object seen whole in one patrol and only by the part of it that changed in the other: an object moved less
-// than its own length, whose other part lies where the object stands in the other patrol, unchanged to the grids.
-struct PartialMove {
-  std::size_t vanished = 0, appeared = 0;
-  bool appeared_whole = false;                      // the whole object is the appeared one (else the vanished one)
-  Eigen::Vector3i shift = Eigen::Vector3i::Zero();  // [voxels] the whole, shifted by this, stands where it was (is)
-  double cost = 0.0, overlap = 0.0;
-};
-
-// The grids of a whole object's patrol (`own`) and of the other patrol (`other`), where its part changed.
-struct GridPair {
-  const VoxelLookup& own;
-  const VoxelLookup& other;
-};
-
-// Where a whole object, shifted, lands in the other patrol's grid: shares of its voxels.
-struct Landing {
-  double on_left_surface = 0.0;  // on surfaces the other grid holds (within `reach` voxels) and its own grid does not
-                                 // hold outside the whole: the place it left or took, not structure both patrols saw
-  double on_free_space = 0.0;    // where the other grid saw free space and no surface within reach: it did not stand
-                                 // there
-  double on_left_voxel = 0.0;    // as on_left_surface, on such a surface voxel itself (how exactly it lands)
-};
-
-Landing LandShifted(const VoxelCluster& whole, const Eigen::Vector3i& shift,
-                    const std::unordered_set<std::uint64_t>& own_reach, const GridPair& grids, int reach,
-                    const GeometryObjectOptions& options) {
-  int landed = 0, free = 0, exact = 0;
-  VoxelEvidence evidence;
-  for (const Eigen::Vector3i& v : whole.voxels) {
-    const Eigen::Vector3i there = v + shift;
-    if (!SurfaceNear(there, reach, grids.other, options.min_surface_occupancy)) {
-      free += grids.other(there, &evidence) && SeenFree(evidence, options);
-      continue;
-    }
-    const bool still_there = own_reach.count(VoxelKey(there)) == 0 && grids.own(there, &evidence) &&
-                             IsSurface(evidence, options.min_surface_occupancy);
-    if (still_there) continue;
-    ++landed;
-    exact += SurfaceNear(there, 0, grids.other, options.min_surface_occupancy);
-  }
-  Landing landing;
-  if (whole.voxels.empty()) return landing;
-  const double voxels = static_cast<double>(whole.voxels.size());
-  landing.on_left_surface = landed / voxels;
-  landing.on_free_space = free / voxels;
-  landing.on_left_voxel = exact / voxels;
-  return landing;
-}
-
-// Whether at least `share` of `part` lies outside the footprint of `whole` (the box of its voxel centres).
-bool MostlyOutside(const VoxelCluster& part, const VoxelCluster& whole, double share) {
-  const Eigen::AlignedBox3d& box = whole.box;
-  const auto outside = std::count_if(part.points.begin(), part.points.end(), [&box](const Eigen::Vector3f& p) {
-    return p.x() < box.min().x() || p.x() > box.max().x() || p.y() < box.min().y() || p.y() > box.max().y();
-  });
-  return static_cast<double>(outside) >= share * static_cast<double>(part.points.size());
-}
-
-// Whether shifting `whole` by (i, j) voxels may make it the other side of a move of which `part` is the changed end:
-// farther than shape_search_m and at most max_move_m, less than the whole's own extent along each axis (where it
-// was and where it is overlap) and farther than the part reaches along the shift (the part is the ground the object
-// left or took, not a whole object standing in its place).
-bool PartialShiftAllowed(int i, int j, const VoxelCluster& whole, const VoxelCluster& part, double voxel,
-                         const GeometryObjectOptions& options) {
-  const double distance = voxel * std::hypot(i, j);
-  if (distance <= options.shape_search_m || distance > options.max_move_m) return false;
-  const Eigen::Vector3d size = whole.box.sizes(), part_size = part.box.sizes();
-  if (std::abs(i) * voxel >= size.x() || std::abs(j) * voxel >= size.y()) return false;
-  return std::abs(i) * part_size.x() + std::abs(j) * part_size.y() < voxel * (i * i + j * j);
-}
-
-// The best horizontal shift (in voxels; PartialShiftAllowed) that moves `whole` onto `part`, the part mostly outside
-// the whole's footprint: at least min_shape_overlap of the part within shape_tolerance_m of the shifted whole, and
-// as much of the shifted whole landing on surfaces it left, at most max_partial_free_share on free space
-// (LandShifted). False when none qualifies; `overlap` is the smaller of the two shares at the best shift.
-bool ShiftOntoPart(const VoxelCluster& whole, const VoxelCluster& part, const GridPair& grids, double voxel,
-                   const GeometryObjectOptions& options, Eigen::Vector3i* best_shift, double* overlap) {
-  *overlap = 0.0;
-  if (!MostlyOutside(part, whole, options.min_shape_overlap)) return false;
-  const int reach = static_cast<int>(std::floor(options.shape_tolerance_m / voxel + 1e-9));
-  const PointIndex index(whole.points);
-  const std::unordered_set<std::uint64_t> own_reach = Dilated(whole, reach);
-  std::vector<Eigen::Vector3f> moved_part(part.points.size());
-  double best_exact = 0.0;
-  // Shifts that bring the whole's box within reach of the part's.
-  Eigen::Vector2i low, high;
-  for (int axis = 0; axis < 2; ++axis) {
-    low[axis] = static_cast<int>(std::floor((part.box.min()[axis] - whole.box.max()[axis]) / voxel)) - reach;
-    high[axis] = static_cast<int>(std::ceil((part.box.max()[axis] - whole.box.min()[axis]) / voxel)) + reach;
-  }
-  for (int i = low.x(); i <= high.x(); ++i) {
-    for (int j = low.y(); j <= high.y(); ++j) {
-      if (!PartialShiftAllowed(i, j, whole, part, voxel, options)) continue;
-      const Eigen::Vector3f offset(static_cast<float>(i * voxel), static_cast<float>(j * voxel), 0.0f);
-      for (std::size_t k = 0; k < part.points.size(); ++k) moved_part[k] = part.points[k] - offset;
-      const double covered = index.PairFraction(moved_part, options.shape_tolerance_m);
-      if (covered < options.min_shape_overlap || covered < *overlap) continue;
-      const Eigen::Vector3i shift(i, j, 0);
-      const Landing landing = LandShifted(whole, shift, own_reach, grids, reach, options);
-      const double landed = landing.on_left_surface;
-      if (landed < options.min_shape_overlap || landing.on_free_space > options.max_partial_free_share ||
-          std::min(covered, landed) < *overlap) {
-        continue;
-      }
-      // Shifts a voxel apart often tie within the tolerance: the one landing more exactly on the surfaces wins.
-      if (std::min(covered, landed) == *overlap && landing.on_left_voxel <= best_exact) continue;
-      *overlap = std::min(covered, landed);
-      *best_shift = shift;
-      best_exact = landing.on_left_voxel;
-    }
-  }
-  return *overlap > 0.0;
-}
-
-// Pairs the vanished and appeared objects no move took, where one is whole and the other the part of it that changed
-// (ShiftOntoPart, either way round), greedily by paper 003's weighted distance.
-std::vector<PartialMove> PairPartialMoves(const std::vector<VoxelCluster>& vanished,
-                                          const std::vector<VoxelCluster>& appeared, std::vector<bool>* vanished_used,
-                                          std::vector<bool>* appeared_used, const VoxelLookup& prior_grid,
-                                          const VoxelLookup& current_grid, double voxel,
-                                          const GeometryObjectOptions& options) {
-  std::vector<PartialMove> candidates;
-  for (std::size_t v = 0; v < vanished.size(); ++v) {
-    for (std::size_t a = 0; a < appeared.size(); ++a) {
-      if ((*vanished_used)[v] || (*appeared_used)[a]) continue;
-      // No shift of at most max_move_m brings objects of at most max_size_m together from farther.
-      const double apart = (vanished[v].Position() - appeared[a].Position()).head<2>().norm();
-      if (apart > options.max_move_m + options.max_size_m) continue;
-      for (const bool appeared_whole : {true, false}) {
-        const VoxelCluster& whole = appeared_whole ? appeared[a] : vanished[v];
-        const VoxelCluster& part = appeared_whole ? vanished[v] : appeared[a];
-        const GridPair grids{appeared_whole ? current_grid : prior_grid, appeared_whole ? prior_grid : current_grid};
-        PartialMove move;
-        move.vanished = v, move.appeared = a, move.appeared_whole = appeared_whole;
-        if (!ShiftOntoPart(whole, part, grids, voxel, options, &move.shift, &move.overlap)) continue;
-        move.cost = MoveCost(voxel * move.shift.cast<double>().norm(), move.overlap, options);
-        candidates.push_back(move);
-      }
-    }
-  }
-  return TakeCheapest(std::move(candidates), vanished_used, appeared_used);
-}
-
-// `cluster` shifted by `shift` voxels.
-VoxelCluster Shifted(const VoxelCluster& cluster, const Eigen::Vector3i& shift, double voxel) {
-  VoxelCluster shifted;
-  for (const Eigen::Vector3i& v : cluster.voxels) shifted.Add(v + shift, voxel);
-  shifted.mean_change = cluster.mean_change;
-  return shifted;
 }
 
 ObjectChange ClassAgnostic(ObjectState state, const VoxelCluster* before, const VoxelCluster* after) {
@@ -598,15 +388,6 @@ std::vector<ObjectChange> GeometryObjects(const GeometryChange& change, const Vo
     ObjectChange moved = Moved(vanished[move.vanished], appeared[move.appeared], move.overlap, move.cost);
     moved.rotation = move.rotation;
     objects.push_back(std::move(moved));
-  }
-  if (options.partial_moves && prior_grid && current_grid) {
-    for (const PartialMove& move : PairPartialMoves(vanished, appeared, &vanished_moved, &appeared_moved, prior_grid,
-                                                    current_grid, change.voxel_size, options)) {
-      const VoxelCluster& whole = move.appeared_whole ? appeared[move.appeared] : vanished[move.vanished];
-      const VoxelCluster other_place = Shifted(whole, move.shift, change.voxel_size);
-      objects.push_back(move.appeared_whole ? Moved(other_place, whole, move.overlap, move.cost)
-                                            : Moved(whole, other_place, move.overlap, move.cost));
-    }
   }
   for (std::size_t v = 0; v < vanished.size(); ++v) {
     if (!vanished_moved[v]) objects.push_back(ClassAgnostic(ObjectState::kRemoved, &vanished[v], nullptr));

@@ -3,23 +3,17 @@
 // free (vanished) are grouped apart into clusters of voxels at most cluster_gap_voxels apart. With complete_objects
 // each cluster then grows in its patrol's grid into the object it belongs to (the occupied voxels above the ground
 // connected to it; paper 003 segments the changed space in the mission's map), and clusters that grew into one
-// object merge, and so do clusters whose footprints meet (a side and a top the grid does not connect) and, with a
-// grid, those within unseen_join_m whose grid shows no free space on the line between them (a vehicle that stereo
-// sees by its ends only: no ray enters it). A cluster of at least min_voxels and at most max_size_m across is an
-// object: appeared, it is new; vanished, it was removed. A vanished and an appeared cluster are one object moved when
-// they lie within max_move_m, their tops differ by at most max_top_difference_m (alike_top_difference_m where the
-// overlap below is at least alike_shape_overlap) and each, registered onto the other (centroids aligned, then the
-// best horizontal shift of up to shape_search_m each way in steps of a voxel or half shape_tolerance_m, since a partial
-// view pulls a centroid off the object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its
-// voxels within shape_tolerance_m of the other's; pairs are taken greedily by paper 003's weighted distance
-// (physical_weight x distance / max_move_m + (1 - physical_weight) x (1 - overlap)). An object moved less than its
-// own length changes only at the ground it left and took; where one patrol's grid completes it whole and the other's
-// holds only that changed part, the two are one move (partial_moves) when the whole, shifted, covers the part and lands
-// on surfaces the other grid holds and its own does not (the whole reported at both places). Unchanged space never
-// makes an object, so these objects are never persistent or unobserved. Detections (objects0/) take precedence: a
-// cluster whose box, grown by detection_margin_m, holds the centroid of an object its patrol's detector mapped, or at
-// least half of whose voxels lie in that object's box grown by detection_margin_m, is left to the detected objects'
-// states.
+// object merge, and so do clusters whose footprints meet (a side and a top the grid does not connect). A cluster of at
+// least min_voxels and at most max_size_m across is an object: appeared, it is new; vanished, it was removed. A
+// vanished and an appeared cluster are one object moved when they lie within max_move_m, their tops differ by at most
+// max_top_difference_m and each, registered onto the other (centroids aligned, then the best horizontal shift of up to
+// shape_search_m each way in steps of a voxel or half shape_tolerance_m, since a partial view pulls a centroid off the
+// object's centre; rotation by RegisterRotation), has at least min_shape_overlap of its voxels within shape_tolerance_m
+// of the other's; pairs are taken greedily by paper 003's weighted distance (physical_weight x distance / max_move_m +
+// (1 - physical_weight) x (1 - overlap)). Unchanged space never makes an object, so these objects are never persistent
+// or unobserved. Detections (objects0/) take precedence: a cluster whose box, grown by detection_margin_m, holds the
+// centroid of an object its patrol's detector mapped, or at least half of whose voxels lie in that object's box grown
+// by detection_margin_m, is left to the detected objects' states.
 #pragma once
 
 #include <vector>

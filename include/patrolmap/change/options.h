@@ -149,22 +149,6 @@ struct GeometryObjectOptions {
   double detection_margin_m = 0.5;     // a cluster whose box grown by this holds a detected object of its patrol,
                                        // or half of which lies in that object's box grown by this, is left to the
                                        // detector [m]
-  // Objects whose footprints come this close are one when the patrol's grid shows no free space on the line between
-  // their centroids (a voxel at least separating_rays rays passed, holding no surface): a vehicle whose ends stereo
-  // sees and whose flat sides and top it does not [m]; 0 = off.
-  double unseen_join_m = 4.0;
-  int separating_rays = 3;
-  // Moved: tops may differ by up to alike_top_difference_m when the shapes overlap by at least alike_shape_overlap
-  // (a lid on a voxel boundary is seen in the voxel above or below it) [m].
-  double alike_top_difference_m = 0.25;
-  double alike_shape_overlap = 0.9;
-  // An object moved less than its own length changes only at the parts that left and took new ground; one side of the
-  // move is then the whole object, the other only a part of it. A vanished and an appeared object no move took are
-  // one moved object when the whole one, shifted horizontally by more than shape_search_m and at most max_move_m,
-  // has min_shape_overlap of the part within shape_tolerance_m and lands, with min_shape_overlap of its voxels, on
-  // surfaces the other patrol's grid holds and its own does not (outside the object) ...
-  bool partial_moves = true;
-  double max_partial_free_share = 0.2;  // ... and where at most this share of it lies on space the other grid saw free
 };
 
 // Evidence grid of one patrol (paper 004).

@@ -154,15 +154,9 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.geometry_objects.min_surface_occupancy", &change.geometry_objects.min_surface_occupancy);
   visitor->Field("change.geometry_objects.ground_clearance_voxels", &change.geometry_objects.ground_clearance_voxels);
   visitor->Field("change.geometry_objects.footprint_gap_m", &change.geometry_objects.footprint_gap_m);
-  visitor->Field("change.geometry_objects.unseen_join_m", &change.geometry_objects.unseen_join_m);
-  visitor->Field("change.geometry_objects.separating_rays", &change.geometry_objects.separating_rays);
   visitor->Field("change.geometry_objects.max_size_m", &change.geometry_objects.max_size_m);
   visitor->Field("change.geometry_objects.max_move_m", &change.geometry_objects.max_move_m);
   visitor->Field("change.geometry_objects.max_top_difference_m", &change.geometry_objects.max_top_difference_m);
-  visitor->Field("change.geometry_objects.alike_top_difference_m", &change.geometry_objects.alike_top_difference_m);
-  visitor->Field("change.geometry_objects.alike_shape_overlap", &change.geometry_objects.alike_shape_overlap);
-  visitor->Field("change.geometry_objects.partial_moves", &change.geometry_objects.partial_moves);
-  visitor->Field("change.geometry_objects.max_partial_free_share", &change.geometry_objects.max_partial_free_share);
   visitor->Field("change.geometry_objects.min_shape_overlap", &change.geometry_objects.min_shape_overlap);
   visitor->Field("change.geometry_objects.shape_tolerance_m", &change.geometry_objects.shape_tolerance_m);
   visitor->Field("change.geometry_objects.shape_search_m", &change.geometry_objects.shape_search_m);
