@@ -44,11 +44,8 @@ void CheckObjectMap(const ObjectMapOptions& m, OptionCheck* check) {
 
 void CheckObjects(const ObjectDiffOptions& o, OptionCheck* check) {
   check->AboveAtMost("change.objects.match_distance_m", o.match_distance_m, 0.0, 1000.0)
-      .AboveAtMost("change.objects.pair_distance_m", o.pair_distance_m, 0.0, 1000.0)
-      .InRange("change.objects.min_pair_fraction", o.min_pair_fraction, 0.0, 1.0)
       .InRange("change.objects.max_move_m", o.max_move_m, 0.0, 10000.0)
       .InRange("change.objects.physical_weight", o.physical_weight, 0.0, 1.0)
-      .InRange("change.objects.max_texture_distance", o.max_texture_distance, 0.0, 1.0)
       .AboveAtMost("change.objects.max_visible_range_m", o.max_visible_range_m, 0.0, 10000.0)
       .InRange("change.objects.min_visible_fraction", o.min_visible_fraction, 0.0, 1.0)
       .AboveAtMost("change.objects.min_expected_detections", o.min_expected_detections, 0.0, 1e6)

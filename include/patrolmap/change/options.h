@@ -100,14 +100,10 @@ struct ObjectMapOptions {
 
 // State of every object between two patrols (papers 000, 001, 003).
 struct ObjectDiffOptions {
-  double match_distance_m = 1.0;       // persistent: centroids this close (then the point-pair test) ...
-  double pair_distance_m = 0.25;       // ... and at least min_pair_fraction of the points of the object seen less
-  double min_pair_fraction = 0.5;      // within this of the other's points (paper 000's point-pair test)
+  double match_distance_m = 1.0;       // persistent: same label, centroids this close [m]
   double max_move_m = 8.0;             // moved: the two positions at most this far apart (farther: removed + new)
   double physical_weight = 0.6;        // alpha of paper 003's weighted normalised distance; the appearance
                                        // distance weighs 1 - alpha (only the ratio orders the candidates)
-  double max_texture_distance = 0.25;  // pairs whose gradient-orientation histograms differ more (half their
-                                       // L1 distance) are not a move
   double max_visible_range_m = 20.0;   // visibility: a prior object farther than this is not covered by a view
   double min_visible_fraction = 0.5;   // visibility: at least this share of its projected box inside the image
   double min_expected_detections = 3;  // removed: the current views covering a prior object would have given at

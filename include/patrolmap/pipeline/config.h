@@ -112,11 +112,8 @@ void VisitConfig(Config* config, Visitor* visitor) {
   visitor->Field("change.object_map.max_range_m", &change.object_map.max_range_m);
   visitor->Field("change.object_map.max_objects", &change.object_map.max_objects);
   visitor->Field("change.objects.match_distance_m", &change.objects.match_distance_m);
-  visitor->Field("change.objects.pair_distance_m", &change.objects.pair_distance_m);
-  visitor->Field("change.objects.min_pair_fraction", &change.objects.min_pair_fraction);
   visitor->Field("change.objects.max_move_m", &change.objects.max_move_m);
   visitor->Field("change.objects.physical_weight", &change.objects.physical_weight);
-  visitor->Field("change.objects.max_texture_distance", &change.objects.max_texture_distance);
   visitor->Field("change.objects.max_visible_range_m", &change.objects.max_visible_range_m);
   visitor->Field("change.objects.min_visible_fraction", &change.objects.min_visible_fraction);
   visitor->Field("change.objects.min_expected_detections", &change.objects.min_expected_detections);
